@@ -1,0 +1,783 @@
+// HDF5 trajectory reader/writer (C API). Layout and guarantees: docs/format.md.
+#include "hdf5_trajectory.hpp"
+
+#include <hdf5.h>
+
+#include <array>
+#include <cstring>
+#include <fstream>
+#include <system_error>
+#include <vector>
+
+#include "errors.hpp"
+
+namespace gs {
+
+namespace {
+
+// ---------------------------------------------------------------- handles and helpers
+
+class Hid {
+ public:
+  Hid() = default;
+  Hid(hid_t id, herr_t (*closer)(hid_t)) : id_(id), closer_(closer) {}
+  Hid(const Hid&) = delete;
+  Hid& operator=(const Hid&) = delete;
+  Hid(Hid&& o) noexcept : id_(o.id_), closer_(o.closer_) { o.id_ = -1; }
+  Hid& operator=(Hid&& o) noexcept {
+    if (this != &o) {
+      reset();
+      id_ = o.id_;
+      closer_ = o.closer_;
+      o.id_ = -1;
+    }
+    return *this;
+  }
+  ~Hid() { reset(); }
+  void reset() {
+    if (id_ >= 0 && closer_) closer_(id_);
+    id_ = -1;
+  }
+  hid_t get() const { return id_; }
+  bool valid() const { return id_ >= 0; }
+
+ private:
+  hid_t id_ = -1;
+  herr_t (*closer_)(hid_t) = nullptr;
+};
+
+void quiet_hdf5() { H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr); }
+
+struct Column {
+  const char* group;
+  const char* name;
+  hid_t (*mem_type)();  // native type getter (H5T_NATIVE_* are runtime values)
+  std::vector<hsize_t> tail;
+  hsize_t chunk_rows;
+};
+
+hid_t t_f64() { return H5T_NATIVE_DOUBLE; }
+hid_t t_i64() { return H5T_NATIVE_INT64; }
+hid_t t_i32() { return H5T_NATIVE_INT32; }
+hid_t t_i8() { return H5T_NATIVE_INT8; }
+
+constexpr hsize_t kRowChunk = 4096;
+constexpr hsize_t kFrameChunk = 64;
+
+// Column order matters for the writer: /frames/end must stay last (commit marker).
+enum Col : int {
+  P_ID, P_POS, P_RAD, P_VEL, P_ANGVEL, P_ORI, P_ROT, P_MASS, P_CLUMP, P_MAT,
+  C_ID1, C_ID2, C_POINT, C_NORMAL, C_FN, C_FS, C_MB, C_MT, C_OVERLAP,
+  W_ID, W_KIND, W_A, W_B, W_FORCE, W_TORQUE,
+  F_TIME, F_STEP, F_DT, F_TWOD, F_LO, F_HI, F_PERIODIC, F_CELL, F_END,
+  N_COLS
+};
+
+const std::vector<Column>& columns() {
+  static const std::vector<Column> cols = {
+      {"particles", "id", t_i64, {}, kRowChunk},
+      {"particles", "position", t_f64, {3}, kRowChunk},
+      {"particles", "radius", t_f64, {}, kRowChunk},
+      {"particles", "velocity", t_f64, {3}, kRowChunk},
+      {"particles", "angular_velocity", t_f64, {3}, kRowChunk},
+      {"particles", "orientation", t_f64, {4}, kRowChunk},
+      {"particles", "rotation", t_f64, {3}, kRowChunk},
+      {"particles", "mass", t_f64, {}, kRowChunk},
+      {"particles", "clump_id", t_i64, {}, kRowChunk},
+      {"particles", "material_id", t_i32, {}, kRowChunk},
+      {"contacts", "id1", t_i64, {}, kRowChunk},
+      {"contacts", "id2", t_i64, {}, kRowChunk},
+      {"contacts", "point", t_f64, {3}, kRowChunk},
+      {"contacts", "normal", t_f64, {3}, kRowChunk},
+      {"contacts", "normal_force", t_f64, {3}, kRowChunk},
+      {"contacts", "shear_force", t_f64, {3}, kRowChunk},
+      {"contacts", "bending_moment", t_f64, {3}, kRowChunk},
+      {"contacts", "twisting_moment", t_f64, {3}, kRowChunk},
+      {"contacts", "overlap", t_f64, {}, kRowChunk},
+      {"walls", "id", t_i64, {}, kFrameChunk},
+      {"walls", "kind", t_i32, {}, kFrameChunk},
+      {"walls", "a", t_f64, {3}, kFrameChunk},
+      {"walls", "b", t_f64, {3}, kFrameChunk},
+      {"walls", "force", t_f64, {3}, kFrameChunk},
+      {"walls", "torque", t_f64, {3}, kFrameChunk},
+      {"frames", "time", t_f64, {}, kFrameChunk},
+      {"frames", "step", t_i64, {}, kFrameChunk},
+      {"frames", "dt", t_f64, {}, kFrameChunk},
+      {"frames", "two_d", t_i8, {}, kFrameChunk},
+      {"frames", "domain_lo", t_f64, {3}, kFrameChunk},
+      {"frames", "domain_hi", t_f64, {3}, kFrameChunk},
+      {"frames", "periodic", t_i8, {}, kFrameChunk},
+      {"frames", "cell", t_f64, {3, 3}, kFrameChunk},
+      {"frames", "end", t_i64, {3}, kFrameChunk},
+  };
+  return cols;
+}
+
+std::string col_path(const Column& c) { return std::string("/") + c.group + "/" + c.name; }
+
+hsize_t row_width(const Column& c) {
+  hsize_t w = 1;
+  for (auto t : c.tail) w *= t;
+  return w;
+}
+
+Hid latest_fapl() {
+  Hid fapl(H5Pcreate(H5P_FILE_ACCESS), H5Pclose);
+  H5Pset_libver_bounds(fapl.get(), H5F_LIBVER_LATEST, H5F_LIBVER_LATEST);
+  return fapl;
+}
+
+void write_string_attr(hid_t obj, const std::string& name, const std::string& value,
+                       const std::string& file) {
+  Hid type(H5Tcopy(H5T_C_S1), H5Tclose);
+  H5Tset_size(type.get(), std::max<size_t>(1, value.size()));
+  H5Tset_strpad(type.get(), H5T_STR_NULLPAD);
+  Hid space(H5Screate(H5S_SCALAR), H5Sclose);
+  Hid attr(H5Acreate2(obj, name.c_str(), type.get(), space.get(), H5P_DEFAULT, H5P_DEFAULT),
+           H5Aclose);
+  if (!attr.valid()) throw InputError(file, "cannot create attribute", name);
+  std::string buf = value.empty() ? std::string(1, '\0') : value;
+  if (H5Awrite(attr.get(), type.get(), buf.data()) < 0)
+    throw InputError(file, "cannot write attribute", name);
+}
+
+void write_int_attr(hid_t obj, const std::string& name, long long value, const std::string& file) {
+  Hid space(H5Screate(H5S_SCALAR), H5Sclose);
+  Hid attr(H5Acreate2(obj, name.c_str(), H5T_STD_I64LE, space.get(), H5P_DEFAULT, H5P_DEFAULT),
+           H5Aclose);
+  if (!attr.valid() || H5Awrite(attr.get(), H5T_NATIVE_LLONG, &value) < 0)
+    throw InputError(file, "cannot write attribute", name);
+}
+
+std::string read_string_attr(hid_t attr, const std::string& file, const std::string& name) {
+  Hid ftype(H5Aget_type(attr), H5Tclose);
+  if (!ftype.valid() || H5Tget_class(ftype.get()) != H5T_STRING)
+    throw InputError(file, "attribute is not a string", name);
+  Hid space(H5Aget_space(attr), H5Sclose);
+  if (!space.valid() || H5Sget_simple_extent_npoints(space.get()) != 1)
+    throw InputError(file, "attribute is not a scalar string", name);
+  if (H5Tis_variable_str(ftype.get()) > 0) {
+    Hid mtype(H5Tcopy(H5T_C_S1), H5Tclose);
+    H5Tset_size(mtype.get(), H5T_VARIABLE);
+    char* p = nullptr;
+    if (H5Aread(attr, mtype.get(), &p) < 0) throw InputError(file, "cannot read attribute", name);
+    std::string s = p ? p : "";
+    H5free_memory(p);
+    return s;
+  }
+  const size_t n = H5Tget_size(ftype.get());
+  if (n == 0 || n > (1u << 24)) throw InputError(file, "attribute has a bad size", name);
+  std::string s(n, '\0');
+  Hid mtype(H5Tcopy(H5T_C_S1), H5Tclose);
+  H5Tset_size(mtype.get(), n);
+  if (H5Aread(attr, mtype.get(), s.data()) < 0)
+    throw InputError(file, "cannot read attribute", name);
+  s.resize(std::strlen(s.c_str()));
+  return s;
+}
+
+// ---------------------------------------------------------------- appendable dataset
+
+struct Appendable {
+  Hid ds;
+  hsize_t rows = 0;
+  const Column* col = nullptr;
+
+  void append(const void* data, hsize_t n, const std::string& file) {
+    if (n == 0) return;
+    std::vector<hsize_t> dims{rows + n};
+    dims.insert(dims.end(), col->tail.begin(), col->tail.end());
+    if (H5Dset_extent(ds.get(), dims.data()) < 0)
+      throw InputError(file, "cannot extend dataset", col_path(*col));
+    Hid fspace(H5Dget_space(ds.get()), H5Sclose);
+    std::vector<hsize_t> start(dims.size(), 0), count = dims;
+    start[0] = rows;
+    count[0] = n;
+    H5Sselect_hyperslab(fspace.get(), H5S_SELECT_SET, start.data(), nullptr, count.data(),
+                        nullptr);
+    Hid mspace(H5Screate_simple(static_cast<int>(count.size()), count.data(), nullptr), H5Sclose);
+    if (H5Dwrite(ds.get(), col->mem_type(), mspace.get(), fspace.get(), H5P_DEFAULT, data) < 0)
+      throw InputError(file, "cannot write dataset", col_path(*col));
+    rows += n;
+  }
+};
+
+template <class T, class F>
+std::vector<T> gather(const std::size_t n, std::size_t width, F&& fill) {
+  std::vector<T> v(n * width);
+  for (std::size_t i = 0; i < n; ++i) fill(i, v.data() + i * width);
+  return v;
+}
+
+void put3(double* out, const Eigen::Vector3d& v) {
+  out[0] = v.x();
+  out[1] = v.y();
+  out[2] = v.z();
+}
+
+Eigen::Vector3d get3(const double* in) { return {in[0], in[1], in[2]}; }
+
+}  // namespace
+
+std::filesystem::path partial_path(const std::filesystem::path& final_path) {
+  auto p = final_path;
+  p += ".partial";
+  return p;
+}
+
+bool is_hdf5_file(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  char sig[8] = {};
+  in.read(sig, 8);
+  return in.gcount() == 8 && std::memcmp(sig, "\x89HDF\r\n\x1a\n", 8) == 0;
+}
+
+// ==================================================================== writer
+
+struct TrajectoryWriter::Impl {
+  std::filesystem::path final_path;
+  std::filesystem::path file_path;
+  Options options;
+  Hid file;
+  std::vector<Appendable> ds;
+  std::size_t frames = 0;
+  bool finished = false;
+
+  std::string name() const { return file_path.string(); }
+
+  void open_datasets() {
+    ds.clear();
+    ds.resize(N_COLS);
+    for (int i = 0; i < N_COLS; ++i) {
+      const auto& c = columns()[i];
+      ds[i].col = &c;
+      ds[i].ds = Hid(H5Dopen2(file.get(), col_path(c).c_str(), H5P_DEFAULT), H5Dclose);
+      if (!ds[i].ds.valid()) throw InputError(name(), "missing dataset", col_path(c));
+      Hid space(H5Dget_space(ds[i].ds.get()), H5Sclose);
+      hsize_t dims[4] = {};
+      if (H5Sget_simple_extent_ndims(space.get()) != static_cast<int>(1 + c.tail.size()))
+        throw InputError(name(), "dataset has wrong rank", col_path(c));
+      H5Sget_simple_extent_dims(space.get(), dims, nullptr);
+      ds[i].rows = dims[0];
+    }
+  }
+
+  void create(const RunMetadata& meta) {
+    quiet_hdf5();
+    std::error_code ec;
+    std::filesystem::remove(file_path, ec);
+    auto fapl = latest_fapl();
+    file = Hid(H5Fcreate(file_path.string().c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.get()),
+               H5Fclose);
+    if (!file.valid()) throw InputError(name(), "cannot create HDF5 file");
+    write_string_attr(file.get(), "format", kTrajectoryFormatName, name());
+    write_int_attr(file.get(), "schema_version", kTrajectorySchemaVersion, name());
+    write_string_attr(file.get(), "code_version",
+                      meta.code_version.empty() ? code_version() : meta.code_version, name());
+    write_string_attr(file.get(), "provenance", meta.provenance, name());
+    {
+      Hid gcpl(H5Pcreate(H5P_GROUP_CREATE), H5Pclose);
+      H5Pset_attr_creation_order(gcpl.get(), H5P_CRT_ORDER_TRACKED | H5P_CRT_ORDER_INDEXED);
+      Hid g(H5Gcreate2(file.get(), "metadata", H5P_DEFAULT, gcpl.get(), H5P_DEFAULT), H5Gclose);
+      if (!g.valid()) throw InputError(name(), "cannot create group", "metadata");
+      for (const auto& [k, v] : meta.parameters) {
+        if (k.empty()) throw InputError(name(), "empty metadata key");
+        write_string_attr(g.get(), k, v, name());
+      }
+    }
+    for (const char* g : {"particles", "contacts", "walls", "frames"}) {
+      Hid grp(H5Gcreate2(file.get(), g, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose);
+      if (!grp.valid()) throw InputError(name(), "cannot create group", g);
+    }
+    for (const auto& c : columns()) {
+      std::vector<hsize_t> dims{0}, maxdims{H5S_UNLIMITED}, chunk{c.chunk_rows};
+      for (auto t : c.tail) {
+        dims.push_back(t);
+        maxdims.push_back(t);
+        chunk.push_back(t);
+      }
+      Hid space(H5Screate_simple(static_cast<int>(dims.size()), dims.data(), maxdims.data()),
+                H5Sclose);
+      Hid dcpl(H5Pcreate(H5P_DATASET_CREATE), H5Pclose);
+      H5Pset_chunk(dcpl.get(), static_cast<int>(chunk.size()), chunk.data());
+      if (options.deflate_level > 0) {
+        H5Pset_shuffle(dcpl.get());
+        H5Pset_deflate(dcpl.get(), static_cast<unsigned>(options.deflate_level));
+      }
+      H5Pset_fletcher32(dcpl.get());
+      hid_t ftype = c.mem_type() == H5T_NATIVE_DOUBLE ? H5T_IEEE_F64LE
+                    : c.mem_type() == H5T_NATIVE_INT64 ? H5T_STD_I64LE
+                    : c.mem_type() == H5T_NATIVE_INT32 ? H5T_STD_I32LE
+                                                       : H5T_STD_I8LE;
+      Hid d(H5Dcreate2(file.get(), col_path(c).c_str(), ftype, space.get(), H5P_DEFAULT,
+                       dcpl.get(), H5P_DEFAULT),
+            H5Dclose);
+      if (!d.valid()) throw InputError(name(), "cannot create dataset", col_path(c));
+    }
+    open_datasets();
+    start_swmr();
+  }
+
+  void start_swmr() {
+    if (H5Fstart_swmr_write(file.get()) < 0)
+      throw InputError(name(), "cannot start single-writer mode");
+  }
+
+  void flush() {
+    if (H5Fflush(file.get(), H5F_SCOPE_LOCAL) < 0) throw InputError(name(), "cannot flush");
+  }
+
+  void append(const Frame& f) {
+    const std::string n = name();
+    const auto& P = f.particles;
+    const auto& C = f.contacts;
+    const auto& W = f.walls;
+    const std::size_t np = P.size(), nc = C.size(), nw = W.size();
+    auto wr = [&](int col, const auto& vec, std::size_t rows) {
+      ds[col].append(vec.data(), rows, n);
+    };
+    wr(P_ID, gather<std::int64_t>(np, 1, [&](auto i, auto* o) { *o = P[i].id; }), np);
+    wr(P_POS, gather<double>(np, 3, [&](auto i, auto* o) { put3(o, P[i].position); }), np);
+    wr(P_RAD, gather<double>(np, 1, [&](auto i, auto* o) { *o = P[i].radius; }), np);
+    wr(P_VEL, gather<double>(np, 3, [&](auto i, auto* o) { put3(o, P[i].velocity); }), np);
+    wr(P_ANGVEL,
+       gather<double>(np, 3, [&](auto i, auto* o) { put3(o, P[i].angular_velocity); }), np);
+    wr(P_ORI, gather<double>(np, 4, [&](auto i, auto* o) {
+         const auto& q = P[i].orientation;
+         o[0] = q.w();
+         o[1] = q.x();
+         o[2] = q.y();
+         o[3] = q.z();
+       }),
+       np);
+    wr(P_ROT, gather<double>(np, 3, [&](auto i, auto* o) { put3(o, P[i].rotation); }), np);
+    wr(P_MASS, gather<double>(np, 1, [&](auto i, auto* o) { *o = P[i].mass; }), np);
+    wr(P_CLUMP, gather<std::int64_t>(np, 1, [&](auto i, auto* o) { *o = P[i].clump_id; }), np);
+    wr(P_MAT, gather<std::int32_t>(np, 1, [&](auto i, auto* o) { *o = P[i].material_id; }), np);
+
+    wr(C_ID1, gather<std::int64_t>(nc, 1, [&](auto i, auto* o) { *o = C[i].id1; }), nc);
+    wr(C_ID2, gather<std::int64_t>(nc, 1, [&](auto i, auto* o) { *o = C[i].id2; }), nc);
+    wr(C_POINT, gather<double>(nc, 3, [&](auto i, auto* o) { put3(o, C[i].point); }), nc);
+    wr(C_NORMAL, gather<double>(nc, 3, [&](auto i, auto* o) { put3(o, C[i].normal); }), nc);
+    wr(C_FN, gather<double>(nc, 3, [&](auto i, auto* o) { put3(o, C[i].normal_force); }), nc);
+    wr(C_FS, gather<double>(nc, 3, [&](auto i, auto* o) { put3(o, C[i].shear_force); }), nc);
+    wr(C_MB, gather<double>(nc, 3, [&](auto i, auto* o) { put3(o, C[i].bending_moment); }), nc);
+    wr(C_MT, gather<double>(nc, 3, [&](auto i, auto* o) { put3(o, C[i].twisting_moment); }), nc);
+    wr(C_OVERLAP, gather<double>(nc, 1, [&](auto i, auto* o) { *o = C[i].overlap; }), nc);
+
+    wr(W_ID, gather<std::int64_t>(nw, 1, [&](auto i, auto* o) { *o = W[i].id; }), nw);
+    wr(W_KIND, gather<std::int32_t>(nw, 1, [&](auto i, auto* o) {
+         *o = static_cast<std::int32_t>(W[i].kind);
+       }),
+       nw);
+    wr(W_A, gather<double>(nw, 3, [&](auto i, auto* o) { put3(o, W[i].a); }), nw);
+    wr(W_B, gather<double>(nw, 3, [&](auto i, auto* o) { put3(o, W[i].b); }), nw);
+    wr(W_FORCE, gather<double>(nw, 3, [&](auto i, auto* o) { put3(o, W[i].force); }), nw);
+    wr(W_TORQUE, gather<double>(nw, 3, [&](auto i, auto* o) { put3(o, W[i].torque); }), nw);
+
+    const std::int8_t two_d = f.two_d ? 1 : 0, periodic = f.domain.periodic ? 1 : 0;
+    double lo[3], hi[3], cell[9];
+    put3(lo, f.domain.lo);
+    put3(hi, f.domain.hi);
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) cell[r * 3 + c] = f.domain.cell(r, c);
+    ds[F_TIME].append(&f.time, 1, n);
+    ds[F_STEP].append(&f.step, 1, n);
+    ds[F_DT].append(&f.dt, 1, n);
+    ds[F_TWOD].append(&two_d, 1, n);
+    ds[F_LO].append(lo, 1, n);
+    ds[F_HI].append(hi, 1, n);
+    ds[F_PERIODIC].append(&periodic, 1, n);
+    ds[F_CELL].append(cell, 1, n);
+    flush();
+    // Commit marker: the frame exists for readers once its end offsets are on disk.
+    const std::int64_t end[3] = {static_cast<std::int64_t>(ds[P_ID].rows),
+                                 static_cast<std::int64_t>(ds[C_ID1].rows),
+                                 static_cast<std::int64_t>(ds[W_ID].rows)};
+    ds[F_END].append(end, 1, n);
+    flush();
+    ++frames;
+  }
+
+  void close() {
+    ds.clear();
+    file.reset();
+  }
+};
+
+TrajectoryWriter::TrajectoryWriter(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+
+TrajectoryWriter::TrajectoryWriter(std::filesystem::path path, const RunMetadata& metadata)
+    : TrajectoryWriter(std::move(path), metadata, Options{}) {}
+
+TrajectoryWriter::TrajectoryWriter(std::filesystem::path path, const RunMetadata& metadata,
+                                   Options options)
+    : impl_(std::make_unique<Impl>()) {
+  impl_->final_path = std::move(path);
+  impl_->file_path = partial_path(impl_->final_path);
+  impl_->options = options;
+  try {
+    impl_->create(metadata);
+  } catch (...) {
+    impl_->close();
+    std::error_code ec;
+    std::filesystem::remove(impl_->file_path, ec);
+    throw;
+  }
+}
+
+TrajectoryWriter TrajectoryWriter::resume(std::filesystem::path path, std::size_t keep_frames,
+                                          Options options) {
+  quiet_hdf5();
+  auto impl = std::make_unique<Impl>();
+  impl->final_path = std::move(path);
+  impl->file_path = partial_path(impl->final_path);
+  impl->options = options;
+  auto fapl = latest_fapl();
+  impl->file = Hid(H5Fopen(impl->file_path.string().c_str(), H5F_ACC_RDWR, fapl.get()), H5Fclose);
+  if (!impl->file.valid()) {
+    // A killed single-writer leaves its flag set; clear it by opening with SWMR read first is
+    // not possible for writing, so reopen through H5Fopen after marking the file as closed.
+    impl->file =
+        Hid(H5Fopen(impl->file_path.string().c_str(), H5F_ACC_RDWR | H5F_ACC_SWMR_WRITE,
+                    fapl.get()),
+            H5Fclose);
+  }
+  if (!impl->file.valid()) throw InputError(impl->name(), "cannot reopen trajectory to resume");
+  impl->open_datasets();
+  const std::size_t have = impl->ds[F_END].rows;
+  const std::size_t keep = std::min(have, keep_frames);
+  std::array<std::int64_t, 3> end{0, 0, 0};
+  if (keep > 0) {
+    Hid fspace(H5Dget_space(impl->ds[F_END].ds.get()), H5Sclose);
+    hsize_t start[2] = {keep - 1, 0}, count[2] = {1, 3};
+    H5Sselect_hyperslab(fspace.get(), H5S_SELECT_SET, start, nullptr, count, nullptr);
+    Hid mspace(H5Screate_simple(2, count, nullptr), H5Sclose);
+    if (H5Dread(impl->ds[F_END].ds.get(), H5T_NATIVE_INT64, mspace.get(), fspace.get(),
+                H5P_DEFAULT, end.data()) < 0)
+      throw InputError(impl->name(), "cannot read frame index", "/frames/end");
+  }
+  for (int i = 0; i < N_COLS; ++i) {
+    const auto& c = columns()[i];
+    const std::string g = c.group;
+    const hsize_t rows = g == "particles" ? end[0]
+                         : g == "contacts" ? end[1]
+                         : g == "walls"    ? end[2]
+                                           : keep;
+    if (rows == impl->ds[i].rows) continue;
+    std::vector<hsize_t> dims{rows};
+    dims.insert(dims.end(), c.tail.begin(), c.tail.end());
+    if (H5Dset_extent(impl->ds[i].ds.get(), dims.data()) < 0)
+      throw InputError(impl->name(), "cannot truncate dataset", col_path(c));
+    impl->ds[i].rows = rows;
+  }
+  impl->frames = keep;
+  if (H5Fget_intent(impl->file.get(), nullptr) >= 0) {
+    unsigned intent = 0;
+    H5Fget_intent(impl->file.get(), &intent);
+    if (!(intent & H5F_ACC_SWMR_WRITE)) impl->start_swmr();
+  }
+  impl->flush();
+  return TrajectoryWriter(std::move(impl));
+}
+
+TrajectoryWriter::TrajectoryWriter(TrajectoryWriter&&) noexcept = default;
+TrajectoryWriter& TrajectoryWriter::operator=(TrajectoryWriter&&) noexcept = default;
+
+TrajectoryWriter::~TrajectoryWriter() {
+  if (!impl_ || impl_->finished) return;
+  impl_->close();
+  if (impl_->options.discard_unfinished) {
+    std::error_code ec;
+    std::filesystem::remove(impl_->file_path, ec);
+  }
+}
+
+void TrajectoryWriter::append(const Frame& frame) {
+  validate_frame(frame, impl_->final_path.string());
+  impl_->append(frame);
+}
+
+std::size_t TrajectoryWriter::frames_written() const { return impl_->frames; }
+
+void TrajectoryWriter::finish() {
+  impl_->close();
+  std::error_code ec;
+  std::filesystem::rename(impl_->file_path, impl_->final_path, ec);
+  if (ec) throw InputError(impl_->final_path.string(), "cannot rename output into place",
+                           ec.message());
+  impl_->finished = true;
+}
+
+// ==================================================================== reader
+
+struct TrajectoryReader::Impl {
+  std::string file_name;
+  Hid file;
+  RunMetadata meta;
+  std::vector<Hid> ds;
+  std::vector<hsize_t> rows;
+  std::size_t n = 0;
+  // Per-frame tables, read once.
+  std::vector<double> time, dt, lo, hi, cell;
+  std::vector<std::int64_t> step, end;
+  std::vector<std::int8_t> two_d, periodic;
+
+  template <class T>
+  std::vector<T> read_rows(int col, hsize_t first, hsize_t count) const {
+    const auto& c = columns()[col];
+    const hsize_t w = row_width(c);
+    std::vector<T> out(count * w);
+    if (count == 0) return out;
+    Hid fspace(H5Dget_space(ds[col].get()), H5Sclose);
+    std::vector<hsize_t> start(1 + c.tail.size(), 0), cnt{count};
+    cnt.insert(cnt.end(), c.tail.begin(), c.tail.end());
+    start[0] = first;
+    if (H5Sselect_hyperslab(fspace.get(), H5S_SELECT_SET, start.data(), nullptr, cnt.data(),
+                            nullptr) < 0)
+      throw InputError(file_name, "bad selection in dataset", col_path(c));
+    Hid mspace(H5Screate_simple(static_cast<int>(cnt.size()), cnt.data(), nullptr), H5Sclose);
+    if (H5Dread(ds[col].get(), c.mem_type(), mspace.get(), fspace.get(), H5P_DEFAULT,
+                out.data()) < 0)
+      throw InputError(file_name, "cannot read dataset (corrupt or truncated)", col_path(c));
+    return out;
+  }
+
+  void open(const std::filesystem::path& path) {
+    quiet_hdf5();
+    file_name = path.string();
+    std::error_code ec;
+    if (!std::filesystem::exists(path, ec)) throw InputError(file_name, "no such file");
+    if (!std::filesystem::is_regular_file(path, ec)) throw InputError(file_name, "not a file");
+    if (!is_hdf5_file(path)) throw InputError(file_name, "not an HDF5 file (bad signature)");
+    file = Hid(H5Fopen(file_name.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose);
+    if (!file.valid())  // a file still open by (or left behind by a killed) single writer
+      file = Hid(H5Fopen(file_name.c_str(), H5F_ACC_RDONLY | H5F_ACC_SWMR_READ, H5P_DEFAULT),
+                 H5Fclose);
+    if (!file.valid()) throw InputError(file_name, "cannot open HDF5 file (corrupt or truncated)");
+
+    // Root attributes.
+    auto attr_string = [&](const char* nm) {
+      Hid a(H5Aopen(file.get(), nm, H5P_DEFAULT), H5Aclose);
+      if (!a.valid()) throw InputError(file_name, "missing root attribute", nm);
+      return read_string_attr(a.get(), file_name, nm);
+    };
+    const std::string fmt = attr_string("format");
+    if (fmt != kTrajectoryFormatName) throw InputError(file_name, "not a granoscope trajectory, format", fmt);
+    {
+      Hid a(H5Aopen(file.get(), "schema_version", H5P_DEFAULT), H5Aclose);
+      long long v = -1;
+      if (!a.valid() || H5Aread(a.get(), H5T_NATIVE_LLONG, &v) < 0)
+        throw InputError(file_name, "missing root attribute", "schema_version");
+      if (v != kTrajectorySchemaVersion)
+        throw InputError(file_name, "unsupported schema_version", std::to_string(v));
+    }
+    meta.code_version = attr_string("code_version");
+    meta.provenance = attr_string("provenance");
+    {
+      Hid g(H5Gopen2(file.get(), "metadata", H5P_DEFAULT), H5Gclose);
+      if (!g.valid()) throw InputError(file_name, "missing group", "/metadata");
+      H5O_info_t info;
+      if (H5Oget_info2(g.get(), &info, H5O_INFO_NUM_ATTRS) < 0)
+        throw InputError(file_name, "cannot read group", "/metadata");
+      for (hsize_t i = 0; i < info.num_attrs; ++i) {
+        Hid a(H5Aopen_by_idx(g.get(), ".", H5_INDEX_CRT_ORDER, H5_ITER_INC, i, H5P_DEFAULT,
+                             H5P_DEFAULT),
+              H5Aclose);
+        if (!a.valid())
+          a = Hid(H5Aopen_by_idx(g.get(), ".", H5_INDEX_NAME, H5_ITER_INC, i, H5P_DEFAULT,
+                                 H5P_DEFAULT),
+                  H5Aclose);
+        if (!a.valid()) throw InputError(file_name, "cannot read metadata attribute", std::to_string(i));
+        const ssize_t len = H5Aget_name(a.get(), 0, nullptr);
+        if (len <= 0 || len > 65536) throw InputError(file_name, "bad metadata attribute name");
+        std::string key(static_cast<size_t>(len) + 1, '\0');
+        H5Aget_name(a.get(), key.size(), key.data());
+        key.resize(static_cast<size_t>(len));
+        meta.parameters.emplace_back(key, read_string_attr(a.get(), file_name, key));
+      }
+    }
+
+    // Datasets: shape checks.
+    ds.resize(N_COLS);
+    rows.assign(N_COLS, 0);
+    for (int i = 0; i < N_COLS; ++i) {
+      const auto& c = columns()[i];
+      ds[i] = Hid(H5Dopen2(file.get(), col_path(c).c_str(), H5P_DEFAULT), H5Dclose);
+      if (!ds[i].valid()) throw InputError(file_name, "missing dataset", col_path(c));
+      Hid space(H5Dget_space(ds[i].get()), H5Sclose);
+      const int rank = H5Sget_simple_extent_ndims(space.get());
+      if (rank != static_cast<int>(1 + c.tail.size()))
+        throw InputError(file_name, "dataset has wrong rank", col_path(c) + " rank " + std::to_string(rank));
+      hsize_t dims[8] = {};
+      H5Sget_simple_extent_dims(space.get(), dims, nullptr);
+      for (size_t k = 0; k < c.tail.size(); ++k)
+        if (dims[k + 1] != c.tail[k])
+          throw InputError(file_name, "dataset has wrong shape", col_path(c));
+      Hid type(H5Dget_type(ds[i].get()), H5Tclose);
+      const auto cls = H5Tget_class(type.get());
+      const bool want_float = c.mem_type() == H5T_NATIVE_DOUBLE;
+      if ((want_float && cls != H5T_FLOAT) || (!want_float && cls != H5T_INTEGER))
+        throw InputError(file_name, "dataset has wrong type", col_path(c));
+      rows[i] = dims[0];
+    }
+    n = rows[F_END];
+    for (int i = F_TIME; i < N_COLS; ++i)
+      if (rows[i] < n) throw InputError(file_name, "frame table shorter than frame index", col_path(columns()[i]));
+    time = read_rows<double>(F_TIME, 0, n);
+    step = read_rows<std::int64_t>(F_STEP, 0, n);
+    dt = read_rows<double>(F_DT, 0, n);
+    two_d = read_rows<std::int8_t>(F_TWOD, 0, n);
+    lo = read_rows<double>(F_LO, 0, n);
+    hi = read_rows<double>(F_HI, 0, n);
+    periodic = read_rows<std::int8_t>(F_PERIODIC, 0, n);
+    cell = read_rows<double>(F_CELL, 0, n);
+    end = read_rows<std::int64_t>(F_END, 0, n);
+    const hsize_t limits[3] = {rows[P_ID], rows[C_ID1], rows[W_ID]};
+    const int first_col[3] = {P_ID, C_ID1, W_ID}, last_col[3] = {P_MAT, C_OVERLAP, W_TORQUE};
+    for (int k = 0; k < 3; ++k) {
+      for (int c = first_col[k]; c <= last_col[k]; ++c)
+        if (rows[c] != limits[k])
+          throw InputError(file_name, "datasets of one group differ in length", col_path(columns()[c]));
+      std::int64_t prev = 0;
+      for (std::size_t i = 0; i < n; ++i) {
+        const std::int64_t e = end[i * 3 + k];
+        if (e < prev || static_cast<hsize_t>(e) > limits[k])
+          throw InputError(file_name, "corrupt frame index /frames/end at frame " + std::to_string(i),
+                           std::to_string(e));
+        prev = e;
+      }
+    }
+  }
+
+  std::pair<hsize_t, hsize_t> range(std::size_t i, int k) const {
+    const hsize_t b = i == 0 ? 0 : static_cast<hsize_t>(end[(i - 1) * 3 + k]);
+    return {b, static_cast<hsize_t>(end[i * 3 + k]) - b};
+  }
+};
+
+TrajectoryReader::TrajectoryReader(const std::filesystem::path& path)
+    : impl_(std::make_unique<Impl>()) {
+  impl_->open(path);
+}
+TrajectoryReader::TrajectoryReader(TrajectoryReader&&) noexcept = default;
+TrajectoryReader::~TrajectoryReader() = default;
+
+std::size_t TrajectoryReader::frame_count() const { return impl_->n; }
+const RunMetadata& TrajectoryReader::metadata() const { return impl_->meta; }
+double TrajectoryReader::time(std::size_t i) const { return impl_->time.at(i); }
+std::size_t TrajectoryReader::particle_count(std::size_t i) const {
+  if (i >= impl_->n) throw std::out_of_range("frame index");
+  return impl_->range(i, 0).second;
+}
+std::size_t TrajectoryReader::contact_count(std::size_t i) const {
+  if (i >= impl_->n) throw std::out_of_range("frame index");
+  return impl_->range(i, 1).second;
+}
+
+Frame TrajectoryReader::frame(std::size_t i) const {
+  const Impl& m = *impl_;
+  if (i >= m.n)
+    throw InputError(m.file_name, "no such frame", std::to_string(i) + " of " + std::to_string(m.n));
+  Frame f;
+  f.time = m.time[i];
+  f.step = m.step[i];
+  f.dt = m.dt[i];
+  f.two_d = m.two_d[i] != 0;
+  f.domain.lo = get3(&m.lo[i * 3]);
+  f.domain.hi = get3(&m.hi[i * 3]);
+  f.domain.periodic = m.periodic[i] != 0;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) f.domain.cell(r, c) = m.cell[i * 9 + r * 3 + c];
+
+  {
+    const auto [b, cnt] = m.range(i, 0);
+    const auto id = m.read_rows<std::int64_t>(P_ID, b, cnt);
+    const auto pos = m.read_rows<double>(P_POS, b, cnt);
+    const auto rad = m.read_rows<double>(P_RAD, b, cnt);
+    const auto vel = m.read_rows<double>(P_VEL, b, cnt);
+    const auto av = m.read_rows<double>(P_ANGVEL, b, cnt);
+    const auto ori = m.read_rows<double>(P_ORI, b, cnt);
+    const auto rot = m.read_rows<double>(P_ROT, b, cnt);
+    const auto mass = m.read_rows<double>(P_MASS, b, cnt);
+    const auto clump = m.read_rows<std::int64_t>(P_CLUMP, b, cnt);
+    const auto mat = m.read_rows<std::int32_t>(P_MAT, b, cnt);
+    f.particles.resize(cnt);
+    for (hsize_t k = 0; k < cnt; ++k) {
+      auto& p = f.particles[k];
+      p.id = id[k];
+      p.position = get3(&pos[k * 3]);
+      p.radius = rad[k];
+      p.velocity = get3(&vel[k * 3]);
+      p.angular_velocity = get3(&av[k * 3]);
+      p.orientation = Eigen::Quaterniond(ori[k * 4], ori[k * 4 + 1], ori[k * 4 + 2], ori[k * 4 + 3]);
+      p.rotation = get3(&rot[k * 3]);
+      p.mass = mass[k];
+      p.clump_id = clump[k];
+      p.material_id = mat[k];
+    }
+  }
+  {
+    const auto [b, cnt] = m.range(i, 1);
+    const auto id1 = m.read_rows<std::int64_t>(C_ID1, b, cnt);
+    const auto id2 = m.read_rows<std::int64_t>(C_ID2, b, cnt);
+    const auto pt = m.read_rows<double>(C_POINT, b, cnt);
+    const auto nn = m.read_rows<double>(C_NORMAL, b, cnt);
+    const auto fn = m.read_rows<double>(C_FN, b, cnt);
+    const auto fs = m.read_rows<double>(C_FS, b, cnt);
+    const auto mb = m.read_rows<double>(C_MB, b, cnt);
+    const auto mt = m.read_rows<double>(C_MT, b, cnt);
+    const auto ov = m.read_rows<double>(C_OVERLAP, b, cnt);
+    f.contacts.resize(cnt);
+    for (hsize_t k = 0; k < cnt; ++k) {
+      auto& c = f.contacts[k];
+      c.id1 = id1[k];
+      c.id2 = id2[k];
+      c.point = get3(&pt[k * 3]);
+      c.normal = get3(&nn[k * 3]);
+      c.normal_force = get3(&fn[k * 3]);
+      c.shear_force = get3(&fs[k * 3]);
+      c.bending_moment = get3(&mb[k * 3]);
+      c.twisting_moment = get3(&mt[k * 3]);
+      c.overlap = ov[k];
+    }
+  }
+  {
+    const auto [b, cnt] = m.range(i, 2);
+    const auto id = m.read_rows<std::int64_t>(W_ID, b, cnt);
+    const auto kind = m.read_rows<std::int32_t>(W_KIND, b, cnt);
+    const auto a = m.read_rows<double>(W_A, b, cnt);
+    const auto bb = m.read_rows<double>(W_B, b, cnt);
+    const auto force = m.read_rows<double>(W_FORCE, b, cnt);
+    const auto torque = m.read_rows<double>(W_TORQUE, b, cnt);
+    f.walls.resize(cnt);
+    for (hsize_t k = 0; k < cnt; ++k) {
+      auto& w = f.walls[k];
+      w.id = id[k];
+      w.kind = static_cast<WallKind>(kind[k]);
+      w.a = get3(&a[k * 3]);
+      w.b = get3(&bb[k * 3]);
+      w.force = get3(&force[k * 3]);
+      w.torque = get3(&torque[k * 3]);
+    }
+  }
+  validate_frame(f, m.file_name + " frame " + std::to_string(i));
+  return f;
+}
+
+Trajectory read_hdf5_trajectory(const std::filesystem::path& path) {
+  TrajectoryReader r(path);
+  Trajectory t;
+  t.metadata = r.metadata();
+  t.frames.reserve(r.frame_count());
+  for (std::size_t i = 0; i < r.frame_count(); ++i) t.frames.push_back(r.frame(i));
+  return t;
+}
+
+void write_hdf5_trajectory(const std::filesystem::path& path, const Trajectory& trajectory) {
+  TrajectoryWriter w(path, trajectory.metadata, TrajectoryWriter::Options{});
+  for (const auto& f : trajectory.frames) w.append(f);
+  w.finish();
+}
+
+}  // namespace gs

@@ -1,0 +1,89 @@
+#include "snapshot.hpp"
+
+#include <cmath>
+#include <limits>
+#include <unordered_set>
+
+#include "errors.hpp"
+
+#ifndef GRANOSCOPE_VERSION
+#define GRANOSCOPE_VERSION "0.0.0"
+#endif
+
+namespace gs {
+
+std::string code_version() { return std::string("granoscope ") + GRANOSCOPE_VERSION; }
+
+std::pair<Eigen::Vector3d, Eigen::Vector3d> particle_bounds(const Frame& frame) {
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+  Eigen::Vector3d hi = -lo;
+  for (const auto& p : frame.particles) {
+    lo = lo.cwiseMin((p.position.array() - p.radius).matrix());
+    hi = hi.cwiseMax((p.position.array() + p.radius).matrix());
+  }
+  if (frame.particles.empty()) lo = hi = Eigen::Vector3d::Zero();
+  return {lo, hi};
+}
+
+namespace {
+
+void check_finite(const std::string& source, const std::string& field, double v) {
+  if (!std::isfinite(v)) throw InputError(source, "non-finite " + field, value_str(v));
+}
+
+template <class Derived>
+void check_finite(const std::string& source, const std::string& field,
+                  const Eigen::MatrixBase<Derived>& v) {
+  for (Eigen::Index i = 0; i < v.size(); ++i)
+    if (!std::isfinite(v(i))) throw InputError(source, "non-finite " + field, value_str(v(i)));
+}
+
+}  // namespace
+
+void validate_frame(const Frame& f, const std::string& source) {
+  check_finite(source, "time", f.time);
+  check_finite(source, "dt", f.dt);
+  if (f.dt < 0) throw InputError(source, "negative dt", value_str(f.dt));
+  check_finite(source, "domain lo", f.domain.lo);
+  check_finite(source, "domain hi", f.domain.hi);
+  check_finite(source, "periodic cell", f.domain.cell);
+  std::unordered_set<std::int64_t> ids;
+  ids.reserve(f.particles.size());
+  for (const auto& p : f.particles) {
+    const std::string pid = "particle " + std::to_string(p.id) + " ";
+    check_finite(source, pid + "position", p.position);
+    check_finite(source, pid + "radius", p.radius);
+    if (!(p.radius > 0)) throw InputError(source, pid + "radius not positive", value_str(p.radius));
+    check_finite(source, pid + "velocity", p.velocity);
+    check_finite(source, pid + "angular velocity", p.angular_velocity);
+    check_finite(source, pid + "orientation", p.orientation.coeffs());
+    check_finite(source, pid + "rotation", p.rotation);
+    check_finite(source, pid + "mass", p.mass);
+    if (p.mass < 0) throw InputError(source, pid + "mass negative", value_str(p.mass));
+    if (!ids.insert(p.id).second) throw InputError(source, "duplicate particle id", value_str(p.id));
+  }
+  for (const auto& c : f.contacts) {
+    const std::string cid =
+        "contact " + std::to_string(c.id1) + "-" + std::to_string(c.id2) + " ";
+    check_finite(source, cid + "point", c.point);
+    check_finite(source, cid + "normal", c.normal);
+    check_finite(source, cid + "normal force", c.normal_force);
+    check_finite(source, cid + "shear force", c.shear_force);
+    check_finite(source, cid + "bending moment", c.bending_moment);
+    check_finite(source, cid + "twisting moment", c.twisting_moment);
+    check_finite(source, cid + "overlap", c.overlap);
+    if (std::abs(c.normal.norm() - 1.0) > 1e-6)
+      throw InputError(source, cid + "normal is not a unit vector, |n|", value_str(c.normal.norm()));
+  }
+  for (const auto& w : f.walls) {
+    const std::string wid = "wall " + std::to_string(w.id) + " ";
+    check_finite(source, wid + "geometry", w.a);
+    check_finite(source, wid + "geometry", w.b);
+    check_finite(source, wid + "force", w.force);
+    check_finite(source, wid + "torque", w.torque);
+    if (w.kind != WallKind::Plane && w.kind != WallKind::Box)
+      throw InputError(source, wid + "unknown kind", value_str(static_cast<int>(w.kind)));
+  }
+}
+
+}  // namespace gs

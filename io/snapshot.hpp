@@ -1,0 +1,98 @@
+// Snapshot model shared by every module: value types, SI units, Eigen at interfaces.
+// Data flows solver -> io (these types) -> analysis/dic; analysis never sees solver headers.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace gs {
+
+/// One sphere (or clump member) at one instant. Lengths in m, velocities in m/s, rad/s.
+struct Particle {
+  std::int64_t id = 0;
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();
+  double radius = 0.0;
+  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
+  Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();       // rad/s
+  Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();  // body -> lab
+  Eigen::Vector3d rotation = Eigen::Vector3d::Zero();  // cumulative rotation vector, rad
+  double mass = 0.0;                                   // kg; 0 = unknown
+  std::int64_t clump_id = -1;                          // -1: not in a clump
+  std::int32_t material_id = 0;
+};
+
+/// One particle–particle or particle–wall contact. Forces in N act on particle id1 (by id2).
+/// For a wall contact id2 is the wall id (walls are numbered after the particles, YADE-style).
+struct Contact {
+  std::int64_t id1 = 0;
+  std::int64_t id2 = 0;
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  // unit, from id1 towards id2
+  Eigen::Vector3d normal_force = Eigen::Vector3d::Zero();
+  Eigen::Vector3d shear_force = Eigen::Vector3d::Zero();
+  Eigen::Vector3d bending_moment = Eigen::Vector3d::Zero();   // N·m
+  Eigen::Vector3d twisting_moment = Eigen::Vector3d::Zero();  // N·m
+  double overlap = 0.0;                                       // m, > 0 when penetrating
+};
+
+enum class WallKind : std::int32_t {
+  Plane = 0,  // a = point on the plane, b = unit normal (pointing into the granular domain)
+  Box = 1,    // a = centre, b = half-extents (axis-aligned)
+};
+
+struct Wall {
+  std::int64_t id = 0;
+  WallKind kind = WallKind::Plane;
+  Eigen::Vector3d a = Eigen::Vector3d::Zero();
+  Eigen::Vector3d b = Eigen::Vector3d::UnitZ();
+  Eigen::Vector3d force = Eigen::Vector3d::Zero();   // N, total contact force on the wall
+  Eigen::Vector3d torque = Eigen::Vector3d::Zero();  // N·m about wall reference point a
+};
+
+/// Simulation domain: axis-aligned box [lo, hi]; optionally a periodic cell whose columns are
+/// the cell vectors (origin lo).
+struct Domain {
+  Eigen::Vector3d lo = Eigen::Vector3d::Zero();
+  Eigen::Vector3d hi = Eigen::Vector3d::Zero();
+  bool periodic = false;
+  Eigen::Matrix3d cell = Eigen::Matrix3d::Identity();
+};
+
+struct Frame {
+  double time = 0.0;  // s
+  std::int64_t step = 0;
+  double dt = 0.0;  // s
+  bool two_d = false;
+  Domain domain;
+  std::vector<Particle> particles;
+  std::vector<Contact> contacts;
+  std::vector<Wall> walls;
+};
+
+/// Run-level metadata: free-form key/value scene parameters plus provenance.
+struct RunMetadata {
+  std::string code_version;  // granoscope version that wrote the file
+  std::string provenance;    // what produced the data (solver, importer + source file, ...)
+  std::vector<std::pair<std::string, std::string>> parameters;
+};
+
+struct Trajectory {
+  RunMetadata metadata;
+  std::vector<Frame> frames;
+};
+
+/// Axis-aligned bounding box of the spheres (centres ± radius).
+std::pair<Eigen::Vector3d, Eigen::Vector3d> particle_bounds(const Frame& frame);
+
+/// Throws InputError naming `source` and the first invalid field: non-finite numbers, radius
+/// <= 0, negative mass, non-unit contact normals, duplicate particle ids.
+void validate_frame(const Frame& frame, const std::string& source);
+
+/// The project version string, e.g. "granoscope 0.1.0".
+std::string code_version();
+
+}  // namespace gs
