@@ -1,17 +1,35 @@
 // granoscope command-line interface. Each module registers its subcommands (apps/commands.hpp).
 #include <CLI/CLI.hpp>
+#include <exception>
 #include <iostream>
 
+#include "commands.hpp"
 #include "snapshot.hpp"
+
+namespace gs::cli {
+
+CLI::App& analyze_command(CLI::App& app) {
+  if (auto* existing = app.get_subcommand_no_throw("analyze")) return *existing;
+  auto* a = app.add_subcommand("analyze", "Analyses of snapshots and trajectories");
+  a->require_subcommand(1);
+  return *a;
+}
+
+}  // namespace gs::cli
 
 int main(int argc, char** argv) {
   CLI::App app{"granoscope: DEM simulation and analysis of granular materials"};
   app.set_version_flag("--version", gs::code_version());
   app.require_subcommand(1);
+  // Subcommands, one line each (keep sorted by module):
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    const int rc = app.exit(e);  // prints help / the usage error
+    return rc == 0 ? 0 : 2;
+  } catch (const std::exception& e) {
+    std::cerr << "error: " << e.what() << "\n";
+    return 2;
   }
   return 0;
 }
