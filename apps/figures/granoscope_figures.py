@@ -1,0 +1,60 @@
+#!/usr/bin/env python3
+"""Figure dispatcher for `granoscope figures INPUT -o DIR [--type NAME]`.
+
+Reads the `format` attribute at the root of the HDF5 input and runs the figure module registered
+for it. Each module `fig_<name>.py` exposes `make(input_path, out_dir, args) -> [written files]`.
+Exit code 2 with one line `error: FILE: what` on bad input.
+"""
+import argparse
+import importlib
+import os
+import sys
+
+# format attribute -> figure modules (first is the default for that format)
+FIGURES = {
+    "granoscope-trajectory": ["fig_positions"],
+}
+
+
+def main(argv):
+    ap = argparse.ArgumentParser(prog="granoscope figures")
+    ap.add_argument("input")
+    ap.add_argument("-o", "--out", required=True)
+    ap.add_argument("--type", default=None, help="figure module name, e.g. positions")
+    ap.add_argument("--frame", type=int, default=-1, help="frame index (trajectory figures)")
+    args = ap.parse_args(argv)
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    import h5py  # noqa: E402
+
+    try:
+        with h5py.File(args.input, "r", swmr=True) as f:
+            fmt = f.attrs.get("format", b"")
+            fmt = fmt.decode() if isinstance(fmt, bytes) else str(fmt)
+    except OSError as e:
+        print(f"error: {args.input}: cannot open HDF5 file ({e})", file=sys.stderr)
+        return 2
+    if fmt not in FIGURES:
+        print(f"error: {args.input}: no figures for format ({fmt or 'missing'})", file=sys.stderr)
+        return 2
+    modules = FIGURES[fmt]
+    if args.type:
+        name = "fig_" + args.type
+        if name not in modules:
+            print(f"error: {args.input}: figure type not available for {fmt} ({args.type})",
+                  file=sys.stderr)
+            return 2
+        modules = [name]
+    os.makedirs(args.out, exist_ok=True)
+    for m in modules:
+        try:
+            written = importlib.import_module(m).make(args.input, args.out, args)
+        except (ValueError, KeyError, OSError) as e:
+            print(f"error: {args.input}: {m}: {e}", file=sys.stderr)
+            return 2
+        for w in written:
+            print(w)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
