@@ -7,7 +7,16 @@
 
 namespace gs::cli {
 
+/// Thrown by a subcommand to make main() return `code` without printing anything more (the
+/// message, if any, was printed already, e.g. by a child process).
+struct ExitStatus {
+  int code;
+};
+
 // Declarations, one line each (keep sorted by module):
+void register_info(CLI::App& app);     // io
+void register_convert(CLI::App& app);  // io
+void register_figures(CLI::App& app);  // apps
 
 /// `granoscope analyze` parent; analyses register below it (analyze hhd, analyze strain, ...).
 CLI::App& analyze_command(CLI::App& app);

@@ -9,7 +9,8 @@
 namespace gs::cli {
 
 CLI::App& analyze_command(CLI::App& app) {
-  if (auto* existing = app.get_subcommand_no_throw("analyze")) return *existing;
+  for (auto* sub : app.get_subcommands([](CLI::App* s) { return s->get_name() == "analyze"; }))
+    return *sub;
   auto* a = app.add_subcommand("analyze", "Analyses of snapshots and trajectories");
   a->require_subcommand(1);
   return *a;
@@ -22,11 +23,16 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", gs::code_version());
   app.require_subcommand(1);
   // Subcommands, one line each (keep sorted by module):
+  gs::cli::register_info(app);
+  gs::cli::register_convert(app);
+  gs::cli::register_figures(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     const int rc = app.exit(e);  // prints help / the usage error
     return rc == 0 ? 0 : 2;
+  } catch (const gs::cli::ExitStatus& s) {
+    return s.code;
   } catch (const std::exception& e) {
     std::cerr << "error: " << e.what() << "\n";
     return 2;

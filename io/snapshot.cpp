@@ -28,14 +28,14 @@ std::pair<Eigen::Vector3d, Eigen::Vector3d> particle_bounds(const Frame& frame) 
 namespace {
 
 void check_finite(const std::string& source, const std::string& field, double v) {
-  if (!std::isfinite(v)) throw InputError(source, "non-finite " + field, value_str(v));
+  if (!std::isfinite(v)) throw InputError(source, field + " is not finite", value_str(v));
 }
 
 template <class Derived>
 void check_finite(const std::string& source, const std::string& field,
                   const Eigen::MatrixBase<Derived>& v) {
   for (Eigen::Index i = 0; i < v.size(); ++i)
-    if (!std::isfinite(v(i))) throw InputError(source, "non-finite " + field, value_str(v(i)));
+    if (!std::isfinite(v(i))) throw InputError(source, field + " is not finite", value_str(v(i)));
 }
 
 }  // namespace
@@ -53,13 +53,13 @@ void validate_frame(const Frame& f, const std::string& source) {
     const std::string pid = "particle " + std::to_string(p.id) + " ";
     check_finite(source, pid + "position", p.position);
     check_finite(source, pid + "radius", p.radius);
-    if (!(p.radius > 0)) throw InputError(source, pid + "radius not positive", value_str(p.radius));
+    if (!(p.radius > 0)) throw InputError(source, pid + "radius is not positive", value_str(p.radius));
     check_finite(source, pid + "velocity", p.velocity);
     check_finite(source, pid + "angular velocity", p.angular_velocity);
     check_finite(source, pid + "orientation", p.orientation.coeffs());
     check_finite(source, pid + "rotation", p.rotation);
     check_finite(source, pid + "mass", p.mass);
-    if (p.mass < 0) throw InputError(source, pid + "mass negative", value_str(p.mass));
+    if (p.mass < 0) throw InputError(source, pid + "mass is negative", value_str(p.mass));
     if (!ids.insert(p.id).second) throw InputError(source, "duplicate particle id", value_str(p.id));
   }
   for (const auto& c : f.contacts) {

@@ -25,8 +25,10 @@ struct Particle {
   std::int32_t material_id = 0;
 };
 
-/// One particle–particle or particle–wall contact. Forces in N act on particle id1 (by id2).
-/// For a wall contact id2 is the wall id (walls are numbered after the particles, YADE-style).
+/// One particle–particle or particle–wall contact, in YADE's convention: the normal points from
+/// id1 towards id2 and the forces (N) are those exerted BY id1 ON id2 (id1 feels the opposite),
+/// so a compressive contact has normal_force·normal > 0. For a wall contact one id is the wall
+/// id (walls are numbered after the particles, as YADE numbers bodies).
 struct Contact {
   std::int64_t id1 = 0;
   std::int64_t id2 = 0;
