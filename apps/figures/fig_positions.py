@@ -1,4 +1,6 @@
 """Particle positions coloured by radius, front view (x horizontal, z up, looking along +y)."""
+import os
+
 import h5py
 import matplotlib.pyplot as plt
 import numpy as np
@@ -45,4 +47,5 @@ def make(path, out_dir, args):
     ax.set_ylabel("z (m)")
     ax.set_title(f"frame {i}, t = {t:.6g} s, {len(rad)} particles (front view)")
     fig.colorbar(coll, ax=ax, label="radius (mm)", shrink=0.8)
-    return [figutil.save(fig, out_dir, f"positions_front_{i:06d}.png")]
+    stem = os.path.splitext(os.path.basename(path))[0]
+    return [figutil.save(fig, out_dir, f"{stem}_positions_front_{i:06d}.png")]

@@ -160,7 +160,7 @@ TEST(Cli, FiguresWritesANonBlankPositionsPng) {
   ASSERT_EQ(run("convert " + (kData / "liggghts" / "dump.atoms").string() + " " + (dir / "run.h5").string(), dir.path).rc, 0);
   const Result r = run("figures " + (dir / "run.h5").string() + " -o " + (dir / "figs").string(), dir.path);
   ASSERT_EQ(r.rc, 0) << r.err;
-  const auto png = dir / "figs" / "positions_front_000001.png";
+  const auto png = dir / "figs" / "run_positions_front_000001.png";
   ASSERT_TRUE(std::filesystem::exists(png)) << r.out << r.err;
   const cv::Mat img = cv::imread(png.string(), cv::IMREAD_GRAYSCALE);
   ASSERT_FALSE(img.empty());
