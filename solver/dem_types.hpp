@@ -1,0 +1,84 @@
+// Value types of the DEM solver: materials, walls, particle state (structure of arrays) and
+// contact histories. Units SI.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "contact_stiffness.hpp"
+
+namespace gs::solver {
+
+/// YADE CohFrictMat (non-cohesive) parameters, seed 000 eq 1-8 / seed 004 Table 4.3.
+struct Material {
+  double young_ec = 0;         // Pa, contact modulus Ec (Kn = Ec·2RaRb/(Ra+Rb))
+  double stiffness_ratio = 0;  // νc = Ks/Kn
+  double friction_deg = 0;     // μ, inter-particle friction angle
+  double density = 0;          // kg/m³
+  double rolling_beta = 0;     // β, Kr = β·Ks·Ra·Rb (0 disables contact moments)
+  double rolling_eta = 0;      // η, |M| ≤ η·R_roll·|Fn| (negative: no limit)
+  RollingRadius rolling_radius = RollingRadius::Min;
+};
+
+enum class WallShape { Box, Plane };
+
+/// A rigid wall. Boxes are axis-aligned (centre, half-extents); planes are infinite (point,
+/// unit normal pointing into the granular domain). Walls move with `velocity` (m/s) and planes
+/// may rotate with `angular_velocity` (rad/s) about their point. A servo wall adjusts its
+/// velocity along `servo_axis` to hold the normal stress on it at `servo_stress_Pa`.
+struct WallSpec {
+  std::string name;
+  WallShape shape = WallShape::Box;
+  Eigen::Vector3d center = Eigen::Vector3d::Zero();        // box centre or plane point
+  Eigen::Vector3d half_extents = Eigen::Vector3d::Zero();  // box only
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();       // plane only
+  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
+  Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();  // plane only
+  // Servo control (off when servo_area_m2 == 0).
+  double servo_stress_Pa = 0;     // target compressive stress
+  double servo_area_m2 = 0;       // area the force is divided by
+  double servo_gain = 0;          // m/s per Pa of stress error
+  double servo_max_velocity = 0;  // m/s cap
+};
+
+/// Per-particle state, structure of arrays (index = particle index, not id).
+struct ParticleState {
+  std::vector<std::int64_t> id;
+  std::vector<double> radius, mass, inertia;
+  std::vector<Eigen::Vector3d> pos, vel, angvel, rot, force, torque;
+  std::vector<Eigen::Quaterniond> ori;
+  std::vector<std::uint8_t> fixed;  // 1: velocities imposed (not integrated from forces)
+
+  std::size_t size() const { return pos.size(); }
+};
+
+/// Wall kinematic state and accumulated loads.
+struct WallState {
+  WallSpec spec;
+  Eigen::Vector3d pos = Eigen::Vector3d::Zero();  // current centre (box) or point (plane)
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
+  Eigen::Vector3d vel = Eigen::Vector3d::Zero();
+  Eigen::Vector3d force = Eigen::Vector3d::Zero(), torque = Eigen::Vector3d::Zero();
+};
+
+/// History of one contact (YADE's CohFrictPhys + ScGeom state that survives between steps).
+/// `b` is a particle index, or walls are encoded as b = kWallBase + wall index.
+struct ContactHistory {
+  std::uint32_t a = 0, b = 0;
+  bool real = false;                                   // in contact after this step's geometry
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();    // last step's unit normal (a -> b)
+  Eigen::Vector3d shear_force = Eigen::Vector3d::Zero();
+  Eigen::Vector3d bending = Eigen::Vector3d::Zero();
+  Eigen::Vector3d twist = Eigen::Vector3d::Zero();
+  // Results of the current step (for output and monitors).
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();
+  double fn = 0, overlap = 0;
+  double kn = 0, ks = 0, kr = 0;
+};
+
+inline constexpr std::uint32_t kWallBase = 0x80000000u;
+
+}  // namespace gs::solver

@@ -1,0 +1,28 @@
+// Verlet neighbour list on a uniform cell grid: candidate sphere pairs closer than the sum of
+// radii plus a skin, and candidate sphere–wall pairs; rebuilt only when the largest particle
+// displacement (plus wall displacement) could have brought a new pair into contact.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <vector>
+
+#include "dem_types.hpp"
+
+namespace gs::solver {
+
+struct NeighborList {
+  double skin = 0;
+  /// Candidate pairs sorted by (a, b); b ≥ kWallBase encodes a wall. Sphere pairs have a < b.
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs;
+  std::vector<Eigen::Vector3d> ref_pos;   // particle positions at the last build
+  std::vector<Eigen::Vector3d> wall_ref;  // wall positions at the last build
+  std::vector<Eigen::Vector3d> wall_normal_ref;
+  std::int64_t builds = 0;
+
+  /// True when some pair may have come within contact since the last build.
+  bool stale(const ParticleState& p, const std::vector<WallState>& walls) const;
+  void build(const ParticleState& p, const std::vector<WallState>& walls);
+};
+
+}  // namespace gs::solver

@@ -1,0 +1,438 @@
+#include "simulation.hpp"
+
+#include <omp.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <limits>
+
+#include "atomic_file.hpp"
+#include "contact_geometry.hpp"
+#include "errors.hpp"
+#include "newton_integrator.hpp"
+
+namespace gs::solver {
+
+double pwave_timestep(const std::vector<double>& radii, double density, double young) {
+  double dt = std::numeric_limits<double>::infinity();
+  for (double r : radii) dt = std::min(dt, r / std::sqrt(young / density));
+  return dt;
+}
+
+Simulation::Simulation(SimulationConfig config, const std::vector<Particle>& particles,
+                       std::vector<WallSpec> walls)
+    : cfg_(std::move(config)) {
+  if (!(cfg_.dt > 0)) throw std::invalid_argument("time step must be positive");
+  if (!(cfg_.material.density > 0) || !(cfg_.material.young_ec > 0))
+    throw std::invalid_argument("material density and Ec must be positive");
+  const std::size_t n = particles.size();
+  if (n >= kWallBase) throw std::invalid_argument("too many particles");
+  p_.id.resize(n);
+  p_.radius.resize(n);
+  p_.mass.resize(n);
+  p_.inertia.resize(n);
+  p_.pos.resize(n);
+  p_.vel.resize(n);
+  p_.angvel.resize(n);
+  p_.rot.resize(n);
+  p_.force.assign(n, Eigen::Vector3d::Zero());
+  p_.torque.assign(n, Eigen::Vector3d::Zero());
+  p_.ori.resize(n);
+  p_.fixed.assign(n, 0);
+  std::int64_t max_id = -1;
+  double rmin = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto& q = particles[i];
+    if (!(q.radius > 0)) throw std::invalid_argument("particle radius must be positive");
+    p_.id[i] = q.id;
+    p_.radius[i] = q.radius;
+    // As YADE's utils.sphere: V = 4/3·π·r³, m = V·ρ, I = (2/5·V·r²)·ρ.
+    const double volume = (4.0 / 3.0) * M_PI * std::pow(q.radius, 3);
+    p_.mass[i] = volume * cfg_.material.density;
+    p_.inertia[i] = (2.0 / 5.0) * volume * std::pow(q.radius, 2) * cfg_.material.density;
+    p_.pos[i] = q.position;
+    p_.vel[i] = q.velocity;
+    p_.angvel[i] = q.angular_velocity;
+    p_.rot[i] = q.rotation;
+    p_.ori[i] = q.orientation;
+    max_id = std::max(max_id, q.id);
+    rmin = std::min(rmin, q.radius);
+  }
+  wall_id_base_ = max_id + 1;
+  for (auto& spec : walls) {
+    WallState w;
+    w.spec = spec;
+    w.pos = spec.center;
+    w.normal = spec.shape == WallShape::Plane ? Eigen::Vector3d(spec.normal.normalized()) : spec.normal;
+    w.vel = spec.velocity;
+    walls_.push_back(w);
+  }
+  nl_.skin = cfg_.skin > 0 ? cfg_.skin : (n > 0 ? 0.5 * rmin : 1e-3);
+}
+
+void Simulation::rebuild_neighbors() {
+  auto old_pairs = std::move(nl_.pairs);
+  auto old_hist = std::move(hist_);
+  nl_.build(p_, walls_);
+  const std::size_t np = nl_.pairs.size();
+  hist_.assign(np, ContactHistory{});
+  params_.resize(np);
+  std::size_t o = 0;
+  for (std::size_t k = 0; k < np; ++k) {
+    const auto pr = nl_.pairs[k];
+    while (o < old_pairs.size() && old_pairs[o] < pr) ++o;
+    if (o < old_pairs.size() && old_pairs[o] == pr) hist_[k] = old_hist[o];
+    hist_[k].a = pr.first;
+    hist_[k].b = pr.second;
+    const double ra = p_.radius[pr.first];
+    const double rb = pr.second >= kWallBase ? ra : p_.radius[pr.second];
+    params_[k] = contact_params(cfg_.material, ra, rb, cfg_.twist_beta, cfg_.twist_eta);
+  }
+  // A contact whose pair left the list cannot be touching (the skin guarantees it).
+}
+
+void Simulation::update_servos() {
+  for (auto& w : walls_) {
+    const auto& s = w.spec;
+    if (!(s.servo_area_m2 > 0)) continue;
+    // Compressive stress on the wall: the particles push it along −normal (its inward normal).
+    const Eigen::Vector3d axis = s.shape == WallShape::Plane ? w.normal : s.normal.normalized();
+    const double stress = -w.force.dot(axis) / s.servo_area_m2;
+    const double v = std::clamp(s.servo_gain * (s.servo_stress_Pa - stress), -s.servo_max_velocity,
+                                s.servo_max_velocity);
+    w.vel = v * axis;  // too little stress: move into the domain
+  }
+}
+
+void Simulation::step() {
+  if (nl_.stale(p_, walls_)) rebuild_neighbors();
+  const double dt = cfg_.dt;
+  const std::size_t np = nl_.pairs.size();
+  loads_.resize(np);
+  active_.assign(np, 0);
+  const int threads = std::max(1, cfg_.threads);
+#pragma omp parallel for num_threads(threads) schedule(static)
+  for (std::size_t k = 0; k < np; ++k) {
+    const auto [a, b] = nl_.pairs[k];
+    ContactHistory& h = hist_[k];
+    ContactGeometry g;
+    BodyMotion m1, m2;
+    if (b >= kWallBase) {
+      const WallState& w = walls_[b - kWallBase];
+      if (w.spec.shape == WallShape::Box)
+        box_sphere_geometry(w.pos, w.spec.half_extents, p_.pos[a], p_.radius[a], g);
+      else
+        plane_sphere_geometry(w.pos, w.normal, p_.pos[a], p_.radius[a], g);
+      m1 = {w.pos, w.vel, w.spec.shape == WallShape::Plane ? w.spec.angular_velocity : Eigen::Vector3d::Zero()};
+      m2 = {p_.pos[a], p_.vel[a], p_.angvel[a]};
+    } else {
+      if (!sphere_sphere_geometry(p_.pos[a], p_.radius[a], p_.pos[b], p_.radius[b], g)) {
+        h.real = false;
+        continue;
+      }
+      m1 = {p_.pos[a], p_.vel[a], p_.angvel[a]};
+      m2 = {p_.pos[b], p_.vel[b], p_.angvel[b]};
+    }
+    if (g.penetration < 0) {  // not touching (YADE erases the interaction)
+      h.real = false;
+      continue;
+    }
+    const bool fresh = !h.real;
+    loads_[k] = cohesive_frictional_step(h, fresh, g, params_[k], m1, m2, dt);
+    h.real = true;
+    active_[k] = 1;
+  }
+
+  // Accumulate in pair order: deterministic whatever the thread count.
+  const std::size_t n = p_.size();
+  std::fill(p_.force.begin(), p_.force.end(), Eigen::Vector3d::Zero());
+  std::fill(p_.torque.begin(), p_.torque.end(), Eigen::Vector3d::Zero());
+  for (auto& w : walls_) {
+    w.force.setZero();
+    w.torque.setZero();
+  }
+  double max_overlap_ratio = 0;
+  for (std::size_t k = 0; k < np; ++k) {
+    if (!active_[k]) continue;
+    const auto [a, b] = nl_.pairs[k];
+    const ContactLoads& L = loads_[k];
+    ledger_.friction_dissipation += L.friction_dissipation;
+    ledger_.rolling_dissipation += L.rolling_dissipation;
+    if (b >= kWallBase) {
+      WallState& w = walls_[b - kWallBase];
+      w.force += L.force1;
+      w.torque += L.arm1;
+      w.torque += -L.moment;
+      p_.force[a] += -L.force1;
+      p_.torque[a] += L.arm2;
+      p_.torque[a] += L.moment;
+      max_overlap_ratio = std::max(max_overlap_ratio, hist_[k].overlap / p_.radius[a]);
+    } else {
+      p_.force[a] += L.force1;
+      p_.torque[a] += L.arm1;
+      p_.torque[a] += -L.moment;
+      p_.force[b] += -L.force1;
+      p_.torque[b] += L.arm2;
+      p_.torque[b] += L.moment;
+      max_overlap_ratio =
+          std::max(max_overlap_ratio, hist_[k].overlap / std::min(p_.radius[a], p_.radius[b]));
+    }
+  }
+  if (!(max_overlap_ratio <= cfg_.max_overlap_ratio))
+    throw BlowUp("step " + std::to_string(step_) + ": overlap of " +
+                 std::to_string(max_overlap_ratio) + " radius exceeds " +
+                 std::to_string(cfg_.max_overlap_ratio) + " (time step too large or walls too fast?)");
+
+  update_servos();
+  // Work of gravity and walls over this step (velocities of the step).
+  double grav = 0;
+  for (std::size_t i = 0; i < n; ++i)
+    if (!p_.fixed[i]) grav += p_.mass[i] * cfg_.gravity.dot(p_.vel[i]);
+  ledger_.gravity_work += grav * dt;
+  for (const auto& w : walls_) ledger_.wall_work += -w.force.dot(w.vel) * dt;
+
+  std::vector<double> damp(n, 0.0);
+  bool finite = true;
+#pragma omp parallel for num_threads(threads) schedule(static) reduction(&& : finite)
+  for (std::size_t i = 0; i < n; ++i) {
+    damp[i] = integrate_particle(p_, i, cfg_.gravity, cfg_.damping, dt);
+    finite = finite && std::isfinite(p_.pos[i].squaredNorm()) && std::isfinite(p_.vel[i].squaredNorm());
+  }
+  if (!finite) throw BlowUp("step " + std::to_string(step_) + ": non-finite particle state");
+  for (double d : damp) ledger_.damping_dissipation += d;
+  for (auto& w : walls_) {
+    w.pos += w.vel * dt;
+    const double om = w.spec.angular_velocity.norm();
+    if (w.spec.shape == WallShape::Plane && om > 0)
+      w.normal = (Eigen::AngleAxisd(om * dt, w.spec.angular_velocity / om) * w.normal).normalized();
+  }
+  time_ += dt;
+  ++step_;
+}
+
+void Simulation::run(std::int64_t steps) {
+  for (std::int64_t s = 0; s < steps; ++s) step();
+}
+
+std::size_t Simulation::contact_count() const {
+  std::size_t c = 0;
+  for (const auto& h : hist_) c += h.real;
+  return c;
+}
+
+double Simulation::kinetic_energy() const {
+  double e = 0;
+  for (std::size_t i = 0; i < p_.size(); ++i)
+    e += 0.5 * p_.mass[i] * p_.vel[i].squaredNorm() + 0.5 * p_.inertia[i] * p_.angvel[i].squaredNorm();
+  return e;
+}
+
+double Simulation::unbalanced_force() const {
+  double sum_f = 0;
+  std::size_t nf = 0;
+  for (std::size_t i = 0; i < p_.size(); ++i) {
+    if (p_.fixed[i]) continue;
+    sum_f += (p_.force[i] + p_.mass[i] * cfg_.gravity).norm();
+    ++nf;
+  }
+  double sum_c = 0;
+  std::size_t nc = 0;
+  for (const auto& h : hist_) {
+    if (!h.real) continue;
+    sum_c += (h.fn * h.normal + h.shear_force).norm();
+    ++nc;
+  }
+  if (nf == 0 || nc == 0 || sum_c == 0) return std::numeric_limits<double>::quiet_NaN();
+  return (sum_f / static_cast<double>(nf)) / (sum_c / static_cast<double>(nc));
+}
+
+const EnergyLedger& Simulation::energy() {
+  ledger_.kinetic = kinetic_energy();
+  ledger_.elastic_normal = ledger_.elastic_shear = ledger_.elastic_rolling = 0;
+  for (std::size_t k = 0; k < hist_.size(); ++k) {
+    const auto& h = hist_[k];
+    if (!h.real) continue;
+    const auto& p = params_[k];
+    ledger_.elastic_normal += 0.5 * h.fn * h.fn / p.kn;
+    if (p.ks > 0) ledger_.elastic_shear += 0.5 * h.shear_force.squaredNorm() / p.ks;
+    if (p.kr > 0) ledger_.elastic_rolling += 0.5 * h.bending.squaredNorm() / p.kr;
+  }
+  if (!ledger_started_) {
+    ledger_.initial = ledger_.stored();
+    ledger_started_ = true;
+  }
+  return ledger_;
+}
+
+Frame Simulation::frame() const {
+  Frame f;
+  f.time = time_;
+  f.step = step_;
+  f.dt = cfg_.dt;
+  const std::size_t n = p_.size();
+  f.particles.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    auto& q = f.particles[i];
+    q.id = p_.id[i];
+    q.position = p_.pos[i];
+    q.radius = p_.radius[i];
+    q.velocity = p_.vel[i];
+    q.angular_velocity = p_.angvel[i];
+    q.orientation = p_.ori[i];
+    q.rotation = p_.rot[i];
+    q.mass = p_.mass[i];
+  }
+  for (const auto& h : hist_) {
+    if (!h.real) continue;
+    Contact c;
+    if (h.b >= kWallBase) {
+      c.id1 = wall_id(h.b - kWallBase);
+      c.id2 = p_.id[h.a];
+    } else {
+      c.id1 = p_.id[h.a];
+      c.id2 = p_.id[h.b];
+    }
+    c.point = h.point;
+    c.normal = h.normal;
+    c.normal_force = h.fn * h.normal;
+    c.shear_force = h.shear_force;
+    c.bending_moment = h.bending;
+    c.twisting_moment = h.twist;
+    c.overlap = h.overlap;
+    f.contacts.push_back(c);
+  }
+  for (std::size_t w = 0; w < walls_.size(); ++w) {
+    const auto& ws = walls_[w];
+    Wall wall;
+    wall.id = wall_id(w);
+    wall.kind = ws.spec.shape == WallShape::Box ? WallKind::Box : WallKind::Plane;
+    wall.a = ws.pos;
+    wall.b = ws.spec.shape == WallShape::Box ? ws.spec.half_extents : ws.normal;
+    wall.force = ws.force;
+    wall.torque = ws.torque;
+    f.walls.push_back(wall);
+  }
+  const auto [lo, hi] = particle_bounds(f);
+  f.domain.lo = lo;
+  f.domain.hi = hi;
+  return f;
+}
+
+// ------------------------------------------------------------------ checkpoints
+
+namespace {
+constexpr char kMagic[8] = {'G', 'S', 'C', 'K', 'P', 'T', '0', '1'};
+
+template <class T>
+void put(std::ostream& o, const T& v) {
+  o.write(reinterpret_cast<const char*>(&v), sizeof(T));
+}
+template <class T>
+void get(std::istream& i, T& v, const std::string& file) {
+  i.read(reinterpret_cast<char*>(&v), sizeof(T));
+  if (!i) throw InputError(file, "truncated checkpoint");
+}
+template <class T>
+void put_vec(std::ostream& o, const std::vector<T>& v) {
+  put(o, static_cast<std::uint64_t>(v.size()));
+  o.write(reinterpret_cast<const char*>(v.data()), static_cast<std::streamsize>(v.size() * sizeof(T)));
+}
+template <class T>
+void get_vec(std::istream& i, std::vector<T>& v, std::size_t expect, const std::string& file) {
+  std::uint64_t n = 0;
+  get(i, n, file);
+  if (n != expect) throw InputError(file, "checkpoint does not match the scene (array length)", std::to_string(n));
+  v.resize(n);
+  i.read(reinterpret_cast<char*>(v.data()), static_cast<std::streamsize>(n * sizeof(T)));
+  if (!i) throw InputError(file, "truncated checkpoint");
+}
+}  // namespace
+
+void Simulation::save_checkpoint(const std::filesystem::path& path) const {
+  AtomicOutput out(path);
+  {
+    std::ofstream o(out.temp_path(), std::ios::binary);
+    o.write(kMagic, 8);
+    put(o, step_);
+    put(o, time_);
+    put(o, ledger_);
+    put(o, static_cast<std::uint8_t>(ledger_started_));
+    put_vec(o, p_.pos);
+    put_vec(o, p_.vel);
+    put_vec(o, p_.angvel);
+    put_vec(o, p_.rot);
+    put_vec(o, p_.ori);
+    put_vec(o, p_.fixed);
+    put(o, static_cast<std::uint64_t>(walls_.size()));
+    for (const auto& w : walls_) {
+      put(o, w.pos);
+      put(o, w.normal);
+      put(o, w.vel);
+    }
+    // Contact histories of real contacts, sorted by pair.
+    std::vector<ContactHistory> real;
+    for (const auto& h : hist_)
+      if (h.real) real.push_back(h);
+    put(o, static_cast<std::uint64_t>(real.size()));
+    for (const auto& h : real) put(o, h);
+    if (!o.flush()) throw InputError(path.string(), "cannot write checkpoint");
+  }
+  out.commit();
+}
+
+void Simulation::load_checkpoint(const std::filesystem::path& path) {
+  const std::string file = path.string();
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(file, "cannot open checkpoint");
+  char magic[8];
+  in.read(magic, 8);
+  if (!in || std::memcmp(magic, kMagic, 8) != 0) throw InputError(file, "not a granoscope checkpoint");
+  get(in, step_, file);
+  get(in, time_, file);
+  get(in, ledger_, file);
+  std::uint8_t started = 0;
+  get(in, started, file);
+  ledger_started_ = started != 0;
+  const std::size_t n = p_.size();
+  get_vec(in, p_.pos, n, file);
+  get_vec(in, p_.vel, n, file);
+  get_vec(in, p_.angvel, n, file);
+  get_vec(in, p_.rot, n, file);
+  get_vec(in, p_.ori, n, file);
+  get_vec(in, p_.fixed, n, file);
+  std::uint64_t nw = 0;
+  get(in, nw, file);
+  if (nw != walls_.size()) throw InputError(file, "checkpoint does not match the scene (walls)", std::to_string(nw));
+  for (auto& w : walls_) {
+    get(in, w.pos, file);
+    get(in, w.normal, file);
+    get(in, w.vel, file);
+  }
+  std::uint64_t nc = 0;
+  get(in, nc, file);
+  if (nc > (1ull << 32)) throw InputError(file, "corrupt checkpoint (contact count)", std::to_string(nc));
+  std::vector<ContactHistory> real(nc);
+  for (auto& h : real) get(in, h, file);
+  // Rebuild the neighbour list from the restored state and put the histories back.
+  nl_.pairs.clear();
+  hist_.clear();
+  nl_.build(p_, walls_);
+  const std::size_t np = nl_.pairs.size();
+  hist_.assign(np, ContactHistory{});
+  params_.resize(np);
+  std::size_t o = 0;
+  for (std::size_t k = 0; k < np; ++k) {
+    const auto pr = nl_.pairs[k];
+    while (o < real.size() && std::make_pair(real[o].a, real[o].b) < pr) ++o;
+    if (o < real.size() && real[o].a == pr.first && real[o].b == pr.second) hist_[k] = real[o];
+    hist_[k].a = pr.first;
+    hist_[k].b = pr.second;
+    const double ra = p_.radius[pr.first];
+    const double rb = pr.second >= kWallBase ? ra : p_.radius[pr.second];
+    params_[k] = contact_params(cfg_.material, ra, rb, cfg_.twist_beta, cfg_.twist_eta);
+  }
+}
+
+}  // namespace gs::solver
