@@ -50,7 +50,8 @@ struct ParticleState {
   std::vector<double> radius, mass, inertia;
   std::vector<Eigen::Vector3d> pos, vel, angvel, rot, force, torque;
   std::vector<Eigen::Quaterniond> ori;
-  std::vector<std::uint8_t> fixed;  // 1: velocities imposed (not integrated from forces)
+  std::vector<std::uint8_t> fixed;        // 1: velocities imposed (not integrated from forces)
+  std::vector<std::uint8_t> rot_blocked;  // 1: angular velocity imposed, translation free
 
   std::size_t size() const { return pos.size(); }
 };

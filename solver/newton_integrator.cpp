@@ -16,9 +16,11 @@ double integrate_particle(ParticleState& p, std::size_t i, const Eigen::Vector3d
     Eigen::Vector3d lin = p.force[i] / m + gravity;
     cundall_damp(damping, dt, p.vel[i], lin);
     p.vel[i] += dt * lin;
-    Eigen::Vector3d ang = p.torque[i] / p.inertia[i];
-    cundall_damp(damping, dt, p.angvel[i], ang);
-    p.angvel[i] += dt * ang;
+    if (!p.rot_blocked[i]) {
+      Eigen::Vector3d ang = p.torque[i] / p.inertia[i];
+      cundall_damp(damping, dt, p.angvel[i], ang);
+      p.angvel[i] += dt * ang;
+    }
   }
   p.pos[i] += p.vel[i] * dt;
   const double a2 = p.angvel[i].squaredNorm();

@@ -41,6 +41,7 @@ Simulation::Simulation(SimulationConfig config, const std::vector<Particle>& par
   p_.torque.assign(n, Eigen::Vector3d::Zero());
   p_.ori.resize(n);
   p_.fixed.assign(n, 0);
+  p_.rot_blocked.assign(n, 0);
   std::int64_t max_id = -1;
   double rmin = std::numeric_limits<double>::infinity();
   for (std::size_t i = 0; i < n; ++i) {
@@ -365,6 +366,7 @@ void Simulation::save_checkpoint(const std::filesystem::path& path) const {
     put_vec(o, p_.rot);
     put_vec(o, p_.ori);
     put_vec(o, p_.fixed);
+    put_vec(o, p_.rot_blocked);
     put(o, static_cast<std::uint64_t>(walls_.size()));
     for (const auto& w : walls_) {
       put(o, w.pos);
@@ -402,6 +404,7 @@ void Simulation::load_checkpoint(const std::filesystem::path& path) {
   get_vec(in, p_.rot, n, file);
   get_vec(in, p_.ori, n, file);
   get_vec(in, p_.fixed, n, file);
+  get_vec(in, p_.rot_blocked, n, file);
   std::uint64_t nw = 0;
   get(in, nw, file);
   if (nw != walls_.size()) throw InputError(file, "checkpoint does not match the scene (walls)", std::to_string(nw));
