@@ -17,6 +17,7 @@ struct ExitStatus {
 void register_info(CLI::App& app);     // io
 void register_convert(CLI::App& app);  // io
 void register_figures(CLI::App& app);  // apps
+void register_simulate(CLI::App& app);  // solver
 
 /// `granoscope analyze` parent; analyses register below it (analyze hhd, analyze strain, ...).
 CLI::App& analyze_command(CLI::App& app);

@@ -26,6 +26,7 @@ int main(int argc, char** argv) {
   gs::cli::register_info(app);
   gs::cli::register_convert(app);
   gs::cli::register_figures(app);
+  gs::cli::register_simulate(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

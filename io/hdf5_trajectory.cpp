@@ -436,12 +436,11 @@ TrajectoryWriter TrajectoryWriter::resume(std::filesystem::path path, std::size_
   auto fapl = latest_fapl();
   impl->file = Hid(H5Fopen(impl->file_path.string().c_str(), H5F_ACC_RDWR, fapl.get()), H5Fclose);
   if (!impl->file.valid()) {
-    // A killed single-writer leaves its flag set; clear it by opening with SWMR read first is
-    // not possible for writing, so reopen through H5Fopen after marking the file as closed.
-    impl->file =
-        Hid(H5Fopen(impl->file_path.string().c_str(), H5F_ACC_RDWR | H5F_ACC_SWMR_WRITE,
-                    fapl.get()),
-            H5Fclose);
+    // A writer killed in single-writer mode leaves the superblock marked as open; clear that
+    // mark (what the h5clear tool does) and open again.
+    hbool_t clear = 1;
+    if (H5Pset(fapl.get(), "clear_status_flags", &clear) >= 0)
+      impl->file = Hid(H5Fopen(impl->file_path.string().c_str(), H5F_ACC_RDWR, fapl.get()), H5Fclose);
   }
   if (!impl->file.valid()) throw InputError(impl->name(), "cannot reopen trajectory to resume");
   impl->open_datasets();
