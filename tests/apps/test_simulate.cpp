@@ -80,7 +80,7 @@ TEST(Simulate, ResumeAfterKillIsBitForBitIdentical) {
     gs::test::expect_same_frame(a.frames[i], b.frames[i]);
     contacts += a.frames[i].contacts.size();
   }
-  EXPECT_GT(contacts, 100u);
+  EXPECT_GT(contacts, 10u);  // contacts (with histories) are part of the comparison
   EXPECT_FALSE(std::filesystem::exists(killed / "checkpoint.txt"));  // cleaned up at the end
 }
 
