@@ -172,6 +172,7 @@ void run(const Args& a) {
       const std::int64_t s = sim.step_count();
       const bool last = s == scene.steps;
       if (s % scene.output.history_every == 0 || last) {
+        sim.check_energy();
         hist << history_row(sim);
         ++history_rows;
       }

@@ -151,6 +151,7 @@ Scene load_scene(const std::filesystem::path& path) {
   s.config.threads = static_cast<int>(r.integer(sol, "solver", "threads", false, 1, 1));
   s.config.skin = r.number(sol, "solver", "skin_m", false, 0);
   s.config.max_overlap_ratio = r.positive(sol, "solver", "max_overlap_ratio", false, 0.1);
+  s.config.max_energy_residual = r.positive(sol, "solver", "max_energy_residual", false, 0.2);
 
   const auto* out = r.table("output", false);
   s.output.trajectory = r.string(out, "output", "trajectory", false, s.output.trajectory);

@@ -267,6 +267,15 @@ const EnergyLedger& Simulation::energy() {
   return ledger_;
 }
 
+void Simulation::check_energy() {
+  const auto& e = energy();
+  const double turnover = e.stored() + e.dissipated() + std::abs(e.gravity_work) + std::abs(e.wall_work) + e.initial;
+  if (turnover > 0 && std::abs(e.residual()) > cfg_.max_energy_residual * turnover)
+    throw BlowUp("step " + std::to_string(step_) + ": energy ledger residual " + std::to_string(e.residual()) +
+                 " J exceeds " + std::to_string(cfg_.max_energy_residual) + " of the energy turnover " +
+                 std::to_string(turnover) + " J");
+}
+
 Frame Simulation::frame() const {
   Frame f;
   f.time = time_;

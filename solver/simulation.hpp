@@ -25,6 +25,8 @@ struct SimulationConfig {
   double twist_beta = 0;  // twisting stiffness factor (0: twisting moment off)
   double twist_eta = -1;  // twisting limit factor (negative: unbounded)
   double max_overlap_ratio = 0.1;  // blow-up when an overlap exceeds this fraction of a radius
+  double max_energy_residual = 0.2;  // blow-up when |ledger residual| exceeds this fraction of
+                                     // the energy turnover (checked by check_energy())
 };
 
 /// Cumulative energy terms (J). Inputs are positive when energy enters the system.
@@ -73,6 +75,8 @@ class Simulation {
   double kinetic_energy() const;
   /// Updates the stored-energy terms of the ledger and returns it.
   const EnergyLedger& energy();
+  /// Throws BlowUp when the ledger residual is out of bounds (see SimulationConfig).
+  void check_energy();
   /// Id that walls get in snapshots: first wall = (largest particle id) + 1, like YADE bodies.
   std::int64_t wall_id(std::size_t w) const { return wall_id_base_ + static_cast<std::int64_t>(w); }
   std::int64_t neighbor_list_builds() const { return nl_.builds; }

@@ -268,3 +268,52 @@ TEST(Physics, BlowUpIsDetected) {
   Simulation sim(c, {sphere(0, {0, 0, 0}, 1e-3, {1, 0, 0}), sphere(1, {2.1e-3, 0, 0}, 1e-3, {-1, 0, 0})}, {});
   EXPECT_THROW(sim.run(100), BlowUp);
 }
+
+// A servo-controlled plane presses a sphere onto a fixed floor and settles at the target stress.
+TEST(Physics, ServoWallReachesTargetStress) {
+  const double r = 1e-3;
+  SimulationConfig c;
+  c.material = material(1e8, 30);
+  c.dt = 1e-7;
+  c.damping = 0.3;
+  WallSpec top = plane({0, 0, 2 * r + 1e-5}, {0, 0, -1});
+  top.servo_stress_Pa = 1e3;
+  top.servo_area_m2 = 1e-6;  // target force 1e-3 N
+  top.servo_gain = 1e-4;     // m/s per Pa
+  top.servo_max_velocity = 0.05;
+  Simulation sim(c, {sphere(0, {0, 0, r}, r)}, {plane({0, 0, 0}, {0, 0, 1}), top});
+  sim.run(200000);
+  const double force = sim.walls()[1].force.dot(Eigen::Vector3d(0, 0, 1));
+  EXPECT_NEAR(force, 1e-3, 1e-5);                                   // stress within 1 %
+  EXPECT_NEAR(sim.walls()[0].force.z(), -1e-3, 1e-5);               // transmitted to the floor
+  EXPECT_NEAR(sim.frame().contacts.at(0).overlap, 1e-3 / (1e8 * r), 1e-9);  // Fn = Kn·u
+}
+
+TEST(Physics, EnergyLedgerCatchesAnUnstableRun) {
+  // A sphere resting on a floor with dt above the critical 2/ω: each bounce creates energy and
+  // the ledger residual flags it before anything becomes non-finite.
+  SimulationConfig c;
+  c.material = material();
+  c.gravity = Eigen::Vector3d(0, 0, -9.81);
+  c.max_overlap_ratio = 1e9;  // let the ledger be the one to catch it
+  const double r = 1e-3, m = (4.0 / 3.0) * M_PI * r * r * r * c.material.density;
+  const double omega = std::sqrt(c.material.young_ec * r / m);
+  auto make = [&](double dt) {
+    c.dt = dt;
+    return Simulation(c, {sphere(0, {0, 0, r - 2e-9}, r)}, {plane({0, 0, 0}, {0, 0, 1})});
+  };
+  Simulation bad = make(2.2 / omega);
+  EXPECT_THROW(
+      {
+        for (int s = 0; s < 10000; ++s) {
+          bad.step();
+          bad.check_energy();
+        }
+      },
+      BlowUp);
+  Simulation good = make(0.2 / omega);  // the same check passes a stable run
+  for (int s = 0; s < 10000; ++s) {
+    good.step();
+    good.check_energy();
+  }
+}
