@@ -261,8 +261,27 @@ const EnergyLedger& Simulation::energy() {
     if (p.kr > 0) ledger_.elastic_rolling += 0.5 * h.bending.squaredNorm() / p.kr;
   }
   if (!ledger_started_) {
-    ledger_.initial = ledger_.stored();
     ledger_started_ = true;
+    ledger_.initial = ledger_.stored();
+    if (step_ == 0) {
+      // Overlaps present in the initial packing become contacts in the first step: their
+      // normal elastic energy ½·Kn·u² belongs to the initial state.
+      if (nl_.stale(p_, walls_)) rebuild_neighbors();
+      for (std::size_t k = 0; k < nl_.pairs.size(); ++k) {
+        const auto [a, b] = nl_.pairs[k];
+        ContactGeometry g;
+        if (b >= kWallBase) {
+          const WallState& w = walls_[b - kWallBase];
+          if (w.spec.shape == WallShape::Box)
+            box_sphere_geometry(w.pos, w.spec.half_extents, p_.pos[a], p_.radius[a], g);
+          else
+            plane_sphere_geometry(w.pos, w.normal, p_.pos[a], p_.radius[a], g);
+        } else if (!sphere_sphere_geometry(p_.pos[a], p_.radius[a], p_.pos[b], p_.radius[b], g)) {
+          continue;
+        }
+        if (g.penetration > 0) ledger_.initial += 0.5 * params_[k].kn * g.penetration * g.penetration;
+      }
+    }
   }
   return ledger_;
 }
