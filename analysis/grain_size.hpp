@@ -15,6 +15,8 @@ double diameter_percentile(const Frame& frame, double fraction);
 /// Same on plain radii.
 double diameter_percentile(std::vector<double> radii, double fraction);
 
-inline double d50(const Frame& frame) { return diameter_percentile(frame, 0.5); }
+inline double d50(const Frame& frame) {
+  return diameter_percentile(frame, 0.5);
+}
 
 }  // namespace gs::analysis

@@ -8,13 +8,16 @@
 namespace gs::cli {
 
 void register_convert(CLI::App& app) {
-  auto* cmd = app.add_subcommand("convert", "Convert between snapshot formats, chosen by file extension");
+  auto* cmd =
+      app.add_subcommand("convert", "Convert between snapshot formats, chosen by file extension");
   auto in = std::make_shared<std::string>();
   auto out = std::make_shared<std::string>();
   auto frame = std::make_shared<long>(-1);
   auto imp = std::make_shared<ImportArgs>();
   cmd->add_option("IN", *in, "input file (any supported format)")->required();
-  cmd->add_option("OUT", *out, "output: .h5 (all frames), .pvd (all frames), .vtu or .csv (one frame)")->required();
+  cmd->add_option("OUT", *out,
+                  "output: .h5 (all frames), .pvd (all frames), .vtu or .csv (one frame)")
+      ->required();
   cmd->add_option("--frame", *frame, "frame written to .vtu/.csv; negative counts from the end")
       ->capture_default_str();
   imp->add_to(*cmd);

@@ -15,7 +15,8 @@ void register_figures(CLI::App& app) {
   auto out = std::make_shared<std::string>();
   auto type = std::make_shared<std::string>();
   auto frame = std::make_shared<long>(-1);
-  cmd->add_option("INPUT", *in, "HDF5 file written by granoscope (trajectory or analysis)")->required();
+  cmd->add_option("INPUT", *in, "HDF5 file written by granoscope (trajectory or analysis)")
+      ->required();
   cmd->add_option("-o,--out", *out, "output directory (created)")->required();
   cmd->add_option("--type", *type, "one figure type (e.g. positions); default: all for the input");
   cmd->add_option("--frame", *frame, "frame of a trajectory (negative counts from the end)")
@@ -24,11 +25,13 @@ void register_figures(CLI::App& app) {
     std::error_code ec;
     if (!std::filesystem::exists(*in, ec)) throw InputError(*in, "no such file");
     if (!is_hdf5_file(*in))
-      throw InputError(*in, "figures need an HDF5 file written by granoscope (use `granoscope convert` first)");
+      throw InputError(
+          *in, "figures need an HDF5 file written by granoscope (use `granoscope convert` first)");
     const auto script = figures_dir() / "granoscope_figures.py";
-    if (!std::filesystem::exists(script, ec)) throw InputError(script.string(), "figure scripts not found");
-    std::vector<std::string> argv{find_python(), script.string(), *in, "-o", *out,
-                                  "--frame", std::to_string(*frame)};
+    if (!std::filesystem::exists(script, ec))
+      throw InputError(script.string(), "figure scripts not found");
+    std::vector<std::string> argv{find_python(), script.string(),       *in, "-o", *out,
+                                  "--frame",     std::to_string(*frame)};
     if (!type->empty()) {
       argv.push_back("--type");
       argv.push_back(*type);

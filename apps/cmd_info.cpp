@@ -34,10 +34,13 @@ void print_info(const std::string& file, const std::string& format, std::size_t 
 }  // namespace
 
 void register_info(CLI::App& app) {
-  auto* cmd = app.add_subcommand("info", "Summarise a snapshot or trajectory file of any supported format");
+  auto* cmd =
+      app.add_subcommand("info", "Summarise a snapshot or trajectory file of any supported format");
   auto file = std::make_shared<std::string>();
   auto imp = std::make_shared<ImportArgs>();
-  cmd->add_option("FILE", *file, "HDF5 trajectory, .vtu, .pvd, YADE .vtk, packing .csv, LIGGGHTS dump")->required();
+  cmd->add_option("FILE", *file,
+                  "HDF5 trajectory, .vtu, .pvd, YADE .vtk, packing .csv, LIGGGHTS dump")
+      ->required();
   imp->add_to(*cmd);
   cmd->callback([file, imp] {
     const auto fmt = detect_format(*file);

@@ -14,9 +14,9 @@ struct ExitStatus {
 };
 
 // Declarations, one line each (keep sorted by module):
-void register_info(CLI::App& app);     // io
-void register_convert(CLI::App& app);  // io
-void register_figures(CLI::App& app);  // apps
+void register_info(CLI::App& app);      // io
+void register_convert(CLI::App& app);   // io
+void register_figures(CLI::App& app);   // apps
 void register_simulate(CLI::App& app);  // solver
 
 /// `granoscope analyze` parent; analyses register below it (analyze hhd, analyze strain, ...).

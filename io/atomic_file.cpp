@@ -14,7 +14,8 @@ std::atomic<unsigned> g_counter{0};
 }
 
 AtomicOutput::AtomicOutput(std::filesystem::path target) : target_(std::move(target)) {
-  const auto parent = target_.has_parent_path() ? target_.parent_path() : std::filesystem::path(".");
+  const auto parent =
+      target_.has_parent_path() ? target_.parent_path() : std::filesystem::path(".");
   std::error_code ec;
   if (!std::filesystem::is_directory(parent, ec))
     throw InputError(target_.string(), "output directory does not exist", parent.string());

@@ -46,7 +46,9 @@ class Hid {
   herr_t (*closer_)(hid_t) = nullptr;
 };
 
-void quiet_hdf5() { H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr); }
+void quiet_hdf5() {
+  H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+}
 
 struct Column {
   const char* group;
@@ -56,20 +58,58 @@ struct Column {
   hsize_t chunk_rows;
 };
 
-hid_t t_f64() { return H5T_NATIVE_DOUBLE; }
-hid_t t_i64() { return H5T_NATIVE_INT64; }
-hid_t t_i32() { return H5T_NATIVE_INT32; }
-hid_t t_i8() { return H5T_NATIVE_INT8; }
+hid_t t_f64() {
+  return H5T_NATIVE_DOUBLE;
+}
+hid_t t_i64() {
+  return H5T_NATIVE_INT64;
+}
+hid_t t_i32() {
+  return H5T_NATIVE_INT32;
+}
+hid_t t_i8() {
+  return H5T_NATIVE_INT8;
+}
 
 constexpr hsize_t kRowChunk = 4096;
 constexpr hsize_t kFrameChunk = 64;
 
 // Column order matters for the writer: /frames/end must stay last (commit marker).
 enum Col : int {
-  P_ID, P_POS, P_RAD, P_VEL, P_ANGVEL, P_ORI, P_ROT, P_MASS, P_CLUMP, P_MAT,
-  C_ID1, C_ID2, C_POINT, C_NORMAL, C_FN, C_FS, C_MB, C_MT, C_OVERLAP,
-  W_ID, W_KIND, W_A, W_B, W_FORCE, W_TORQUE,
-  F_TIME, F_STEP, F_DT, F_TWOD, F_LO, F_HI, F_PERIODIC, F_CELL, F_END,
+  P_ID,
+  P_POS,
+  P_RAD,
+  P_VEL,
+  P_ANGVEL,
+  P_ORI,
+  P_ROT,
+  P_MASS,
+  P_CLUMP,
+  P_MAT,
+  C_ID1,
+  C_ID2,
+  C_POINT,
+  C_NORMAL,
+  C_FN,
+  C_FS,
+  C_MB,
+  C_MT,
+  C_OVERLAP,
+  W_ID,
+  W_KIND,
+  W_A,
+  W_B,
+  W_FORCE,
+  W_TORQUE,
+  F_TIME,
+  F_STEP,
+  F_DT,
+  F_TWOD,
+  F_LO,
+  F_HI,
+  F_PERIODIC,
+  F_CELL,
+  F_END,
   N_COLS
 };
 
@@ -113,7 +153,9 @@ const std::vector<Column>& columns() {
   return cols;
 }
 
-std::string col_path(const Column& c) { return std::string("/") + c.group + "/" + c.name; }
+std::string col_path(const Column& c) {
+  return std::string("/") + c.group + "/" + c.name;
+}
 
 hsize_t row_width(const Column& c) {
   hsize_t w = 1;
@@ -193,8 +235,7 @@ struct Appendable {
     std::vector<hsize_t> start(dims.size(), 0), count = dims;
     start[0] = rows;
     count[0] = n;
-    H5Sselect_hyperslab(fspace.get(), H5S_SELECT_SET, start.data(), nullptr, count.data(),
-                        nullptr);
+    H5Sselect_hyperslab(fspace.get(), H5S_SELECT_SET, start.data(), nullptr, count.data(), nullptr);
     Hid mspace(H5Screate_simple(static_cast<int>(count.size()), count.data(), nullptr), H5Sclose);
     if (H5Dwrite(ds.get(), col->mem_type(), mspace.get(), fspace.get(), H5P_DEFAULT, data) < 0)
       throw InputError(file, "cannot write dataset", col_path(*col));
@@ -215,7 +256,9 @@ void put3(double* out, const Eigen::Vector3d& v) {
   out[2] = v.z();
 }
 
-Eigen::Vector3d get3(const double* in) { return {in[0], in[1], in[2]}; }
+Eigen::Vector3d get3(const double* in) {
+  return {in[0], in[1], in[2]};
+}
 
 }  // namespace
 
@@ -305,12 +348,12 @@ struct TrajectoryWriter::Impl {
         H5Pset_deflate(dcpl.get(), static_cast<unsigned>(options.deflate_level));
       }
       H5Pset_fletcher32(dcpl.get());
-      hid_t ftype = c.mem_type() == H5T_NATIVE_DOUBLE ? H5T_IEEE_F64LE
+      hid_t ftype = c.mem_type() == H5T_NATIVE_DOUBLE  ? H5T_IEEE_F64LE
                     : c.mem_type() == H5T_NATIVE_INT64 ? H5T_STD_I64LE
                     : c.mem_type() == H5T_NATIVE_INT32 ? H5T_STD_I32LE
                                                        : H5T_STD_I8LE;
-      Hid d(H5Dcreate2(file.get(), col_path(c).c_str(), ftype, space.get(), H5P_DEFAULT,
-                       dcpl.get(), H5P_DEFAULT),
+      Hid d(H5Dcreate2(file.get(), col_path(c).c_str(), ftype, space.get(), H5P_DEFAULT, dcpl.get(),
+                       H5P_DEFAULT),
             H5Dclose);
       if (!d.valid()) throw InputError(name(), "cannot create dataset", col_path(c));
     }
@@ -340,15 +383,17 @@ struct TrajectoryWriter::Impl {
     wr(P_POS, gather<double>(np, 3, [&](auto i, auto* o) { put3(o, P[i].position); }), np);
     wr(P_RAD, gather<double>(np, 1, [&](auto i, auto* o) { *o = P[i].radius; }), np);
     wr(P_VEL, gather<double>(np, 3, [&](auto i, auto* o) { put3(o, P[i].velocity); }), np);
-    wr(P_ANGVEL,
-       gather<double>(np, 3, [&](auto i, auto* o) { put3(o, P[i].angular_velocity); }), np);
-    wr(P_ORI, gather<double>(np, 4, [&](auto i, auto* o) {
-         const auto& q = P[i].orientation;
-         o[0] = q.w();
-         o[1] = q.x();
-         o[2] = q.y();
-         o[3] = q.z();
-       }),
+    wr(P_ANGVEL, gather<double>(np, 3, [&](auto i, auto* o) { put3(o, P[i].angular_velocity); }),
+       np);
+    wr(P_ORI,
+       gather<double>(np, 4,
+                      [&](auto i, auto* o) {
+                        const auto& q = P[i].orientation;
+                        o[0] = q.w();
+                        o[1] = q.x();
+                        o[2] = q.y();
+                        o[3] = q.z();
+                      }),
        np);
     wr(P_ROT, gather<double>(np, 3, [&](auto i, auto* o) { put3(o, P[i].rotation); }), np);
     wr(P_MASS, gather<double>(np, 1, [&](auto i, auto* o) { *o = P[i].mass; }), np);
@@ -366,9 +411,9 @@ struct TrajectoryWriter::Impl {
     wr(C_OVERLAP, gather<double>(nc, 1, [&](auto i, auto* o) { *o = C[i].overlap; }), nc);
 
     wr(W_ID, gather<std::int64_t>(nw, 1, [&](auto i, auto* o) { *o = W[i].id; }), nw);
-    wr(W_KIND, gather<std::int32_t>(nw, 1, [&](auto i, auto* o) {
-         *o = static_cast<std::int32_t>(W[i].kind);
-       }),
+    wr(W_KIND,
+       gather<std::int32_t>(nw, 1,
+                            [&](auto i, auto* o) { *o = static_cast<std::int32_t>(W[i].kind); }),
        nw);
     wr(W_A, gather<double>(nw, 3, [&](auto i, auto* o) { put3(o, W[i].a); }), nw);
     wr(W_B, gather<double>(nw, 3, [&](auto i, auto* o) { put3(o, W[i].b); }), nw);
@@ -440,7 +485,8 @@ TrajectoryWriter TrajectoryWriter::resume(std::filesystem::path path, std::size_
     // mark (what the h5clear tool does) and open again.
     hbool_t clear = 1;
     if (H5Pset(fapl.get(), "clear_status_flags", &clear) >= 0)
-      impl->file = Hid(H5Fopen(impl->file_path.string().c_str(), H5F_ACC_RDWR, fapl.get()), H5Fclose);
+      impl->file =
+          Hid(H5Fopen(impl->file_path.string().c_str(), H5F_ACC_RDWR, fapl.get()), H5Fclose);
   }
   if (!impl->file.valid()) throw InputError(impl->name(), "cannot reopen trajectory to resume");
   impl->open_datasets();
@@ -452,14 +498,14 @@ TrajectoryWriter TrajectoryWriter::resume(std::filesystem::path path, std::size_
     hsize_t start[2] = {keep - 1, 0}, count[2] = {1, 3};
     H5Sselect_hyperslab(fspace.get(), H5S_SELECT_SET, start, nullptr, count, nullptr);
     Hid mspace(H5Screate_simple(2, count, nullptr), H5Sclose);
-    if (H5Dread(impl->ds[F_END].ds.get(), H5T_NATIVE_INT64, mspace.get(), fspace.get(),
-                H5P_DEFAULT, end.data()) < 0)
+    if (H5Dread(impl->ds[F_END].ds.get(), H5T_NATIVE_INT64, mspace.get(), fspace.get(), H5P_DEFAULT,
+                end.data()) < 0)
       throw InputError(impl->name(), "cannot read frame index", "/frames/end");
   }
   for (int i = 0; i < N_COLS; ++i) {
     const auto& c = columns()[i];
     const std::string g = c.group;
-    const hsize_t rows = g == "particles" ? end[0]
+    const hsize_t rows = g == "particles"  ? end[0]
                          : g == "contacts" ? end[1]
                          : g == "walls"    ? end[2]
                                            : keep;
@@ -497,14 +543,16 @@ void TrajectoryWriter::append(const Frame& frame) {
   impl_->append(frame);
 }
 
-std::size_t TrajectoryWriter::frames_written() const { return impl_->frames; }
+std::size_t TrajectoryWriter::frames_written() const {
+  return impl_->frames;
+}
 
 void TrajectoryWriter::finish() {
   impl_->close();
   std::error_code ec;
   std::filesystem::rename(impl_->file_path, impl_->final_path, ec);
-  if (ec) throw InputError(impl_->final_path.string(), "cannot rename output into place",
-                           ec.message());
+  if (ec)
+    throw InputError(impl_->final_path.string(), "cannot rename output into place", ec.message());
   impl_->finished = true;
 }
 
@@ -536,8 +584,8 @@ struct TrajectoryReader::Impl {
                             nullptr) < 0)
       throw InputError(file_name, "bad selection in dataset", col_path(c));
     Hid mspace(H5Screate_simple(static_cast<int>(cnt.size()), cnt.data(), nullptr), H5Sclose);
-    if (H5Dread(ds[col].get(), c.mem_type(), mspace.get(), fspace.get(), H5P_DEFAULT,
-                out.data()) < 0)
+    if (H5Dread(ds[col].get(), c.mem_type(), mspace.get(), fspace.get(), H5P_DEFAULT, out.data()) <
+        0)
       throw InputError(file_name, "cannot read dataset (corrupt or truncated)", col_path(c));
     return out;
   }
@@ -562,7 +610,8 @@ struct TrajectoryReader::Impl {
       return read_string_attr(a.get(), file_name, nm);
     };
     const std::string fmt = attr_string("format");
-    if (fmt != kTrajectoryFormatName) throw InputError(file_name, "not a granoscope trajectory, format", fmt);
+    if (fmt != kTrajectoryFormatName)
+      throw InputError(file_name, "not a granoscope trajectory, format", fmt);
     {
       Hid a(H5Aopen(file.get(), "schema_version", H5P_DEFAULT), H5Aclose);
       long long v = -1;
@@ -584,10 +633,11 @@ struct TrajectoryReader::Impl {
                              H5P_DEFAULT),
               H5Aclose);
         if (!a.valid())
-          a = Hid(H5Aopen_by_idx(g.get(), ".", H5_INDEX_NAME, H5_ITER_INC, i, H5P_DEFAULT,
-                                 H5P_DEFAULT),
-                  H5Aclose);
-        if (!a.valid()) throw InputError(file_name, "cannot read metadata attribute", std::to_string(i));
+          a = Hid(
+              H5Aopen_by_idx(g.get(), ".", H5_INDEX_NAME, H5_ITER_INC, i, H5P_DEFAULT, H5P_DEFAULT),
+              H5Aclose);
+        if (!a.valid())
+          throw InputError(file_name, "cannot read metadata attribute", std::to_string(i));
         const ssize_t len = H5Aget_name(a.get(), 0, nullptr);
         if (len <= 0 || len > 65536) throw InputError(file_name, "bad metadata attribute name");
         std::string key(static_cast<size_t>(len) + 1, '\0');
@@ -607,7 +657,8 @@ struct TrajectoryReader::Impl {
       Hid space(H5Dget_space(ds[i].get()), H5Sclose);
       const int rank = H5Sget_simple_extent_ndims(space.get());
       if (rank != static_cast<int>(1 + c.tail.size()))
-        throw InputError(file_name, "dataset has wrong rank", col_path(c) + " rank " + std::to_string(rank));
+        throw InputError(file_name, "dataset has wrong rank",
+                         col_path(c) + " rank " + std::to_string(rank));
       hsize_t dims[8] = {};
       H5Sget_simple_extent_dims(space.get(), dims, nullptr);
       for (size_t k = 0; k < c.tail.size(); ++k)
@@ -622,7 +673,8 @@ struct TrajectoryReader::Impl {
     }
     n = rows[F_END];
     for (int i = F_TIME; i < N_COLS; ++i)
-      if (rows[i] < n) throw InputError(file_name, "frame table shorter than frame index", col_path(columns()[i]));
+      if (rows[i] < n)
+        throw InputError(file_name, "frame table shorter than frame index", col_path(columns()[i]));
     time = read_rows<double>(F_TIME, 0, n);
     step = read_rows<std::int64_t>(F_STEP, 0, n);
     dt = read_rows<double>(F_DT, 0, n);
@@ -637,12 +689,14 @@ struct TrajectoryReader::Impl {
     for (int k = 0; k < 3; ++k) {
       for (int c = first_col[k]; c <= last_col[k]; ++c)
         if (rows[c] != limits[k])
-          throw InputError(file_name, "datasets of one group differ in length", col_path(columns()[c]));
+          throw InputError(file_name, "datasets of one group differ in length",
+                           col_path(columns()[c]));
       std::int64_t prev = 0;
       for (std::size_t i = 0; i < n; ++i) {
         const std::int64_t e = end[i * 3 + k];
         if (e < prev || static_cast<hsize_t>(e) > limits[k])
-          throw InputError(file_name, "corrupt frame index /frames/end at frame " + std::to_string(i),
+          throw InputError(file_name,
+                           "corrupt frame index /frames/end at frame " + std::to_string(i),
                            std::to_string(e));
         prev = e;
       }
@@ -662,9 +716,15 @@ TrajectoryReader::TrajectoryReader(const std::filesystem::path& path)
 TrajectoryReader::TrajectoryReader(TrajectoryReader&&) noexcept = default;
 TrajectoryReader::~TrajectoryReader() = default;
 
-std::size_t TrajectoryReader::frame_count() const { return impl_->n; }
-const RunMetadata& TrajectoryReader::metadata() const { return impl_->meta; }
-double TrajectoryReader::time(std::size_t i) const { return impl_->time.at(i); }
+std::size_t TrajectoryReader::frame_count() const {
+  return impl_->n;
+}
+const RunMetadata& TrajectoryReader::metadata() const {
+  return impl_->meta;
+}
+double TrajectoryReader::time(std::size_t i) const {
+  return impl_->time.at(i);
+}
 std::size_t TrajectoryReader::particle_count(std::size_t i) const {
   if (i >= impl_->n) throw std::out_of_range("frame index");
   return impl_->range(i, 0).second;
@@ -677,7 +737,8 @@ std::size_t TrajectoryReader::contact_count(std::size_t i) const {
 Frame TrajectoryReader::frame(std::size_t i) const {
   const Impl& m = *impl_;
   if (i >= m.n)
-    throw InputError(m.file_name, "no such frame", std::to_string(i) + " of " + std::to_string(m.n));
+    throw InputError(m.file_name, "no such frame",
+                     std::to_string(i) + " of " + std::to_string(m.n));
   Frame f;
   f.time = m.time[i];
   f.step = m.step[i];
@@ -709,7 +770,8 @@ Frame TrajectoryReader::frame(std::size_t i) const {
       p.radius = rad[k];
       p.velocity = get3(&vel[k * 3]);
       p.angular_velocity = get3(&av[k * 3]);
-      p.orientation = Eigen::Quaterniond(ori[k * 4], ori[k * 4 + 1], ori[k * 4 + 2], ori[k * 4 + 3]);
+      p.orientation =
+          Eigen::Quaterniond(ori[k * 4], ori[k * 4 + 1], ori[k * 4 + 2], ori[k * 4 + 3]);
       p.rotation = get3(&rot[k * 3]);
       p.mass = mass[k];
       p.clump_id = clump[k];

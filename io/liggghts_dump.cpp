@@ -28,7 +28,8 @@ std::vector<Block> parse_blocks(const std::string& text, const std::string& name
   std::vector<Block> blocks;
   std::size_t i = 0;
   auto need_line = [&](std::size_t k) {
-    if (k >= lines.size()) throw InputError(name, "truncated dump at line " + std::to_string(k + 1));
+    if (k >= lines.size())
+      throw InputError(name, "truncated dump at line " + std::to_string(k + 1));
     return lines[k];
   };
   while (i < lines.size()) {
@@ -59,7 +60,8 @@ std::vector<Block> parse_blocks(const std::string& text, const std::string& name
       if (fl != "pp") b.periodic = false;
     for (int d = 0; d < 3; ++d) {
       const auto t = text::split_ws(need_line(i + 1 + d));
-      if (t.size() < 2) throw InputError(name, "line " + std::to_string(i + 2 + d) + ": bad box bounds");
+      if (t.size() < 2)
+        throw InputError(name, "line " + std::to_string(i + 2 + d) + ": bad box bounds");
       b.lo[d] = text::to_double(t[0], name, i + 2 + d, "box bounds");
       b.hi[d] = text::to_double(t[1], name, i + 2 + d, "box bounds");
     }
@@ -75,8 +77,9 @@ std::vector<Block> parse_blocks(const std::string& text, const std::string& name
     for (std::size_t r = 0; r < b.count; ++r) {
       const auto t = text::split_ws(need_line(i + r));
       if (!b.columns.empty() && t.size() != b.columns.size())
-        throw InputError(name, "line " + std::to_string(i + r + 1) + ": expected " +
-                                   std::to_string(b.columns.size()) + " columns",
+        throw InputError(name,
+                         "line " + std::to_string(i + r + 1) + ": expected " +
+                             std::to_string(b.columns.size()) + " columns",
                          std::to_string(t.size()));
       b.rows.push_back(t);
     }
@@ -121,8 +124,14 @@ Trajectory read_liggghts_dump(const std::filesystem::path& atoms_path,
     const int cx = find_col(b.columns, {"x", "xu"}), cy = find_col(b.columns, {"y", "yu"}),
               cz = find_col(b.columns, {"z", "zu"});
     const int cr = find_col(b.columns, {"radius"});
-    const char* missing = cid < 0 ? "id" : cx < 0 ? "x" : cy < 0 ? "y" : cz < 0 ? "z" : cr < 0 ? "radius" : nullptr;
-    if (missing) throw InputError(name, "timestep " + std::to_string(b.step) + ": missing column", missing);
+    const char* missing = cid < 0  ? "id"
+                          : cx < 0 ? "x"
+                          : cy < 0 ? "y"
+                          : cz < 0 ? "z"
+                          : cr < 0 ? "radius"
+                                   : nullptr;
+    if (missing)
+      throw InputError(name, "timestep " + std::to_string(b.step) + ": missing column", missing);
     const int ctype = find_col(b.columns, {"type"}), cm = find_col(b.columns, {"mass"});
     const int cv[3] = {find_col(b.columns, {"vx"}), find_col(b.columns, {"vy"}),
                        find_col(b.columns, {"vz"})};
@@ -142,10 +151,12 @@ Trajectory read_liggghts_dump(const std::filesystem::path& atoms_path,
       const std::size_t ln = b.first_row_line + r;
       auto& p = f.particles[r];
       p.id = text::to_int(row[cid], name, ln, "id");
-      p.position = {text::to_double(row[cx], name, ln, "x"), text::to_double(row[cy], name, ln, "y"),
+      p.position = {text::to_double(row[cx], name, ln, "x"),
+                    text::to_double(row[cy], name, ln, "y"),
                     text::to_double(row[cz], name, ln, "z")};
       p.radius = text::to_double(row[cr], name, ln, "radius");
-      if (ctype >= 0) p.material_id = static_cast<std::int32_t>(text::to_int(row[ctype], name, ln, "type"));
+      if (ctype >= 0)
+        p.material_id = static_cast<std::int32_t>(text::to_int(row[ctype], name, ln, "type"));
       if (cm >= 0) p.mass = text::to_double(row[cm], name, ln, "mass");
       for (int d = 0; d < 3; ++d) {
         if (cv[d] >= 0) p.velocity[d] = text::to_double(row[cv[d]], name, ln, "velocity");
@@ -162,7 +173,8 @@ Trajectory read_liggghts_dump(const std::filesystem::path& atoms_path,
     const std::string ptext = text::read_text_file(*pairs);
     const auto pblocks = parse_blocks(ptext, pname, "ENTRIES", "ENTRIES");
     std::map<std::string, int> col;
-    for (std::size_t k = 0; k < opt.pair_columns.size(); ++k) col[opt.pair_columns[k]] = static_cast<int>(k);
+    for (std::size_t k = 0; k < opt.pair_columns.size(); ++k)
+      col[opt.pair_columns[k]] = static_cast<int>(k);
     for (const char* need : {"id1", "id2", "fx", "fy", "fz"})
       if (!col.count(need)) throw InputError(pname, "pair column mapping lacks", need);
     std::map<std::int64_t, Frame*> by_step;
@@ -178,8 +190,9 @@ Trajectory read_liggghts_dump(const std::filesystem::path& atoms_path,
         const auto& row = b.rows[r];
         const std::size_t ln = b.first_row_line + r;
         if (row.size() < opt.pair_columns.size())
-          throw InputError(pname, "line " + std::to_string(ln) + ": expected " +
-                                      std::to_string(opt.pair_columns.size()) + " columns",
+          throw InputError(pname,
+                           "line " + std::to_string(ln) + ": expected " +
+                               std::to_string(opt.pair_columns.size()) + " columns",
                            std::to_string(row.size()));
         auto num = [&](const char* c) { return text::to_double(row[col.at(c)], pname, ln, c); };
         Contact c;
@@ -193,7 +206,8 @@ Trajectory read_liggghts_dump(const std::filesystem::path& atoms_path,
         const double r1 = p1->second->radius, r2 = p2->second->radius;
         const Eigen::Vector3d branch = x2 - x1;
         const double dist = branch.norm();
-        if (!(dist > 0)) throw InputError(pname, "line " + std::to_string(ln) + ": coincident centres");
+        if (!(dist > 0))
+          throw InputError(pname, "line " + std::to_string(ln) + ": coincident centres");
         c.normal = branch / dist;
         c.overlap = r1 + r2 - dist;
         c.point = x1 + (r1 - 0.5 * c.overlap) * c.normal;

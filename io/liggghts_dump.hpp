@@ -15,7 +15,7 @@ struct LiggghtsImportOptions {
   std::optional<std::filesystem::path> pairs;
   /// Meaning of the pair dump's columns, in order. Default: LIGGGHTS
   /// `compute pair/gran/local pos id force` (force = force on the first atom).
-  std::vector<std::string> pair_columns{"x1", "y1", "z1", "x2", "y2", "z2",
+  std::vector<std::string> pair_columns{"x1",  "y1",  "z1",       "x2", "y2", "z2",
                                         "id1", "id2", "periodic", "fx", "fy", "fz"};
   /// Time step (s): frame time = timestep × dt. 0 leaves times at 0.
   double dt = 0;

@@ -24,8 +24,7 @@ Frame read_packing_csv(const std::filesystem::path& path) {
     std::size_t found = header.size();
     for (std::size_t c = 0; c < header.size(); ++c)
       if (header[c] == need[k]) found = c;
-    if (found == header.size())
-      throw InputError(name, "missing column in header", need[k]);
+    if (found == header.size()) throw InputError(name, "missing column in header", need[k]);
     col[k] = found;
   }
   Frame f;
@@ -34,8 +33,9 @@ Frame read_packing_csv(const std::filesystem::path& path) {
     if (l.empty() || l.front() == '#') continue;
     const auto fields = text::split_csv(l);
     if (fields.size() != header.size())
-      throw InputError(name, "line " + std::to_string(li + 1) + ": expected " +
-                                 std::to_string(header.size()) + " fields",
+      throw InputError(name,
+                       "line " + std::to_string(li + 1) + ": expected " +
+                           std::to_string(header.size()) + " fields",
                        std::to_string(fields.size()));
     Particle p;
     p.id = text::to_int(fields[col[0]], name, li + 1, "id");
@@ -58,9 +58,8 @@ void write_packing_csv(const std::filesystem::path& path, const Frame& frame) {
     o << "id,x,y,z,r\n";
     char buf[256];
     for (const auto& p : frame.particles) {
-      std::snprintf(buf, sizeof buf, "%lld,%.17g,%.17g,%.17g,%.17g\n",
-                    static_cast<long long>(p.id), p.position.x(), p.position.y(), p.position.z(),
-                    p.radius);
+      std::snprintf(buf, sizeof buf, "%lld,%.17g,%.17g,%.17g,%.17g\n", static_cast<long long>(p.id),
+                    p.position.x(), p.position.y(), p.position.z(), p.radius);
       o << buf;
     }
     if (!o.flush()) throw InputError(path.string(), "write failed");

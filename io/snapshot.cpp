@@ -12,7 +12,9 @@
 
 namespace gs {
 
-std::string code_version() { return std::string("granoscope ") + GRANOSCOPE_VERSION; }
+std::string code_version() {
+  return std::string("granoscope ") + GRANOSCOPE_VERSION;
+}
 
 std::pair<Eigen::Vector3d, Eigen::Vector3d> particle_bounds(const Frame& frame) {
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
@@ -53,18 +55,19 @@ void validate_frame(const Frame& f, const std::string& source) {
     const std::string pid = "particle " + std::to_string(p.id) + " ";
     check_finite(source, pid + "position", p.position);
     check_finite(source, pid + "radius", p.radius);
-    if (!(p.radius > 0)) throw InputError(source, pid + "radius is not positive", value_str(p.radius));
+    if (!(p.radius > 0))
+      throw InputError(source, pid + "radius is not positive", value_str(p.radius));
     check_finite(source, pid + "velocity", p.velocity);
     check_finite(source, pid + "angular velocity", p.angular_velocity);
     check_finite(source, pid + "orientation", p.orientation.coeffs());
     check_finite(source, pid + "rotation", p.rotation);
     check_finite(source, pid + "mass", p.mass);
     if (p.mass < 0) throw InputError(source, pid + "mass is negative", value_str(p.mass));
-    if (!ids.insert(p.id).second) throw InputError(source, "duplicate particle id", value_str(p.id));
+    if (!ids.insert(p.id).second)
+      throw InputError(source, "duplicate particle id", value_str(p.id));
   }
   for (const auto& c : f.contacts) {
-    const std::string cid =
-        "contact " + std::to_string(c.id1) + "-" + std::to_string(c.id2) + " ";
+    const std::string cid = "contact " + std::to_string(c.id1) + "-" + std::to_string(c.id2) + " ";
     check_finite(source, cid + "point", c.point);
     check_finite(source, cid + "normal", c.normal);
     check_finite(source, cid + "normal force", c.normal_force);
@@ -73,7 +76,8 @@ void validate_frame(const Frame& f, const std::string& source) {
     check_finite(source, cid + "twisting moment", c.twisting_moment);
     check_finite(source, cid + "overlap", c.overlap);
     if (std::abs(c.normal.norm() - 1.0) > 1e-6)
-      throw InputError(source, cid + "normal is not a unit vector, |n|", value_str(c.normal.norm()));
+      throw InputError(source, cid + "normal is not a unit vector, |n|",
+                       value_str(c.normal.norm()));
   }
   for (const auto& w : f.walls) {
     const std::string wid = "wall " + std::to_string(w.id) + " ";

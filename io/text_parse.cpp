@@ -24,8 +24,8 @@ std::string read_text_file(const std::filesystem::path& path, std::size_t max_by
   in.read(s.data(), static_cast<std::streamsize>(size));
   if (static_cast<std::size_t>(in.gcount()) != size) throw InputError(name, "short read");
   if (s.find('\0') != std::string::npos)
-    throw InputError(name, "binary content in a text file", "NUL byte at offset " +
-                                                                 std::to_string(s.find('\0')));
+    throw InputError(name, "binary content in a text file",
+                     "NUL byte at offset " + std::to_string(s.find('\0')));
   return s;
 }
 
@@ -69,7 +69,8 @@ std::vector<std::string_view> split_csv(std::string_view line) {
   std::size_t b = 0;
   while (true) {
     const auto e = line.find(',', b);
-    out.push_back(trim(line.substr(b, e == std::string_view::npos ? std::string_view::npos : e - b)));
+    out.push_back(
+        trim(line.substr(b, e == std::string_view::npos ? std::string_view::npos : e - b)));
     if (e == std::string_view::npos) break;
     b = e + 1;
   }

@@ -11,12 +11,18 @@ namespace gs {
 
 std::string format_name(SnapshotFormat f) {
   switch (f) {
-    case SnapshotFormat::Hdf5: return "granoscope HDF5 trajectory";
-    case SnapshotFormat::Vtu: return "VTK XML particles (.vtu)";
-    case SnapshotFormat::Pvd: return "ParaView series (.pvd)";
-    case SnapshotFormat::YadeLegacyVtk: return "YADE VTKExporter legacy VTK";
-    case SnapshotFormat::PackingCsv: return "packing CSV";
-    case SnapshotFormat::LiggghtsDump: return "LIGGGHTS/LAMMPS dump";
+    case SnapshotFormat::Hdf5:
+      return "granoscope HDF5 trajectory";
+    case SnapshotFormat::Vtu:
+      return "VTK XML particles (.vtu)";
+    case SnapshotFormat::Pvd:
+      return "ParaView series (.pvd)";
+    case SnapshotFormat::YadeLegacyVtk:
+      return "YADE VTKExporter legacy VTK";
+    case SnapshotFormat::PackingCsv:
+      return "packing CSV";
+    case SnapshotFormat::LiggghtsDump:
+      return "LIGGGHTS/LAMMPS dump";
   }
   return "unknown";
 }
@@ -46,7 +52,8 @@ SnapshotFormat detect_format(const std::filesystem::path& path) {
   if (e == ".vtu") return SnapshotFormat::Vtu;
   if (e == ".pvd") return SnapshotFormat::Pvd;
   if (e == ".csv") return SnapshotFormat::PackingCsv;
-  if (e == ".vtk") throw InputError(name, "not a legacy VTK file (missing '# vtk DataFile' header)");
+  if (e == ".vtk")
+    throw InputError(name, "not a legacy VTK file (missing '# vtk DataFile' header)");
   throw InputError(name, "unknown file type", e.empty() ? "no extension" : e);
 }
 
@@ -101,21 +108,29 @@ void write_snapshots(const std::filesystem::path& path, const Trajectory& t, lon
     const long n = static_cast<long>(t.frames.size());
     const long i = frame < 0 ? n + frame : frame;
     if (i < 0 || i >= n)
-      throw InputError(path.string(), "no such frame to write", std::to_string(frame) + " of " + std::to_string(n));
+      throw InputError(path.string(), "no such frame to write",
+                       std::to_string(frame) + " of " + std::to_string(n));
     return t.frames[static_cast<std::size_t>(i)];
   };
   if (t.frames.empty()) throw InputError(path.string(), "nothing to write (no frames)");
   switch (fmt) {
-    case SnapshotFormat::Hdf5: write_hdf5_trajectory(path, t); return;
-    case SnapshotFormat::Pvd: write_pvd_series(path, t); return;
-    case SnapshotFormat::PackingCsv: write_packing_csv(path, pick()); return;
+    case SnapshotFormat::Hdf5:
+      write_hdf5_trajectory(path, t);
+      return;
+    case SnapshotFormat::Pvd:
+      write_pvd_series(path, t);
+      return;
+    case SnapshotFormat::PackingCsv:
+      write_packing_csv(path, pick());
+      return;
     case SnapshotFormat::Vtu: {
       const Frame& f = pick();
       write_vtp_contacts(std::filesystem::path(path).replace_extension(".vtp"), f);
       write_vtu_particles(path, f);
       return;
     }
-    default: break;
+    default:
+      break;
   }
   throw InputError(path.string(), "unsupported output type");
 }

@@ -54,7 +54,8 @@ void run_reader(Reader* r, const std::filesystem::path& path) {
   r->SetFileName(name.c_str());
   r->Update();
   if (!sink.first.empty() || r->GetErrorCode() != 0)
-    throw InputError(name, "cannot read VTK XML file", sink.first.empty() ? "reader error" : sink.first);
+    throw InputError(name, "cannot read VTK XML file",
+                     sink.first.empty() ? "reader error" : sink.first);
 }
 
 vtkDataArray* find_array(vtkFieldData* fd, std::initializer_list<const char*> names, int comps,
@@ -64,7 +65,8 @@ vtkDataArray* find_array(vtkFieldData* fd, std::initializer_list<const char*> na
     if (!a) continue;
     if (a->GetNumberOfComponents() != comps || a->GetNumberOfTuples() != n)
       throw InputError(file, std::string("array ") + nm + " has the wrong shape",
-                       std::to_string(a->GetNumberOfTuples()) + "x" + std::to_string(a->GetNumberOfComponents()));
+                       std::to_string(a->GetNumberOfTuples()) + "x" +
+                           std::to_string(a->GetNumberOfComponents()));
     return a;
   }
   if (required) throw InputError(file, "missing array", *names.begin());
@@ -186,12 +188,15 @@ Trajectory read_pvd_series(const std::filesystem::path& pvd_path) {
     std::vector<std::pair<double, std::filesystem::path>> out;
     static const std::regex ds(R"(<DataSet\b([^>]*)>)");
     static const std::regex ts(R"(timestep\s*=\s*"([^"]*)\")"), fl(R"(file\s*=\s*"([^"]*)\")");
-    for (auto it = std::sregex_iterator(xml.begin(), xml.end(), ds); it != std::sregex_iterator(); ++it) {
+    for (auto it = std::sregex_iterator(xml.begin(), xml.end(), ds); it != std::sregex_iterator();
+         ++it) {
       const std::string attrs = (*it)[1];
       std::smatch mt, mf;
-      if (!std::regex_search(attrs, mf, fl)) throw InputError(p.string(), "DataSet without file attribute");
+      if (!std::regex_search(attrs, mf, fl))
+        throw InputError(p.string(), "DataSet without file attribute");
       double t = 0;
-      if (std::regex_search(attrs, mt, ts)) t = text::to_double(mt[1].str(), p.string(), 0, "timestep");
+      if (std::regex_search(attrs, mt, ts))
+        t = text::to_double(mt[1].str(), p.string(), 0, "timestep");
       out.emplace_back(t, p.parent_path() / mf[1].str());
     }
     if (out.empty()) throw InputError(p.string(), "collection lists no DataSet");

@@ -15,7 +15,9 @@ struct Tokens {
 
   bool done() const { return i >= tok.size(); }
   std::string_view peek() const { return done() ? std::string_view{} : tok[i].first; }
-  std::size_t line() const { return done() ? (tok.empty() ? 0 : tok.back().second) : tok[i].second; }
+  std::size_t line() const {
+    return done() ? (tok.empty() ? 0 : tok.back().second) : tok[i].second;
+  }
   std::string_view next(const char* what) {
     if (done()) throw InputError(name, std::string("unexpected end of file, expected ") + what);
     return tok[i++].first;
@@ -66,7 +68,8 @@ void read_attributes(Tokens& t, std::size_t n, std::map<std::string, LegacyPolyD
       name = std::string(t.next("name"));
       t.next("type");
       // Optional component count, then LOOKUP_TABLE.
-      if (t.peek() != "LOOKUP_TABLE") a.components = static_cast<int>(t.next_count("components", 4));
+      if (t.peek() != "LOOKUP_TABLE")
+        a.components = static_cast<int>(t.next_count("components", 4));
       if (t.peek() == "LOOKUP_TABLE") {
         t.next("LOOKUP_TABLE");
         t.next("table name");
@@ -111,7 +114,8 @@ LegacyPolyData read_legacy_polydata(const std::filesystem::path& path) {
   if (lines.size() < 4 || lines[0].rfind("# vtk DataFile", 0) != 0)
     throw InputError(t.name, "not a legacy VTK file (missing '# vtk DataFile' header)");
   if (text::trim(lines[2]) != "ASCII")
-    throw InputError(t.name, "only ASCII legacy VTK is supported", std::string(text::trim(lines[2]).substr(0, 20)));
+    throw InputError(t.name, "only ASCII legacy VTK is supported",
+                     std::string(text::trim(lines[2]).substr(0, 20)));
   for (std::size_t l = 3; l < lines.size(); ++l)
     for (auto tok : text::split_ws(lines[l])) t.tok.emplace_back(tok, l + 1);
   if (t.next("DATASET") != "DATASET" || t.next("POLYDATA") != "POLYDATA")
@@ -133,7 +137,8 @@ LegacyPolyData read_legacy_polydata(const std::filesystem::path& path) {
       read_cells(t, npoints);
     } else if (kw == "POINT_DATA") {
       const std::size_t n = t.next_count("POINT_DATA count", t.tok.size());
-      if (n != npoints) throw InputError(t.name, "POINT_DATA count differs from POINTS", std::to_string(n));
+      if (n != npoints)
+        throw InputError(t.name, "POINT_DATA count differs from POINTS", std::to_string(n));
       read_attributes(t, n, d.point_data);
     } else if (kw == "CELL_DATA") {
       const std::size_t n = t.next_count("CELL_DATA count", t.tok.size());

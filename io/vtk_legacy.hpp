@@ -9,9 +9,9 @@
 namespace gs {
 
 struct LegacyPolyData {
-  std::vector<double> points;                     // 3 per point
-  std::vector<std::vector<long long>> vertices;   // VERTICES cells
-  std::vector<std::vector<long long>> lines;      // LINES cells
+  std::vector<double> points;                    // 3 per point
+  std::vector<std::vector<long long>> vertices;  // VERTICES cells
+  std::vector<std::vector<long long>> lines;     // LINES cells
   struct Array {
     int components = 1;
     std::vector<double> values;  // components per tuple

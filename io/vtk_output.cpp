@@ -1,11 +1,11 @@
 // ParaView output through VTK's XML writers (binary appended, zlib, Float64/Int64 arrays).
 #include <vtkCellArray.h>
+#include <vtkCellData.h>
 #include <vtkDoubleArray.h>
 #include <vtkFieldData.h>
 #include <vtkIntArray.h>
 #include <vtkNew.h>
 #include <vtkPointData.h>
-#include <vtkCellData.h>
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
 #include <vtkTypeInt64Array.h>
@@ -79,7 +79,8 @@ void write_vtu_particles(const std::filesystem::path& path, const Frame& f) {
     rad->SetValue(i, p.radius);
     vel->SetTuple(i, p.velocity.data());
     av->SetTuple(i, p.angular_velocity.data());
-    const double q[4] = {p.orientation.w(), p.orientation.x(), p.orientation.y(), p.orientation.z()};
+    const double q[4] = {p.orientation.w(), p.orientation.x(), p.orientation.y(),
+                         p.orientation.z()};
     ori->SetTuple(i, q);
     rot->SetTuple(i, p.rotation.data());
     mass->SetValue(i, p.mass);
@@ -89,8 +90,8 @@ void write_vtu_particles(const std::filesystem::path& path, const Frame& f) {
   g->SetPoints(pts);
   g->SetCells(VTK_VERTEX, cells);
   auto* pd = g->GetPointData();
-  for (vtkAbstractArray* a : std::initializer_list<vtkAbstractArray*>{
-           id, rad, vel, av, ori, rot, mass, clump, mat})
+  for (vtkAbstractArray* a :
+       std::initializer_list<vtkAbstractArray*>{id, rad, vel, av, ori, rot, mass, clump, mat})
     pd->AddArray(a);
   pd->SetActiveScalars("radius");
   auto* fd = g->GetFieldData();
@@ -102,7 +103,8 @@ void write_vtu_particles(const std::filesystem::path& path, const Frame& f) {
   add_field(fd, "domain_hi", {f.domain.hi.x(), f.domain.hi.y(), f.domain.hi.z()});
   add_field(fd, "periodic", {f.domain.periodic ? 1.0 : 0.0});
   const auto& c = f.domain.cell;
-  add_field(fd, "cell", {c(0, 0), c(0, 1), c(0, 2), c(1, 0), c(1, 1), c(1, 2), c(2, 0), c(2, 1), c(2, 2)});
+  add_field(fd, "cell",
+            {c(0, 0), c(0, 1), c(0, 2), c(1, 0), c(1, 1), c(1, 2), c(2, 0), c(2, 1), c(2, 2)});
   vtkNew<vtkXMLUnstructuredGridWriter> w;
   w->SetInputData(g);
   write_xml(w.Get(), path);
@@ -121,10 +123,10 @@ void write_vtp_contacts(const std::filesystem::path& path, const Frame& f) {
   id1->SetNumberOfTuples(n);
   id2->SetName("id2");
   id2->SetNumberOfTuples(n);
-  auto pt = vec_array("point", 3, n), nn = vec_array("normal", 3, n), fn = vec_array("normal_force", 3, n),
-       fs = vec_array("shear_force", 3, n), fnm = vec_array("fn_magnitude", 1, n),
-       mb = vec_array("bending_moment", 3, n), mt = vec_array("twisting_moment", 3, n),
-       ov = vec_array("overlap", 1, n);
+  auto pt = vec_array("point", 3, n), nn = vec_array("normal", 3, n),
+       fn = vec_array("normal_force", 3, n), fs = vec_array("shear_force", 3, n),
+       fnm = vec_array("fn_magnitude", 1, n), mb = vec_array("bending_moment", 3, n),
+       mt = vec_array("twisting_moment", 3, n), ov = vec_array("overlap", 1, n);
   for (vtkIdType i = 0; i < n; ++i) {
     const auto& c = f.contacts[static_cast<std::size_t>(i)];
     const auto a = byid.find(c.id1), b = byid.find(c.id2);
@@ -149,7 +151,8 @@ void write_vtp_contacts(const std::filesystem::path& path, const Frame& f) {
   pd->SetPoints(pts);
   pd->SetLines(lines);
   auto* cd = pd->GetCellData();
-  for (vtkAbstractArray* a : std::initializer_list<vtkAbstractArray*>{id1, id2, pt, nn, fn, fs, fnm, mb, mt, ov})
+  for (vtkAbstractArray* a :
+       std::initializer_list<vtkAbstractArray*>{id1, id2, pt, nn, fn, fs, fnm, mb, mt, ov})
     cd->AddArray(a);
   cd->SetActiveScalars("fn_magnitude");
   add_field(pd->GetFieldData(), "TimeValue", {f.time});
@@ -160,7 +163,8 @@ void write_vtp_contacts(const std::filesystem::path& path, const Frame& f) {
 
 namespace {
 
-void write_pvd_file(const std::filesystem::path& path, const std::vector<std::pair<double, std::string>>& entries) {
+void write_pvd_file(const std::filesystem::path& path,
+                    const std::vector<std::pair<double, std::string>>& entries) {
   AtomicOutput out(path);
   {
     std::ofstream o(out.temp_path());

@@ -30,7 +30,8 @@ Eigen::Vector3d v3(const LegacyPolyData::Array& a, std::size_t i) {
 
 }  // namespace
 
-Frame read_yade_legacy(const std::filesystem::path& spheres, const std::filesystem::path& intrs_in) {
+Frame read_yade_legacy(const std::filesystem::path& spheres,
+                       const std::filesystem::path& intrs_in) {
   const std::string name = spheres.string();
   const LegacyPolyData s = read_legacy_polydata(spheres);
   const std::size_t n = s.points.size() / 3;
@@ -46,7 +47,8 @@ Frame read_yade_legacy(const std::filesystem::path& spheres, const std::filesyst
     auto& p = f.particles[i];
     p.position = {s.points[3 * i], s.points[3 * i + 1], s.points[3 * i + 2]};
     p.radius = rad->values[i];
-    p.id = id ? static_cast<std::int64_t>(std::llround(id->values[i])) : static_cast<std::int64_t>(i);
+    p.id =
+        id ? static_cast<std::int64_t>(std::llround(id->values[i])) : static_cast<std::int64_t>(i);
     if (vel) p.velocity = v3(*vel, i);
     if (av) p.angular_velocity = v3(*av, i);
     if (mass) p.mass = mass->values[i];
@@ -61,7 +63,8 @@ Frame read_yade_legacy(const std::filesystem::path& spheres, const std::filesyst
     if (k != std::string::npos) {
       fn.replace(k, 9, "-intrs-");
       std::error_code ec;
-      if (std::filesystem::is_regular_file(spheres.parent_path() / fn, ec)) intrs = spheres.parent_path() / fn;
+      if (std::filesystem::is_regular_file(spheres.parent_path() / fn, ec))
+        intrs = spheres.parent_path() / fn;
     }
   }
   if (intrs.empty()) return f;
@@ -74,8 +77,9 @@ Frame read_yade_legacy(const std::filesystem::path& spheres, const std::filesyst
   const auto* id1 = find(d.cell_data, {"id1"}, 1, iname);
   const auto* id2 = find(d.cell_data, {"id2"}, 1, iname);
   if (!id1 || !id2)
-    throw InputError(iname, "interactions need cell arrays id1 and id2 (export them with "
-                            "what=dict(id1='i.id1', id2='i.id2', ...))");
+    throw InputError(iname,
+                     "interactions need cell arrays id1 and id2 (export them with "
+                     "what=dict(id1='i.id1', id2='i.id2', ...))");
   const auto* fn = find(d.cell_data, {"forceN", "normalForce"}, 3, iname);
   const auto* fs = find(d.cell_data, {"forceT", "shearForce"}, 3, iname);
   const auto* nn = find(d.cell_data, {"normal"}, 3, iname);
@@ -88,15 +92,18 @@ Frame read_yade_legacy(const std::filesystem::path& spheres, const std::filesyst
     auto& c = f.contacts[i];
     c.id1 = static_cast<std::int64_t>(std::llround(id1->values[i]));
     c.id2 = static_cast<std::int64_t>(std::llround(id2->values[i]));
-    if (d.lines[i].size() != 2) throw InputError(iname, "interaction line without 2 points", std::to_string(i));
-    const auto a = static_cast<std::size_t>(d.lines[i][0]), b = static_cast<std::size_t>(d.lines[i][1]);
+    if (d.lines[i].size() != 2)
+      throw InputError(iname, "interaction line without 2 points", std::to_string(i));
+    const auto a = static_cast<std::size_t>(d.lines[i][0]),
+               b = static_cast<std::size_t>(d.lines[i][1]);
     const Eigen::Vector3d xa(d.points[3 * a], d.points[3 * a + 1], d.points[3 * a + 2]);
     const Eigen::Vector3d xb(d.points[3 * b], d.points[3 * b + 1], d.points[3 * b + 2]);
     if (nn) {
       c.normal = v3(*nn, i);
     } else {
       const Eigen::Vector3d br = xb - xa;
-      if (!(br.norm() > 0)) throw InputError(iname, "interaction of zero length and no normal", std::to_string(i));
+      if (!(br.norm() > 0))
+        throw InputError(iname, "interaction of zero length and no normal", std::to_string(i));
       c.normal = br.normalized();
     }
     c.point = cp ? v3(*cp, i) : 0.5 * (xa + xb);

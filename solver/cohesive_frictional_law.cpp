@@ -6,8 +6,8 @@ namespace gs::solver {
 
 ContactParams contact_params(const Material& m, double r1, double r2, double twist_beta,
                              double twist_eta) {
-  const auto k = contact_stiffness(m.young_ec, m.stiffness_ratio, m.rolling_beta, r1, r2,
-                                   m.rolling_radius);
+  const auto k =
+      contact_stiffness(m.young_ec, m.stiffness_ratio, m.rolling_beta, r1, r2, m.rolling_radius);
   ContactParams p;
   p.kn = k.kn;
   p.ks = k.ks;

@@ -29,7 +29,7 @@ struct BodyMotion {
 /// force1 and the torques arm1 − moment; body 2 receives −force1 and arm2 + moment.
 struct ContactLoads {
   Eigen::Vector3d force1, arm1, arm2, moment;
-  double fn = 0;  // |normal force|, N
+  double fn = 0;                                             // |normal force|, N
   double friction_dissipation = 0, rolling_dissipation = 0;  // J, this step
 };
 

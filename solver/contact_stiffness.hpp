@@ -10,10 +10,10 @@ enum class RollingRadius {
 };
 
 struct ContactStiffness {
-  double kn = 0;                 // N/m, normal
-  double ks = 0;                 // N/m, shear
-  double kr = 0;                 // N·m/rad, rolling (bending)
-  double rolling_radius_m = 0;   // R_roll of the moment limit
+  double kn = 0;                // N/m, normal
+  double ks = 0;                // N/m, shear
+  double kr = 0;                // N·m/rad, rolling (bending)
+  double rolling_radius_m = 0;  // R_roll of the moment limit
 };
 
 /// Kn = Ec·2RA·RB/(RA+RB), Ks = νc·Kn, Kr = β·Ks·RA·RB. A sphere–wall contact passes rb = ra

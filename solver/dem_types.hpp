@@ -69,8 +69,8 @@ struct WallState {
 /// `b` is a particle index, or walls are encoded as b = kWallBase + wall index.
 struct ContactHistory {
   std::uint32_t a = 0, b = 0;
-  bool real = false;                                   // in contact after this step's geometry
-  Eigen::Vector3d normal = Eigen::Vector3d::Zero();    // last step's unit normal (a -> b)
+  bool real = false;                                 // in contact after this step's geometry
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();  // last step's unit normal (a -> b)
   Eigen::Vector3d shear_force = Eigen::Vector3d::Zero();
   Eigen::Vector3d bending = Eigen::Vector3d::Zero();
   Eigen::Vector3d twist = Eigen::Vector3d::Zero();

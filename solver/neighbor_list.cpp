@@ -11,7 +11,8 @@ namespace gs::solver {
 bool NeighborList::stale(const ParticleState& p, const std::vector<WallState>& walls) const {
   if (ref_pos.size() != p.size() || wall_ref.size() != walls.size()) return true;
   double dmax2 = 0;
-  for (std::size_t i = 0; i < p.size(); ++i) dmax2 = std::max(dmax2, (p.pos[i] - ref_pos[i]).squaredNorm());
+  for (std::size_t i = 0; i < p.size(); ++i)
+    dmax2 = std::max(dmax2, (p.pos[i] - ref_pos[i]).squaredNorm());
   const double dmax = std::sqrt(dmax2);
   if (2 * dmax > skin) return true;
   double wmax = 0;
@@ -45,11 +46,13 @@ void NeighborList::build(const ParticleState& p, const std::vector<WallState>& w
   const double cell = 2 * rmax + skin;
   Eigen::Array3i dims;
   for (int k = 0; k < 3; ++k)
-    dims[k] = std::max(1, std::min(1 << 10, static_cast<int>(std::floor((hi[k] - lo[k]) / cell)) + 1));
+    dims[k] =
+        std::max(1, std::min(1 << 10, static_cast<int>(std::floor((hi[k] - lo[k]) / cell)) + 1));
   const std::size_t ncells = static_cast<std::size_t>(dims[0]) * dims[1] * dims[2];
   auto cell_of = [&](const Eigen::Vector3d& x) {
     Eigen::Array3i c;
-    for (int k = 0; k < 3; ++k) c[k] = std::min(dims[k] - 1, std::max(0, static_cast<int>((x[k] - lo[k]) / cell)));
+    for (int k = 0; k < 3; ++k)
+      c[k] = std::min(dims[k] - 1, std::max(0, static_cast<int>((x[k] - lo[k]) / cell)));
     return c;
   };
   // Counting sort of particles into cells.
@@ -63,7 +66,8 @@ void NeighborList::build(const ParticleState& p, const std::vector<WallState>& w
   for (std::size_t c = 0; c < ncells; ++c) start[c + 1] += start[c];
   {
     std::vector<std::uint32_t> fill(start.begin(), start.end() - 1);
-    for (std::size_t i = 0; i < n; ++i) order[fill[cell_index[i]]++] = static_cast<std::uint32_t>(i);
+    for (std::size_t i = 0; i < n; ++i)
+      order[fill[cell_index[i]]++] = static_cast<std::uint32_t>(i);
   }
   for (std::size_t i = 0; i < n; ++i) {
     const auto c = cell_of(p.pos[i]);
@@ -71,7 +75,8 @@ void NeighborList::build(const ParticleState& p, const std::vector<WallState>& w
       for (int dy = -1; dy <= 1; ++dy)
         for (int dx = -1; dx <= 1; ++dx) {
           const int cx = c[0] + dx, cy = c[1] + dy, cz = c[2] + dz;
-          if (cx < 0 || cy < 0 || cz < 0 || cx >= dims[0] || cy >= dims[1] || cz >= dims[2]) continue;
+          if (cx < 0 || cy < 0 || cz < 0 || cx >= dims[0] || cy >= dims[1] || cz >= dims[2])
+            continue;
           const std::size_t ci = static_cast<std::size_t>((cz * dims[1] + cy) * dims[0] + cx);
           for (std::uint32_t k = start[ci]; k < start[ci + 1]; ++k) {
             const std::uint32_t j = order[k];
@@ -87,7 +92,8 @@ void NeighborList::build(const ParticleState& p, const std::vector<WallState>& w
                               ? box_distance(wall.pos, wall.spec.half_extents, p.pos[i])
                               : (p.pos[i] - wall.pos).dot(wall.normal);
       if (dist < p.radius[i] + skin)
-        pairs.emplace_back(static_cast<std::uint32_t>(i), kWallBase + static_cast<std::uint32_t>(w));
+        pairs.emplace_back(static_cast<std::uint32_t>(i),
+                           kWallBase + static_cast<std::uint32_t>(w));
     }
   }
   std::sort(pairs.begin(), pairs.end());

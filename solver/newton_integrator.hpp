@@ -9,7 +9,8 @@
 namespace gs::solver {
 
 /// YADE's cundallDamp2nd: a_i *= 1 − damping·sign(a_i·(v_i + a_i·dt/2)), per component.
-inline void cundall_damp(double damping, double dt, const Eigen::Vector3d& vel, Eigen::Vector3d& accel) {
+inline void cundall_damp(double damping, double dt, const Eigen::Vector3d& vel,
+                         Eigen::Vector3d& accel) {
   for (int i = 0; i < 3; ++i) {
     const double s = accel[i] * (vel[i] + 0.5 * dt * accel[i]);
     accel[i] *= 1 - damping * (s > 0 ? 1.0 : (s < 0 ? -1.0 : 0.0));

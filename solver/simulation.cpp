@@ -66,7 +66,8 @@ Simulation::Simulation(SimulationConfig config, const std::vector<Particle>& par
     WallState w;
     w.spec = spec;
     w.pos = spec.center;
-    w.normal = spec.shape == WallShape::Plane ? Eigen::Vector3d(spec.normal.normalized()) : spec.normal;
+    w.normal =
+        spec.shape == WallShape::Plane ? Eigen::Vector3d(spec.normal.normalized()) : spec.normal;
     w.vel = spec.velocity;
     walls_.push_back(w);
   }
@@ -126,7 +127,8 @@ void Simulation::step() {
         box_sphere_geometry(w.pos, w.spec.half_extents, p_.pos[a], p_.radius[a], g);
       else
         plane_sphere_geometry(w.pos, w.normal, p_.pos[a], p_.radius[a], g);
-      m1 = {w.pos, w.vel, w.spec.shape == WallShape::Plane ? w.spec.angular_velocity : Eigen::Vector3d::Zero()};
+      m1 = {w.pos, w.vel,
+            w.spec.shape == WallShape::Plane ? w.spec.angular_velocity : Eigen::Vector3d::Zero()};
       m2 = {p_.pos[a], p_.vel[a], p_.angvel[a]};
     } else {
       if (!sphere_sphere_geometry(p_.pos[a], p_.radius[a], p_.pos[b], p_.radius[b], g)) {
@@ -184,7 +186,8 @@ void Simulation::step() {
   if (!(max_overlap_ratio <= cfg_.max_overlap_ratio))
     throw BlowUp("step " + std::to_string(step_) + ": overlap of " +
                  std::to_string(max_overlap_ratio) + " radius exceeds " +
-                 std::to_string(cfg_.max_overlap_ratio) + " (time step too large or walls too fast?)");
+                 std::to_string(cfg_.max_overlap_ratio) +
+                 " (time step too large or walls too fast?)");
 
   update_servos();
   // Work of gravity and walls over this step (velocities of the step).
@@ -194,12 +197,14 @@ void Simulation::step() {
   ledger_.gravity_work += grav * dt;
   for (const auto& w : walls_) ledger_.wall_work += -w.force.dot(w.vel) * dt;
 
-  std::vector<double> damp(n, 0.0);
+  damp_.resize(n);
+  auto& damp = damp_;
   bool finite = true;
 #pragma omp parallel for num_threads(threads) schedule(static) reduction(&& : finite)
   for (std::size_t i = 0; i < n; ++i) {
     damp[i] = integrate_particle(p_, i, cfg_.gravity, cfg_.damping, dt);
-    finite = finite && std::isfinite(p_.pos[i].squaredNorm()) && std::isfinite(p_.vel[i].squaredNorm());
+    finite =
+        finite && std::isfinite(p_.pos[i].squaredNorm()) && std::isfinite(p_.vel[i].squaredNorm());
   }
   if (!finite) throw BlowUp("step " + std::to_string(step_) + ": non-finite particle state");
   for (double d : damp) ledger_.damping_dissipation += d;
@@ -226,7 +231,8 @@ std::size_t Simulation::contact_count() const {
 double Simulation::kinetic_energy() const {
   double e = 0;
   for (std::size_t i = 0; i < p_.size(); ++i)
-    e += 0.5 * p_.mass[i] * p_.vel[i].squaredNorm() + 0.5 * p_.inertia[i] * p_.angvel[i].squaredNorm();
+    e += 0.5 * p_.mass[i] * p_.vel[i].squaredNorm() +
+         0.5 * p_.inertia[i] * p_.angvel[i].squaredNorm();
   return e;
 }
 
@@ -279,7 +285,8 @@ const EnergyLedger& Simulation::energy() {
         } else if (!sphere_sphere_geometry(p_.pos[a], p_.radius[a], p_.pos[b], p_.radius[b], g)) {
           continue;
         }
-        if (g.penetration > 0) ledger_.initial += 0.5 * params_[k].kn * g.penetration * g.penetration;
+        if (g.penetration > 0)
+          ledger_.initial += 0.5 * params_[k].kn * g.penetration * g.penetration;
       }
     }
   }
@@ -288,10 +295,12 @@ const EnergyLedger& Simulation::energy() {
 
 void Simulation::check_energy() {
   const auto& e = energy();
-  const double turnover = e.stored() + e.dissipated() + std::abs(e.gravity_work) + std::abs(e.wall_work) + e.initial;
+  const double turnover =
+      e.stored() + e.dissipated() + std::abs(e.gravity_work) + std::abs(e.wall_work) + e.initial;
   if (turnover > 0 && std::abs(e.residual()) > cfg_.max_energy_residual * turnover)
-    throw BlowUp("step " + std::to_string(step_) + ": energy ledger residual " + std::to_string(e.residual()) +
-                 " J exceeds " + std::to_string(cfg_.max_energy_residual) + " of the energy turnover " +
+    throw BlowUp("step " + std::to_string(step_) + ": energy ledger residual " +
+                 std::to_string(e.residual()) + " J exceeds " +
+                 std::to_string(cfg_.max_energy_residual) + " of the energy turnover " +
                  std::to_string(turnover) + " J");
 }
 
@@ -366,13 +375,15 @@ void get(std::istream& i, T& v, const std::string& file) {
 template <class T>
 void put_vec(std::ostream& o, const std::vector<T>& v) {
   put(o, static_cast<std::uint64_t>(v.size()));
-  o.write(reinterpret_cast<const char*>(v.data()), static_cast<std::streamsize>(v.size() * sizeof(T)));
+  o.write(reinterpret_cast<const char*>(v.data()),
+          static_cast<std::streamsize>(v.size() * sizeof(T)));
 }
 template <class T>
 void get_vec(std::istream& i, std::vector<T>& v, std::size_t expect, const std::string& file) {
   std::uint64_t n = 0;
   get(i, n, file);
-  if (n != expect) throw InputError(file, "checkpoint does not match the scene (array length)", std::to_string(n));
+  if (n != expect)
+    throw InputError(file, "checkpoint does not match the scene (array length)", std::to_string(n));
   v.resize(n);
   i.read(reinterpret_cast<char*>(v.data()), static_cast<std::streamsize>(n * sizeof(T)));
   if (!i) throw InputError(file, "truncated checkpoint");
@@ -418,7 +429,8 @@ void Simulation::load_checkpoint(const std::filesystem::path& path) {
   if (!in) throw InputError(file, "cannot open checkpoint");
   char magic[8];
   in.read(magic, 8);
-  if (!in || std::memcmp(magic, kMagic, 8) != 0) throw InputError(file, "not a granoscope checkpoint");
+  if (!in || std::memcmp(magic, kMagic, 8) != 0)
+    throw InputError(file, "not a granoscope checkpoint");
   get(in, step_, file);
   get(in, time_, file);
   get(in, ledger_, file);
@@ -435,7 +447,8 @@ void Simulation::load_checkpoint(const std::filesystem::path& path) {
   get_vec(in, p_.rot_blocked, n, file);
   std::uint64_t nw = 0;
   get(in, nw, file);
-  if (nw != walls_.size()) throw InputError(file, "checkpoint does not match the scene (walls)", std::to_string(nw));
+  if (nw != walls_.size())
+    throw InputError(file, "checkpoint does not match the scene (walls)", std::to_string(nw));
   for (auto& w : walls_) {
     get(in, w.pos, file);
     get(in, w.normal, file);
@@ -443,7 +456,8 @@ void Simulation::load_checkpoint(const std::filesystem::path& path) {
   }
   std::uint64_t nc = 0;
   get(in, nc, file);
-  if (nc > (1ull << 32)) throw InputError(file, "corrupt checkpoint (contact count)", std::to_string(nc));
+  if (nc > (1ull << 32))
+    throw InputError(file, "corrupt checkpoint (contact count)", std::to_string(nc));
   std::vector<ContactHistory> real(nc);
   for (auto& h : real) get(in, h, file);
   // Rebuild the neighbour list from the restored state and put the histories back.

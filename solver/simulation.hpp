@@ -22,9 +22,9 @@ struct SimulationConfig {
   Eigen::Vector3d gravity = Eigen::Vector3d::Zero();
   double skin = 0;  // m; 0 = half the smallest radius (YADE's default verletDist)
   int threads = 1;
-  double twist_beta = 0;  // twisting stiffness factor (0: twisting moment off)
-  double twist_eta = -1;  // twisting limit factor (negative: unbounded)
-  double max_overlap_ratio = 0.1;  // blow-up when an overlap exceeds this fraction of a radius
+  double twist_beta = 0;             // twisting stiffness factor (0: twisting moment off)
+  double twist_eta = -1;             // twisting limit factor (negative: unbounded)
+  double max_overlap_ratio = 0.1;    // blow-up when an overlap exceeds this fraction of a radius
   double max_energy_residual = 0.2;  // blow-up when |ledger residual| exceeds this fraction of
                                      // the energy turnover (checked by check_energy())
 };
@@ -36,7 +36,9 @@ struct EnergyLedger {
   double gravity_work = 0, wall_work = 0;
   double initial = 0;  // kinetic + elastic at the start
   double stored() const { return kinetic + elastic_normal + elastic_shear + elastic_rolling; }
-  double dissipated() const { return friction_dissipation + rolling_dissipation + damping_dissipation; }
+  double dissipated() const {
+    return friction_dissipation + rolling_dissipation + damping_dissipation;
+  }
   /// stored + dissipated − (initial + work in): zero for an exact integration.
   double residual() const { return stored() + dissipated() - (initial + gravity_work + wall_work); }
 };
@@ -97,6 +99,7 @@ class Simulation {
   std::vector<ContactParams> params_;
   std::vector<ContactLoads> loads_;
   std::vector<std::uint8_t> active_;
+  std::vector<double> damp_;  // per-particle damping dissipation of the step
   std::int64_t step_ = 0;
   double time_ = 0;
   std::int64_t wall_id_base_ = 0;

@@ -12,7 +12,7 @@ import sys
 
 # format attribute -> figure modules (first is the default for that format)
 FIGURES = {
-    "granoscope-trajectory": ["fig_positions"],
+    "granoscope-trajectory": ["fig_positions", "fig_history"],
 }
 
 

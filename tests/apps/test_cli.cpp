@@ -29,7 +29,8 @@ std::string slurp(const std::filesystem::path& p) {
 
 Result run(const std::string& args, const std::filesystem::path& scratch) {
   const auto o = scratch / "stdout.txt", e = scratch / "stderr.txt";
-  const std::string cmd = kExe + " " + args + " >" + o.string() + " 2>" + e.string() + " </dev/null";
+  const std::string cmd =
+      kExe + " " + args + " >" + o.string() + " 2>" + e.string() + " </dev/null";
   const int status = std::system(cmd.c_str());
   Result r;
   r.rc = WIFEXITED(status) ? WEXITSTATUS(status) : 128;
@@ -49,7 +50,8 @@ void expect_rejected(const Result& r, const std::string& file) {
 
 std::vector<std::string> listing(const std::filesystem::path& dir) {
   std::vector<std::string> v;
-  for (const auto& e : std::filesystem::recursive_directory_iterator(dir)) v.push_back(e.path().filename().string());
+  for (const auto& e : std::filesystem::recursive_directory_iterator(dir))
+    v.push_back(e.path().filename().string());
   std::sort(v.begin(), v.end());
   return v;
 }
@@ -58,7 +60,8 @@ std::vector<std::string> listing(const std::filesystem::path& dir) {
 
 TEST(Cli, InfoReportsFixtureCounts) {
   gs::test::ScratchDir dir("cli_info");
-  Result r = run("info " + (kData / "yade" / "yade_export-spheres-00000000.vtk").string(), dir.path);
+  Result r =
+      run("info " + (kData / "yade" / "yade_export-spheres-00000000.vtk").string(), dir.path);
   ASSERT_EQ(r.rc, 0) << r.err;
   EXPECT_NE(r.out.find("particles:    40 (first frame)"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("contacts:     74 (first frame)"), std::string::npos) << r.out;
@@ -77,9 +80,18 @@ TEST(Cli, InfoReportsFixtureCounts) {
 
 TEST(Cli, ConvertRoundTripHdf5VtuHdf5) {
   gs::test::ScratchDir dir("cli_convert");
-  ASSERT_EQ(run("convert " + (kData / "liggghts" / "dump.atoms").string() + " " + (dir / "a.h5").string(), dir.path).rc, 0);
-  ASSERT_EQ(run("convert " + (dir / "a.h5").string() + " " + (dir / "b.vtu").string() + " --frame 1", dir.path).rc, 0);
-  ASSERT_EQ(run("convert " + (dir / "b.vtu").string() + " " + (dir / "c.h5").string(), dir.path).rc, 0);
+  ASSERT_EQ(
+      run("convert " + (kData / "liggghts" / "dump.atoms").string() + " " + (dir / "a.h5").string(),
+          dir.path)
+          .rc,
+      0);
+  ASSERT_EQ(
+      run("convert " + (dir / "a.h5").string() + " " + (dir / "b.vtu").string() + " --frame 1",
+          dir.path)
+          .rc,
+      0);
+  ASSERT_EQ(run("convert " + (dir / "b.vtu").string() + " " + (dir / "c.h5").string(), dir.path).rc,
+            0);
   const auto a = gs::read_snapshots(dir / "a.h5"), c = gs::read_snapshots(dir / "c.h5");
   ASSERT_EQ(a.frames.size(), 2u);
   ASSERT_EQ(c.frames.size(), 1u);
@@ -115,13 +127,16 @@ TEST(Cli, BadInputGivesOneLineAndExitCode2AndNoOutput) {
   }
   const std::string atoms = slurp(kData / "liggghts" / "dump.atoms");
   std::string garbage(4096, '\0');
-  for (std::size_t i = 0; i < garbage.size(); ++i) garbage[i] = static_cast<char>((i * 2654435761u) >> 13);
+  for (std::size_t i = 0; i < garbage.size(); ++i)
+    garbage[i] = static_cast<char>((i * 2654435761u) >> 13);
   const std::vector<std::pair<std::string, std::string>> cases = {
       {(in / "missing.h5").string(), "no such file"},
       {(in / "trunc.h5").string(), "cannot open HDF5 file (corrupt or truncated)"},
       {(in / "schema.h5").string(), "unsupported schema_version (7)"},
-      {write("nan.csv", "id,x,y,z,r\n0,0,0,0,0.001\n1,0.5,0,0,nan\n"), "particle 1 radius is not finite (nan)"},
-      {write("neg.csv", "id,x,y,z,r\n0,0,0,0,-0.001\n"), "particle 0 radius is not positive (-0.001)"},
+      {write("nan.csv", "id,x,y,z,r\n0,0,0,0,0.001\n1,0.5,0,0,nan\n"),
+       "particle 1 radius is not finite (nan)"},
+      {write("neg.csv", "id,x,y,z,r\n0,0,0,0,-0.001\n"),
+       "particle 0 radius is not positive (-0.001)"},
       {write("cols.csv", "id,x,y,r\n0,0,0,0.001\n"), "missing column in header (z)"},
       {write("short.csv", "id,x,y,z,r\n0,0,0,0.001\n"), "line 2: expected 5 fields (4)"},
       {write("garbage.h5", garbage), "not an HDF5 file (bad signature)"},
@@ -146,7 +161,8 @@ TEST(Cli, BadInputGivesOneLineAndExitCode2AndNoOutput) {
   // Bad output type and bad frame index are rejected before anything is written.
   Result r = run("convert " + (in / "good.h5").string() + " " + (out / "x.txt").string(), dir.path);
   expect_rejected(r, (out / "x.txt").string());
-  r = run("convert " + (in / "good.h5").string() + " " + (out / "x.vtu").string() + " --frame 5", dir.path);
+  r = run("convert " + (in / "good.h5").string() + " " + (out / "x.vtu").string() + " --frame 5",
+          dir.path);
   expect_rejected(r, (out / "x.vtu").string());
   EXPECT_TRUE(listing(out).empty());
   // Usage errors exit 2 as well.
@@ -157,8 +173,13 @@ TEST(Cli, BadInputGivesOneLineAndExitCode2AndNoOutput) {
 
 TEST(Cli, FiguresWritesANonBlankPositionsPng) {
   gs::test::ScratchDir dir("cli_fig");
-  ASSERT_EQ(run("convert " + (kData / "liggghts" / "dump.atoms").string() + " " + (dir / "run.h5").string(), dir.path).rc, 0);
-  const Result r = run("figures " + (dir / "run.h5").string() + " -o " + (dir / "figs").string(), dir.path);
+  ASSERT_EQ(run("convert " + (kData / "liggghts" / "dump.atoms").string() + " " +
+                    (dir / "run.h5").string(),
+                dir.path)
+                .rc,
+            0);
+  const Result r =
+      run("figures " + (dir / "run.h5").string() + " -o " + (dir / "figs").string(), dir.path);
   ASSERT_EQ(r.rc, 0) << r.err;
   const auto png = dir / "figs" / "run_positions_front_000001.png";
   ASSERT_TRUE(std::filesystem::exists(png)) << r.out << r.err;
@@ -169,8 +190,11 @@ TEST(Cli, FiguresWritesANonBlankPositionsPng) {
   cv::meanStdDev(img, mean, sd);
   EXPECT_GT(sd[0], 10.0) << "blank image";
   // Bad inputs to figures.
-  expect_rejected(run("figures " + (dir / "nope.h5").string() + " -o " + (dir / "f2").string(), dir.path),
-                  (dir / "nope.h5").string());
-  expect_rejected(run("figures " + (kData / "packing_small.csv").string() + " -o " + (dir / "f2").string(), dir.path),
-                  (kData / "packing_small.csv").string());
+  expect_rejected(
+      run("figures " + (dir / "nope.h5").string() + " -o " + (dir / "f2").string(), dir.path),
+      (dir / "nope.h5").string());
+  expect_rejected(
+      run("figures " + (kData / "packing_small.csv").string() + " -o " + (dir / "f2").string(),
+          dir.path),
+      (kData / "packing_small.csv").string());
 }

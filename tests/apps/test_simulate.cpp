@@ -28,8 +28,10 @@ std::string slurp(const std::filesystem::path& p) {
 }
 
 int run(const std::string& args, std::string* err = nullptr) {
-  const auto e = std::filesystem::temp_directory_path() / ("gs_sim_err_" + std::to_string(::getpid()));
-  const int status = std::system((kExe + " " + args + " >/dev/null 2>" + e.string() + " </dev/null").c_str());
+  const auto e =
+      std::filesystem::temp_directory_path() / ("gs_sim_err_" + std::to_string(::getpid()));
+  const int status =
+      std::system((kExe + " " + args + " >/dev/null 2>" + e.string() + " </dev/null").c_str());
   if (err) *err = slurp(e);
   std::filesystem::remove(e);
   return WIFEXITED(status) ? WEXITSTATUS(status) : 128;
@@ -49,7 +51,8 @@ TEST(Simulate, ResumeAfterKillIsBitForBitIdentical) {
     const int devnull = ::open("/dev/null", O_WRONLY);
     dup2(devnull, 1);
     dup2(devnull, 2);
-    execl(kExe.c_str(), kExe.c_str(), "simulate", scene.c_str(), "-q", "-o", killed.c_str(), nullptr);
+    execl(kExe.c_str(), kExe.c_str(), "simulate", scene.c_str(), "-q", "-o", killed.c_str(),
+          nullptr);
     _exit(127);
   }
   // Kill once a checkpoint past step 2000 is on disk, mid-run.
@@ -98,12 +101,16 @@ TEST(Simulate, BadScenesGiveOneLineAndExit2) {
   };
   const std::vector<std::pair<std::string, std::string>> cases = {
       {(dir / "missing.toml").string(), "no such scene file"},
-      {variant("young.toml", "young_Pa = 5.0e7", "young_Pa = -5.0e7"), "material.young_Pa: must be positive (-50000000)"},
+      {variant("young.toml", "young_Pa = 5.0e7", "young_Pa = -5.0e7"),
+       "material.young_Pa: must be positive (-50000000)"},
       {variant("syntax.toml", "[solver]", "[solver"), "TOML syntax error"},
-      {variant("shape.toml", "shape = \"plane\"", "shape = \"sphere\""), "walls[0].shape: expected \"box\" or \"plane\" (sphere)"},
+      {variant("shape.toml", "shape = \"plane\"", "shape = \"sphere\""),
+       "walls[0].shape: expected \"box\" or \"plane\" (sphere)"},
       {variant("nopack.toml", "drop_packing.csv", "nope.csv"), "no such file"},
-      {variant("damp.toml", "damping = 0.1", "damping = 1.5"), "solver.damping: outside [0, 1) (1.5)"},
-      {variant("vec.toml", "normal = [0.0, 0.0, 1.0]", "normal = [0.0, 1.0]"), "walls[0].normal: expected an array of 3 numbers"},
+      {variant("damp.toml", "damping = 0.1", "damping = 1.5"),
+       "solver.damping: outside [0, 1) (1.5)"},
+      {variant("vec.toml", "normal = [0.0, 0.0, 1.0]", "normal = [0.0, 1.0]"),
+       "walls[0].normal: expected an array of 3 numbers"},
   };
   for (const auto& [file, what] : cases) {
     std::string err;
@@ -114,6 +121,9 @@ TEST(Simulate, BadScenesGiveOneLineAndExit2) {
   }
   // Resume without a checkpoint.
   std::string err;
-  EXPECT_EQ(run("simulate " + (kData / "scenes" / "drop.toml").string() + " -q --resume -o " + (dir / "empty").string(), &err), 2);
+  EXPECT_EQ(run("simulate " + (kData / "scenes" / "drop.toml").string() + " -q --resume -o " +
+                    (dir / "empty").string(),
+                &err),
+            2);
   EXPECT_NE(err.find("no checkpoint to resume from"), std::string::npos) << err;
 }

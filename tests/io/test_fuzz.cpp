@@ -21,7 +21,8 @@ std::string slurp(const std::filesystem::path& p) {
 }
 
 void spit(const std::filesystem::path& p, const std::string& s) {
-  std::ofstream(p, std::ios::binary | std::ios::trunc).write(s.data(), static_cast<std::streamsize>(s.size()));
+  std::ofstream(p, std::ios::binary | std::ios::trunc)
+      .write(s.data(), static_cast<std::streamsize>(s.size()));
 }
 
 struct Outcome {
@@ -29,7 +30,8 @@ struct Outcome {
 };
 
 // Mutates `victim` (a copy inside dir) `rounds` times and reads `entry` each time.
-Outcome fuzz(const std::filesystem::path& victim, const std::filesystem::path& entry, int rounds, unsigned seed) {
+Outcome fuzz(const std::filesystem::path& victim, const std::filesystem::path& entry, int rounds,
+             unsigned seed) {
   const std::string original = slurp(victim);
   std::mt19937 rng(seed);
   Outcome out;
@@ -39,7 +41,8 @@ Outcome fuzz(const std::filesystem::path& victim, const std::filesystem::path& e
       case 0:  // a few bit flips anywhere
       case 1: {
         const int flips = 1 + static_cast<int>(rng() % 8);
-        for (int f = 0; f < flips && !m.empty(); ++f) m[rng() % m.size()] ^= static_cast<char>(1u << (rng() % 8));
+        for (int f = 0; f < flips && !m.empty(); ++f)
+          m[rng() % m.size()] ^= static_cast<char>(1u << (rng() % 8));
         break;
       }
       case 2:  // truncation
@@ -48,7 +51,8 @@ Outcome fuzz(const std::filesystem::path& victim, const std::filesystem::path& e
       case 3: {  // a run of random bytes
         if (m.empty()) break;
         const std::size_t at = rng() % m.size(), len = 1 + rng() % 16;
-        for (std::size_t i = at; i < std::min(m.size(), at + len); ++i) m[i] = static_cast<char>(rng());
+        for (std::size_t i = at; i < std::min(m.size(), at + len); ++i)
+          m[i] = static_cast<char>(rng());
         break;
       }
     }
@@ -63,7 +67,8 @@ Outcome fuzz(const std::filesystem::path& victim, const std::filesystem::path& e
       EXPECT_EQ(msg.find('\n'), std::string::npos) << "one line: " << msg;
       ++out.rejected;
     } catch (const std::exception& e) {
-      ADD_FAILURE() << victim << " mutant " << k << ": unexpected " << typeid(e).name() << ": " << e.what();
+      ADD_FAILURE() << victim << " mutant " << k << ": unexpected " << typeid(e).name() << ": "
+                    << e.what();
     }
   }
   spit(victim, original);
@@ -78,7 +83,8 @@ class Fuzz : public ::testing::TestWithParam<std::vector<std::string>> {};
 TEST_P(Fuzz, MutantsAreRejectedOrValid) {
   const auto files = GetParam();
   gs::test::ScratchDir dir("fuzz");
-  for (const auto& f : files) std::filesystem::copy_file(kData / f, dir / std::filesystem::path(f).filename().string());
+  for (const auto& f : files)
+    std::filesystem::copy_file(kData / f, dir / std::filesystem::path(f).filename().string());
   const auto entry = dir / std::filesystem::path(files.front()).filename().string();
   const auto victim = dir / std::filesystem::path(files.back()).filename().string();
   const Outcome o = fuzz(victim, entry, 120, 12345u + static_cast<unsigned>(files.back().size()));
@@ -107,8 +113,11 @@ TEST(FuzzOwnFormats, Hdf5VtuVtpPvd) {
   write_snapshots(dir / "one.vtu", t);
   write_snapshots(dir / "series.pvd", t);
   for (const auto& [entry, victim] : std::vector<std::pair<std::string, std::string>>{
-           {"run.h5", "run.h5"}, {"one.vtu", "one.vtu"}, {"one.vtu", "one.vtp"},
-           {"series.pvd", "series.pvd"}, {"series.pvd", "series_files/particles_000001.vtu"}}) {
+           {"run.h5", "run.h5"},
+           {"one.vtu", "one.vtu"},
+           {"one.vtu", "one.vtp"},
+           {"series.pvd", "series.pvd"},
+           {"series.pvd", "series_files/particles_000001.vtu"}}) {
     const Outcome o = fuzz(dir / victim, dir / entry, 120, 777u);
     EXPECT_GT(o.rejected, 0) << victim;
   }

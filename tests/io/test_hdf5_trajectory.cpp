@@ -41,7 +41,8 @@ TEST(Hdf5Trajectory, RoundTripsEveryFieldExactly) {
   Trajectory t;
   t.metadata = meta();
   // Frames with different particle and contact counts, and an empty contact list.
-  t.frames = {random_frame(50, 80, 1, 0.0), random_frame(37, 0, 2, 0.5), random_frame(61, 12, 3, 1.0)};
+  t.frames = {random_frame(50, 80, 1, 0.0), random_frame(37, 0, 2, 0.5),
+              random_frame(61, 12, 3, 1.0)};
   const auto path = dir / "run.h5";
   write_hdf5_trajectory(path, t);
   EXPECT_FALSE(std::filesystem::exists(partial_path(path)));
@@ -160,7 +161,8 @@ TEST(Hdf5Trajectory, RejectsBadFilesWithOneClearMessage) {
   for (double frac : {0.05, 0.3, 0.6, 0.95}) {
     const auto cut = dir / "cut.h5";
     std::filesystem::copy_file(good, cut, std::filesystem::copy_options::overwrite_existing);
-    std::filesystem::resize_file(cut, static_cast<std::uintmax_t>(frac * static_cast<double>(size)));
+    std::filesystem::resize_file(cut,
+                                 static_cast<std::uintmax_t>(frac * static_cast<double>(size)));
     const std::string e = error_of([&] { read_hdf5_trajectory(cut); });
     EXPECT_EQ(e.rfind(cut.string() + ": ", 0), 0u) << e;
   }
@@ -176,7 +178,8 @@ TEST(Hdf5Trajectory, RejectsBadFilesWithOneClearMessage) {
     H5Awrite(a, H5T_NATIVE_LLONG, &v);
     H5Aclose(a);
     H5Fclose(f);
-    EXPECT_EQ(error_of([&] { TrajectoryReader r(bad); }), bad.string() + ": unsupported schema_version (99)");
+    EXPECT_EQ(error_of([&] { TrajectoryReader r(bad); }),
+              bad.string() + ": unsupported schema_version (99)");
   }
 
   // NaN and negative radius written behind the library's back.
@@ -205,7 +208,8 @@ TEST(Hdf5Trajectory, RejectsBadFilesWithOneClearMessage) {
   {
     const auto txt = dir / "text.h5";
     std::ofstream(txt) << "id,x,y,z,r\n";
-    EXPECT_EQ(error_of([&] { TrajectoryReader r(txt); }), txt.string() + ": not an HDF5 file (bad signature)");
+    EXPECT_EQ(error_of([&] { TrajectoryReader r(txt); }),
+              txt.string() + ": not an HDF5 file (bad signature)");
   }
 }
 
@@ -235,13 +239,16 @@ TEST(Hdf5Trajectory, ReadableByH5py) {
   const std::string script =
       "import h5py, sys\n"
       "f = h5py.File(sys.argv[1], 'r')\n"
-      "print(f.attrs['format'].decode() if isinstance(f.attrs['format'], bytes) else f.attrs['format'])\n"
+      "print(f.attrs['format'].decode() if isinstance(f.attrs['format'], bytes) else "
+      "f.attrs['format'])\n"
       "print(int(f.attrs['schema_version']))\n"
       "e = f['frames/end'][:]\n"
       "print(len(e), int(e[-1][0]), int(e[-1][1]))\n"
-      "print(repr(float(f['particles/position'][13][1])), repr(float(f['particles/radius'][20])))\n";
+      "print(repr(float(f['particles/position'][13][1])), "
+      "repr(float(f['particles/radius'][20])))\n";
   std::ofstream(dir / "read.py") << script;
-  const std::string cmd = py + " " + (dir / "read.py").string() + " " + path.string() + " > " + out.string();
+  const std::string cmd =
+      py + " " + (dir / "read.py").string() + " " + path.string() + " > " + out.string();
   ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
   std::ifstream in(out);
   std::string fmt;

@@ -96,7 +96,8 @@ TEST(Importers, LiggghtsAtomsAndPairsMatchTheDump) {
   // none of them, so the check discriminates.
   const Frame& f = t.frames[1];
   std::map<std::int64_t, Eigen::Vector3d> ours, reversed;
-  for (const auto& p : f.particles) ours[p.id] = reversed[p.id] = Eigen::Vector3d(0, 0, -9.81 * p.mass);
+  for (const auto& p : f.particles)
+    ours[p.id] = reversed[p.id] = Eigen::Vector3d(0, 0, -9.81 * p.mass);
   for (const auto& c : f.contacts) {
     const Eigen::Vector3d on2 = c.normal_force + c.shear_force;
     ours[c.id1] -= on2;
@@ -114,12 +115,14 @@ TEST(Importers, LiggghtsAtomsAndPairsMatchTheDump) {
   for (std::size_t i = first; i < first + 60; ++i) {
     const auto tok = text::split_ws(lines[i]);
     const auto id = text::to_int(tok[0], "dump", i, "id");
-    const Eigen::Vector3d x(text::to_double(tok[2], "dump", i, "x"), text::to_double(tok[3], "dump", i, "y"),
+    const Eigen::Vector3d x(text::to_double(tok[2], "dump", i, "x"),
+                            text::to_double(tok[3], "dump", i, "y"),
                             text::to_double(tok[4], "dump", i, "z"));
     const double r = text::to_double(tok[14], "dump", i, "radius");
     const double gap = std::min({x.x(), 0.04 - x.x(), x.y(), 0.04 - x.y(), x.z()}) - r;
     if (gap < 1e-5) continue;  // touching (or about to touch) a wall: wall forces are not dumped
-    const Eigen::Vector3d dumped(text::to_double(tok[8], "dump", i, "fx"), text::to_double(tok[9], "dump", i, "fy"),
+    const Eigen::Vector3d dumped(text::to_double(tok[8], "dump", i, "fx"),
+                                 text::to_double(tok[9], "dump", i, "fy"),
                                  text::to_double(tok[10], "dump", i, "fz"));
     ++checked;
     balanced += (ours[id] - dumped).norm() < 1e-4;

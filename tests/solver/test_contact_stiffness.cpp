@@ -14,8 +14,8 @@ TEST(ContactStiffness, HandComputedPair) {
   EXPECT_DOUBLE_EQ(k.ks, 0.3 * 450000.0);
   EXPECT_DOUBLE_EQ(k.kr, 0.7 * 135000.0 * 3e-6);
   EXPECT_DOUBLE_EQ(k.rolling_radius_m, 2e-3);
-  EXPECT_DOUBLE_EQ(contact_stiffness(3e8, 0.3, 0.7, 1e-3, 3e-3, RollingRadius::Min).rolling_radius_m,
-                   1e-3);
+  EXPECT_DOUBLE_EQ(
+      contact_stiffness(3e8, 0.3, 0.7, 1e-3, 3e-3, RollingRadius::Min).rolling_radius_m, 1e-3);
 }
 
 TEST(ContactStiffness, WallConventionEqualRadii) {
@@ -27,9 +27,12 @@ TEST(ContactStiffness, WallConventionEqualRadii) {
 }
 
 TEST(ContactStiffness, RejectsDegenerateInput) {
-  EXPECT_THROW(contact_stiffness(3e8, 0.3, 0.7, 0.0, 1e-3, RollingRadius::Min), std::invalid_argument);
-  EXPECT_THROW(contact_stiffness(3e8, 0.3, 0.7, -1e-3, 1e-3, RollingRadius::Min), std::invalid_argument);
-  EXPECT_THROW(contact_stiffness(0.0, 0.3, 0.7, 1e-3, 1e-3, RollingRadius::Min), std::invalid_argument);
+  EXPECT_THROW(contact_stiffness(3e8, 0.3, 0.7, 0.0, 1e-3, RollingRadius::Min),
+               std::invalid_argument);
+  EXPECT_THROW(contact_stiffness(3e8, 0.3, 0.7, -1e-3, 1e-3, RollingRadius::Min),
+               std::invalid_argument);
+  EXPECT_THROW(contact_stiffness(0.0, 0.3, 0.7, 1e-3, 1e-3, RollingRadius::Min),
+               std::invalid_argument);
   EXPECT_THROW(contact_stiffness(3e8, 0.3, 0.7, std::nan(""), 1e-3, RollingRadius::Min),
                std::invalid_argument);
 }

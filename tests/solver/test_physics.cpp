@@ -25,7 +25,8 @@ Material material(double young = 1e8, double mu_deg = 30, double beta = 0, doubl
   return m;
 }
 
-Particle sphere(std::int64_t id, Eigen::Vector3d x, double r, Eigen::Vector3d v = Eigen::Vector3d::Zero()) {
+Particle sphere(std::int64_t id, Eigen::Vector3d x, double r,
+                Eigen::Vector3d v = Eigen::Vector3d::Zero()) {
   Particle p;
   p.id = id;
   p.position = x;
@@ -57,8 +58,9 @@ TEST(Physics, HeadOnImpactDurationRestitutionEnergy) {
   const double duration = M_PI * std::sqrt(0.5 * m / kn);
   c.dt = duration / 2000;
   const double gap = 4e-6;
-  Simulation sim(c, {sphere(0, {0, 0, 0}, r, {v0, 0, 0}), sphere(1, {2 * r + gap, 0, 0}, r, {-v0, 0, 0})},
-                 {plane({-r - gap, 0, 0}, {1, 0, 0}), plane({3 * r + 2 * gap, 0, 0}, {-1, 0, 0})});
+  Simulation sim(
+      c, {sphere(0, {0, 0, 0}, r, {v0, 0, 0}), sphere(1, {2 * r + gap, 0, 0}, r, {-v0, 0, 0})},
+      {plane({-r - gap, 0, 0}, {1, 0, 0}), plane({3 * r + 2 * gap, 0, 0}, {-1, 0, 0})});
   const double e0 = sim.kinetic_energy();
   std::int64_t first = -1, last = -1;
   double max_energy_error = 0;
@@ -67,8 +69,9 @@ TEST(Physics, HeadOnImpactDurationRestitutionEnergy) {
   for (int s = 0; s < 100000; ++s) {
     sim.step();
     const auto f = sim.frame();
-    const bool pair_contact = std::any_of(f.contacts.begin(), f.contacts.end(),
-                                          [](const Contact& k) { return k.id1 == 0 && k.id2 == 1; });
+    const bool pair_contact =
+        std::any_of(f.contacts.begin(), f.contacts.end(),
+                    [](const Contact& k) { return k.id1 == 0 && k.id2 == 1; });
     if (pair_contact && collisions == 0) {
       if (first < 0) first = s;
       last = s;
@@ -105,7 +108,8 @@ InclineResult incline(double theta_deg, double mu_deg, bool block_rotation, doub
   SimulationConfig c;
   c.material = material(1e8, mu_deg, beta, beta > 0 ? 1e9 : -1);
   c.gravity = Eigen::Vector3d(0, 0, -g);
-  const Eigen::Vector3d n(-std::sin(th), 0, std::cos(th)), down_slope(-std::cos(th), 0, -std::sin(th));
+  const Eigen::Vector3d n(-std::sin(th), 0, std::cos(th)),
+      down_slope(-std::cos(th), 0, -std::sin(th));
   // Start at static overlap so the normal direction is at rest.
   const double m = (4.0 / 3.0) * M_PI * r * r * r * c.material.density;
   const double delta = m * g * std::cos(th) / (c.material.young_ec * r);
@@ -116,7 +120,8 @@ InclineResult incline(double theta_deg, double mu_deg, bool block_rotation, doub
   const Eigen::Vector3d x0 = sim.particles().pos[0];
   for (int s = 0; s < steps / 2; ++s) {
     sim.step();
-    if (max_travel) *max_travel = std::max(*max_travel, std::abs((sim.particles().pos[0] - x0).dot(down_slope)));
+    if (max_travel)
+      *max_travel = std::max(*max_travel, std::abs((sim.particles().pos[0] - x0).dot(down_slope)));
   }
   const double v1 = sim.particles().vel[0].dot(down_slope), w1 = sim.particles().angvel[0].y();
   sim.run(steps / 2);
@@ -199,9 +204,10 @@ std::vector<Particle> random_packing(int n, unsigned seed) {
   const int side = static_cast<int>(std::ceil(std::cbrt(n)));
   for (int i = 0; i < n; ++i) {
     const int x = i % side, y = (i / side) % side, z = i / (side * side);
-    ps.push_back(sphere(i, Eigen::Vector3d(x, y, z) * 1.98e-3 + Eigen::Vector3d(u(rng), u(rng), u(rng)) * 5e-5,
-                        1e-3 * (0.95 + 0.1 * u(rng)),
-                        Eigen::Vector3d(u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5) * 0.1));
+    ps.push_back(sphere(
+        i, Eigen::Vector3d(x, y, z) * 1.98e-3 + Eigen::Vector3d(u(rng), u(rng), u(rng)) * 5e-5,
+        1e-3 * (0.95 + 0.1 * u(rng)),
+        Eigen::Vector3d(u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5) * 0.1));
   }
   return ps;
 }
@@ -247,7 +253,8 @@ TEST(Physics, CheckpointResumesBitForBit) {
   straight.run(1200);
   Simulation first(packing_config(2), ps, box_walls());
   first.run(500);
-  const auto ckpt = std::filesystem::temp_directory_path() / ("gs_ckpt_" + std::to_string(::getpid()));
+  const auto ckpt =
+      std::filesystem::temp_directory_path() / ("gs_ckpt_" + std::to_string(::getpid()));
   first.save_checkpoint(ckpt);
   Simulation resumed(packing_config(1), ps, box_walls());
   resumed.load_checkpoint(ckpt);
@@ -265,7 +272,8 @@ TEST(Physics, BlowUpIsDetected) {
   SimulationConfig c;
   c.material = material();
   c.dt = 1e-4;  // far above critical
-  Simulation sim(c, {sphere(0, {0, 0, 0}, 1e-3, {1, 0, 0}), sphere(1, {2.1e-3, 0, 0}, 1e-3, {-1, 0, 0})}, {});
+  Simulation sim(
+      c, {sphere(0, {0, 0, 0}, 1e-3, {1, 0, 0}), sphere(1, {2.1e-3, 0, 0}, 1e-3, {-1, 0, 0})}, {});
   EXPECT_THROW(sim.run(100), BlowUp);
 }
 
@@ -284,8 +292,8 @@ TEST(Physics, ServoWallReachesTargetStress) {
   Simulation sim(c, {sphere(0, {0, 0, r}, r)}, {plane({0, 0, 0}, {0, 0, 1}), top});
   sim.run(200000);
   const double force = sim.walls()[1].force.dot(Eigen::Vector3d(0, 0, 1));
-  EXPECT_NEAR(force, 1e-3, 1e-5);                                   // stress within 1 %
-  EXPECT_NEAR(sim.walls()[0].force.z(), -1e-3, 1e-5);               // transmitted to the floor
+  EXPECT_NEAR(force, 1e-3, 1e-5);                      // stress within 1 %
+  EXPECT_NEAR(sim.walls()[0].force.z(), -1e-3, 1e-5);  // transmitted to the floor
   EXPECT_NEAR(sim.frame().contacts.at(0).overlap, 1e-3 / (1e8 * r), 1e-9);  // Fn = Kn·u
 }
 

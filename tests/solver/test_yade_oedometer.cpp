@@ -22,7 +22,8 @@ TEST(YadeOedometer, PositionsAndWallForcesMatchYade) {
   cfg.max_overlap_ratio = 0.5;  // the top wall squeezes soft spheres past 10 % overlap by the end
   solver::Simulation sim(cfg, packing.particles, test::oedometer_walls());
   auto perturbed_particles = packing.particles;
-  perturbed_particles[100].position.x() = std::nextafter(perturbed_particles[100].position.x(), 1.0);
+  perturbed_particles[100].position.x() =
+      std::nextafter(perturbed_particles[100].position.x(), 1.0);
   solver::Simulation twin(cfg, perturbed_particles, test::oedometer_walls());
   // walls.csv: step,time,wall,fx,fy,fz,px,py,pz every 100 steps.
   std::map<std::pair<long, int>, Eigen::Vector3d> yade_walls;
@@ -47,7 +48,8 @@ TEST(YadeOedometer, PositionsAndWallForcesMatchYade) {
         const Eigen::Vector3d ref = yade_walls.at({s, w});
         const Eigen::Vector3d ours = sim.walls()[w].force;
         const double rel = (ours - ref).norm() / std::max(ref.norm(), 1e-12);
-        const double rel_twin = (twin.walls()[w].force - ours).norm() / std::max(ours.norm(), 1e-12);
+        const double rel_twin =
+            (twin.walls()[w].force - ours).norm() / std::max(ours.norm(), 1e-12);
         worst_yade = std::max(worst_yade, rel);
         worst_twin = std::max(worst_twin, rel_twin);
         if (s <= 5000) {
@@ -65,9 +67,11 @@ TEST(YadeOedometer, PositionsAndWallForcesMatchYade) {
         dmax = std::max(dmax, (sim.particles().pos[i] - Eigen::Vector3d(r[0], r[1], r[2])).norm());
         dtwin = std::max(dtwin, (sim.particles().pos[i] - twin.particles().pos[i]).norm());
       }
-      std::printf("step %5ld: max |x - x_yade| = %.3e m (1-ulp twin: %.3e m), contacts %zu; worst wall-force "
-                  "deviation so far: from YADE %.3e, twin %.3e\n",
-                  s, dmax, dtwin, sim.contact_count(), worst_yade, worst_twin);
+      std::printf(
+          "step %5ld: max |x - x_yade| = %.3e m (1-ulp twin: %.3e m), contacts %zu; worst "
+          "wall-force "
+          "deviation so far: from YADE %.3e, twin %.3e\n",
+          s, dmax, dtwin, sim.contact_count(), worst_yade, worst_twin);
       if (s == 2000) {
         EXPECT_LT(dmax, 1e-9) << "positions after 2000 steps";
       }

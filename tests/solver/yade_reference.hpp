@@ -14,7 +14,8 @@
 namespace gs::test {
 
 inline std::filesystem::path yade_reference_dir() {
-  return std::filesystem::path(GS_SOURCE_DIR) / ".." / "shared" / "reference" / "yade" / "oedometer";
+  return std::filesystem::path(GS_SOURCE_DIR) / ".." / "shared" / "reference" / "yade" /
+         "oedometer";
 }
 
 /// Parameters of case.json (material, damping, gravity, dt, walls).
@@ -62,7 +63,8 @@ inline std::map<long, std::vector<double>> read_yade_state(const std::filesystem
     if (text::trim(lines[i]).empty()) continue;
     const auto f = text::split_csv(lines[i]);
     std::vector<double> v;
-    for (std::size_t k = 1; k < f.size(); ++k) v.push_back(text::to_double(f[k], p.string(), i + 1, "state"));
+    for (std::size_t k = 1; k < f.size(); ++k)
+      v.push_back(text::to_double(f[k], p.string(), i + 1, "state"));
     rows[static_cast<long>(text::to_int(f[0], p.string(), i + 1, "id"))] = v;
   }
   return rows;
