@@ -8,6 +8,7 @@
 namespace gs::cli {
 
 // Declarations, one line each (keep sorted by module):
+void register_dic(CLI::App& app);  // dic (apps/cmd_dic.cpp)
 
 /// `granoscope analyze` parent; analyses register below it (analyze hhd, analyze strain, ...).
 CLI::App& analyze_command(CLI::App& app);
