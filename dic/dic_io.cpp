@@ -15,6 +15,7 @@
 
 #include "atomic_file.hpp"
 #include "errors.hpp"
+#include "render_frames.hpp"
 #include "snapshot.hpp"
 
 namespace gs::dic {
@@ -196,6 +197,43 @@ void write_dic_vti(const std::filesystem::path& path, const SequenceResult& resu
   w->SetFileName(out.temp_path().string().c_str());
   w->SetInputData(img);
   if (w->Write() != 1) throw InputError(path.string(), "cannot write VTK image");
+  out.commit();
+}
+
+void write_ground_truth_hdf5(const std::filesystem::path& path, const Camera& camera,
+                             const std::string& view, const std::vector<GroundTruth>& frames) {
+  AtomicOutput out(path);
+  const std::string name = path.string();
+  {
+    const H5 file(H5Fcreate(out.temp_path().string().c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT),
+                  H5Fclose, name, "create");
+    const hid_t root = file.get();
+    attr_string(root, name, "format", "granoscope-render-truth");
+    attr_string(root, name, "code_version", code_version());
+    attr_string(root, name, "view", view);
+    attr_double(root, name, "px_per_m", camera.px_per_m);
+    attr_double(root, name, "a0_m", camera.a0);
+    attr_double(root, name, "b0_m", camera.b0);
+    attr_string(root, name, "reference", "frame 0 of the input; u, v in px, image axes (x right, y down)");
+    const auto rows = static_cast<hsize_t>(camera.rows), cols = static_cast<hsize_t>(camera.cols);
+    const auto nf = static_cast<hsize_t>(frames.size());
+    std::vector<int> grain;
+    if (!frames.empty()) {
+      const cv::Mat& g = frames.front().grain;
+      grain.assign(g.begin<int>(), g.end<int>());
+    }
+    dataset(root, name, "grain", {rows, cols}, H5T_STD_I32LE, H5T_NATIVE_INT, grain);
+    std::vector<float> u, v;
+    std::vector<std::uint8_t> vis;
+    for (const auto& f : frames) {
+      for (auto it = f.u.begin<double>(); it != f.u.end<double>(); ++it) u.push_back(static_cast<float>(*it));
+      for (auto it = f.v.begin<double>(); it != f.v.end<double>(); ++it) v.push_back(static_cast<float>(*it));
+      vis.insert(vis.end(), f.visible.begin<std::uint8_t>(), f.visible.end<std::uint8_t>());
+    }
+    dataset(root, name, "u", {nf, rows, cols}, H5T_IEEE_F32LE, H5T_NATIVE_FLOAT, u);
+    dataset(root, name, "v", {nf, rows, cols}, H5T_IEEE_F32LE, H5T_NATIVE_FLOAT, v);
+    dataset(root, name, "visible", {nf, rows, cols}, H5T_STD_U8LE, H5T_NATIVE_UINT8, vis);
+  }
   out.commit();
 }
 

@@ -36,3 +36,16 @@ void write_dic_vti(const std::filesystem::path& path, const SequenceResult& resu
                    std::size_t frame, const DicRunInfo& info);
 
 }  // namespace gs::dic
+
+namespace gs::dic {
+
+struct GroundTruth;
+struct Camera;
+
+/// Ground truth of rendered frames (root attribute format = "granoscope-render-truth"):
+/// /grain (rows x cols, index of the reference particle, -1 background), /u, /v, /visible
+/// (frames x rows x cols; px, reference = frame 0), camera attributes.
+void write_ground_truth_hdf5(const std::filesystem::path& path, const Camera& camera,
+                             const std::string& view, const std::vector<GroundTruth>& frames);
+
+}  // namespace gs::dic
