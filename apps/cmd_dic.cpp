@@ -138,7 +138,8 @@ struct RenderArgs {
 
 void run_render(const RenderArgs& a) {
   const dic::View view = dic::parse_view(a.view);
-  if (a.bits != 8 && a.bits != 16) throw InputError("--bits", "must be 8 or 16", std::to_string(a.bits));
+  if (a.bits != 8 && a.bits != 16)
+    throw InputError("--bits", "must be 8 or 16", std::to_string(a.bits));
   if (a.format != "png" && a.format != "tif")
     throw InputError("--format", "must be png or tif", a.format);
   if (a.supersample < 1 || a.supersample > 16)
@@ -169,13 +170,15 @@ void run_render(const RenderArgs& a) {
     std::snprintf(name, sizeof name, "frame_%04zu.%s", k, a.format.c_str());
     const std::filesystem::path target = std::filesystem::path(a.out_dir) / name;
     AtomicOutput out(target);
-    const std::string tmp = out.temp_path().string() + "." + a.format;  // imwrite needs the extension
+    const std::string tmp =
+        out.temp_path().string() + "." + a.format;  // imwrite needs the extension
     if (!cv::imwrite(tmp, q)) throw InputError(target.string(), "cannot write image");
     std::filesystem::rename(tmp, out.temp_path());
     out.commit();
     truth.push_back(dic::ground_truth(ref, f, cam));
   }
-  dic::write_ground_truth_hdf5(std::filesystem::path(a.out_dir) / "ground_truth.h5", cam, a.view, truth);
+  dic::write_ground_truth_hdf5(std::filesystem::path(a.out_dir) / "ground_truth.h5", cam, a.view,
+                               truth);
   std::cout << "rendered " << reader.frame_count() << " frames " << cam.cols << "x" << cam.rows
             << " px (" << a.px_per_d50 << " px per d50) to " << a.out_dir << "\n";
 }
@@ -184,15 +187,20 @@ void run_render(const RenderArgs& a) {
 
 void register_dic(CLI::App& app) {
   auto rargs = std::make_shared<RenderArgs>();
-  auto* r = app.add_subcommand("render", "Speckle images of DEM frames for DIC, with exact ground truth");
+  auto* r =
+      app.add_subcommand("render", "Speckle images of DEM frames for DIC, with exact ground truth");
   r->add_option("input", rargs->input, "trajectory RUN.h5")->required();
   r->add_option("-o,--output", rargs->out_dir, "output directory (frame_NNNN.png, ground_truth.h5)")
       ->required();
-  r->add_option("--view", rargs->view, "front, back, left, right, top or bottom")->capture_default_str();
-  r->add_option("--px-per-d50", rargs->px_per_d50, "pixels per median grain diameter")->capture_default_str();
-  r->add_option("--margin", rargs->margin_d50, "margin around the grains, in d50")->capture_default_str();
+  r->add_option("--view", rargs->view, "front, back, left, right, top or bottom")
+      ->capture_default_str();
+  r->add_option("--px-per-d50", rargs->px_per_d50, "pixels per median grain diameter")
+      ->capture_default_str();
+  r->add_option("--margin", rargs->margin_d50, "margin around the grains, in d50")
+      ->capture_default_str();
   r->add_option("--supersample", rargs->supersample, "s x s rays per pixel")->capture_default_str();
-  r->add_option("--noise", rargs->noise, "Gaussian noise sigma, fraction of full scale")->capture_default_str();
+  r->add_option("--noise", rargs->noise, "Gaussian noise sigma, fraction of full scale")
+      ->capture_default_str();
   r->add_option("--bits", rargs->bits, "8 or 16")->capture_default_str();
   r->add_option("--format", rargs->format, "png or tif")->capture_default_str();
   r->add_option("--seed", rargs->seed, "grain textures and noise")->capture_default_str();
@@ -212,8 +220,10 @@ void register_dic(CLI::App& app) {
               "correlate each image with the previous one and accumulate (default: cumulative)");
   c->add_option("--strain-window", args->strain_window, "strain plane-fit window, POIs (odd)")
       ->capture_default_str();
-  c->add_option("--strain", args->strain, "strain in CSV/VTK: green or small")->capture_default_str();
-  c->add_option("--zncc-min", args->zncc_min, "POIs below this ZNCC are invalid")->capture_default_str();
+  c->add_option("--strain", args->strain, "strain in CSV/VTK: green or small")
+      ->capture_default_str();
+  c->add_option("--zncc-min", args->zncc_min, "POIs below this ZNCC are invalid")
+      ->capture_default_str();
   c->add_option("--search", args->search, "seed search half-width, px")->capture_default_str();
   c->add_option("--threads", args->threads, "threads (0 = OpenMP default)")->capture_default_str();
   c->add_flag("--no-csv", args->no_csv, "do not write CSV tables");

@@ -2,14 +2,14 @@
 // Usage: bench_dic [--quick]. Prints Markdown tables; timings are wall clock.
 #include <omp.h>
 
+#include <Eigen/Geometry>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <Eigen/Geometry>
-#include <random>
 #include <numbers>
 #include <opencv2/imgproc.hpp>
+#include <random>
 #include <vector>
 
 #include "dic_strain.hpp"
@@ -28,7 +28,8 @@ double now() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
-cv::Mat render(const SpecklePattern& pat, int rows, int cols, const InverseMap& inv, std::uint64_t seed) {
+cv::Mat render(const SpecklePattern& pat, int rows, int cols, const InverseMap& inv,
+               std::uint64_t seed) {
   RenderParams rp;
   rp.noise_sigma = kNoise;
   rp.noise_seed = seed;
@@ -61,7 +62,9 @@ Stats stats(const std::vector<double>& e) {
 
 void translations(int n) {
   std::printf("\n## Rigid translations (subset 31 px, step 4 px, noise 1%%, %dx%d px)\n\n", n, n);
-  std::printf("| shift px | bias u px | std u px | bias v px | std v px | valid POIs |\n|---|---|---|---|---|---|\n");
+  std::printf(
+      "| shift px | bias u px | std u px | bias v px | std v px | valid POIs "
+      "|\n|---|---|---|---|---|---|\n");
   const SpecklePattern pat(-40, -40, n + 40, n + 40, SpeckleParams{});
   const cv::Mat ref = render(pat, n, n, identity(), 1);
   DicOptions opt;
@@ -71,9 +74,9 @@ void translations(int n) {
   double worst_bias = 0.0, worst_sd = 0.0;
   for (int k = 0; k <= 10; ++k) {
     const double t = 0.1 * k;
-    const cv::Mat def = render(pat, n, n, [t](const Eigen::Vector2d& x) {
-      return Eigen::Vector2d(x.x() - t, x.y());
-    }, 100 + static_cast<std::uint64_t>(k));
+    const cv::Mat def = render(
+        pat, n, n, [t](const Eigen::Vector2d& x) { return Eigen::Vector2d(x.x() - t, x.y()); },
+        100 + static_cast<std::uint64_t>(k));
     const DicField f = correlate(ref, def, grid, opt);
     std::vector<double> eu, ev;
     for (std::size_t i = 0; i < f.p.size(); ++i)
@@ -84,21 +87,26 @@ void translations(int n) {
     const Stats su = stats(eu), sv = stats(ev);
     worst_bias = std::max({worst_bias, std::abs(su.mean), std::abs(sv.mean)});
     worst_sd = std::max({worst_sd, su.sd, sv.sd});
-    std::printf("| %.1f | %+.4f | %.4f | %+.4f | %.4f | %d/%d |\n", t, su.mean, su.sd, sv.mean, sv.sd,
-                su.n, grid.size());
+    std::printf("| %.1f | %+.4f | %.4f | %+.4f | %.4f | %d/%d |\n", t, su.mean, su.sd, sv.mean,
+                sv.sd, su.n, grid.size());
   }
   std::printf("\nworst |bias| = %.4f px (target < 0.005), worst std = %.4f px (target < 0.01)\n",
               worst_bias, worst_sd);
 }
 
 void uniform_strain(int n) {
-  std::printf("\n## Uniform strain (exx = 0.5%%, eyy = -0.2%%, subset 31, step 2, window 15 POIs, noise 1%%)\n\n");
+  std::printf(
+      "\n## Uniform strain (exx = 0.5%%, eyy = -0.2%%, subset 31, step 2, window 15 POIs, noise "
+      "1%%)\n\n");
   const double exx = 0.005, eyy = -0.002, c0 = n / 2.0;
   const SpecklePattern pat(-40, -40, n + 40, n + 40, SpeckleParams{});
   const cv::Mat ref = render(pat, n, n, identity(), 1);
-  const cv::Mat def = render(pat, n, n, [&](const Eigen::Vector2d& x) {
-    return Eigen::Vector2d(c0 + (x.x() - c0) / (1 + exx), c0 + (x.y() - c0) / (1 + eyy));
-  }, 2);
+  const cv::Mat def = render(
+      pat, n, n,
+      [&](const Eigen::Vector2d& x) {
+        return Eigen::Vector2d(c0 + (x.x() - c0) / (1 + exx), c0 + (x.y() - c0) / (1 + eyy));
+      },
+      2);
   DicOptions opt;
   opt.radius = 15;
   opt.threads = 2;
@@ -124,23 +132,33 @@ void uniform_strain(int n) {
     for (double v : e) m = std::max(m, std::abs(v));
     return m;
   };
-  std::printf("| Exx | %+.2e | %.2e | %.2e |\n| Eyy | %+.2e | %.2e | %.2e |\n| Exy | %+.2e | %.2e | %.2e |\n",
-              a.mean, a.rms, mx(e1), b.mean, b.rms, mx(e2), c.mean, c.rms, mx(e3));
+  std::printf(
+      "| Exx | %+.2e | %.2e | %.2e |\n| Eyy | %+.2e | %.2e | %.2e |\n| Exy | %+.2e | %.2e | %.2e "
+      "|\n",
+      a.mean, a.rms, mx(e1), b.mean, b.rms, mx(e2), c.mean, c.rms, mx(e3));
   std::printf("\nVSG = %.0f px; %d POIs with strain (target: error < 5e-4)\n", s.vsg_px, a.n);
 }
 
 void sinusoidal(int rows, int cols) {
   const double A = 0.5, lambda = 128.0, k = 2 * std::numbers::pi / lambda;
-  std::printf("\n## Sinusoidal displacement u = %.1f sin(2 pi X / %.0f) (noise 1%%, step 2, %dx%d px, 2 threads)\n\n",
-              A, lambda, cols, rows);
+  std::printf(
+      "\n## Sinusoidal displacement u = %.1f sin(2 pi X / %.0f) (noise 1%%, step 2, %dx%d px, 2 "
+      "threads)\n\n",
+      A, lambda, cols, rows);
   const SpecklePattern pat(-40, -40, cols + 40, rows + 40, SpeckleParams{});
   const cv::Mat ref = render(pat, rows, cols, identity(), 1);
-  const cv::Mat def = render(pat, rows, cols, [&](const Eigen::Vector2d& x) {
-    double X = x.x();
-    for (int it = 0; it < 30; ++it) X -= (X + A * std::sin(k * X) - x.x()) / (1 + A * k * std::cos(k * X));
-    return Eigen::Vector2d(X, x.y());
-  }, 3);
-  std::printf("| subset px | RMS u error px | time per POI us | window POIs | VSG px | RMS exx error |\n|---|---|---|---|---|---|\n");
+  const cv::Mat def = render(
+      pat, rows, cols,
+      [&](const Eigen::Vector2d& x) {
+        double X = x.x();
+        for (int it = 0; it < 30; ++it)
+          X -= (X + A * std::sin(k * X) - x.x()) / (1 + A * k * std::cos(k * X));
+        return Eigen::Vector2d(X, x.y());
+      },
+      3);
+  std::printf(
+      "| subset px | RMS u error px | time per POI us | window POIs | VSG px | RMS exx error "
+      "|\n|---|---|---|---|---|---|\n");
   for (const int subset : {21, 31, 41, 61}) {
     DicOptions opt;
     opt.radius = subset / 2;
@@ -173,12 +191,17 @@ void sinusoidal(int rows, int cols) {
 }
 
 void speed(int n) {
-  std::printf("\n## Speed (subset 31, step 2, %dx%d px image, translation 0.37 px + 0.2%% strain)\n\n", n, n);
+  std::printf(
+      "\n## Speed (subset 31, step 2, %dx%d px image, translation 0.37 px + 0.2%% strain)\n\n", n,
+      n);
   const SpecklePattern pat(-40, -40, n + 40, n + 40, SpeckleParams{});
   const cv::Mat ref = render(pat, n, n, identity(), 1);
-  const cv::Mat def = render(pat, n, n, [](const Eigen::Vector2d& x) {
-    return Eigen::Vector2d((x.x() - 0.37) / 1.002, x.y() + 0.21);
-  }, 2);
+  const cv::Mat def = render(
+      pat, n, n,
+      [](const Eigen::Vector2d& x) {
+        return Eigen::Vector2d((x.x() - 0.37) / 1.002, x.y() + 0.21);
+      },
+      2);
   DicOptions opt;
   opt.radius = 15;
   const PoiGrid grid = make_grid(n, n, opt.radius, 2);
@@ -217,7 +240,8 @@ void rendered_dem(int size_d50) {
   const double d50 = 0.002;
   std::mt19937_64 rng(5);
   const double L = size_d50 * d50, T = 3 * d50;
-  std::uniform_real_distribution<double> ux(0, L), uy(0, T), ur(0.4 * d50, 0.6 * d50), rot(-0.02, 0.02);
+  std::uniform_real_distribution<double> ux(0, L), uy(0, T), ur(0.4 * d50, 0.6 * d50),
+      rot(-0.02, 0.02);
   gs::Frame f0;
   for (int tries = 0; tries < 400000; ++tries) {
     gs::Particle p;
@@ -250,10 +274,15 @@ void rendered_dem(int size_d50) {
   f1n.step = 1;  // different noise realisation
   const cv::Mat def = render_frame(f1n, cam, ro);
   const GroundTruth gt = ground_truth(f0, f1, cam);
-  std::printf("\n## Rendered DEM frames (%zu spheres, %dx%d px, 25 px per d50, simple shear %.0f%%, 1%% noise)\n\n",
-              f0.particles.size(), cam.cols, cam.rows, 100 * gamma);
-  std::printf("DIC u, v against the ground truth averaged over each subset (visible grain pixels).\n\n");
-  std::printf("| subset px | subset / d50 | RMS u-u_gt px | RMS v-v_gt px | valid POIs | time per POI us |\n|---|---|---|---|---|---|\n");
+  std::printf(
+      "\n## Rendered DEM frames (%zu spheres, %dx%d px, 25 px per d50, simple shear %.0f%%, 1%% "
+      "noise)\n\n",
+      f0.particles.size(), cam.cols, cam.rows, 100 * gamma);
+  std::printf(
+      "DIC u, v against the ground truth averaged over each subset (visible grain pixels).\n\n");
+  std::printf(
+      "| subset px | subset / d50 | RMS u-u_gt px | RMS v-v_gt px | valid POIs | time per POI us "
+      "|\n|---|---|---|---|---|---|\n");
   for (const int subset : {21, 31, 41, 61}) {
     DicOptions opt;
     opt.radius = subset / 2;
@@ -280,8 +309,8 @@ void rendered_dem(int size_d50) {
       eu.push_back(f.p[static_cast<std::size_t>(i)][0] - su / n);
       ev.push_back(f.p[static_cast<std::size_t>(i)][3] - sv / n);
     }
-    std::printf("| %d | %.2f | %.4f | %.4f | %zu/%d | %.2f |\n", subset, subset / 25.0, stats(eu).rms,
-                stats(ev).rms, eu.size(), grid.size(), 1e6 * dt / grid.size());
+    std::printf("| %d | %.2f | %.4f | %.4f | %zu/%d | %.2f |\n", subset, subset / 25.0,
+                stats(eu).rms, stats(ev).rms, eu.size(), grid.size(), 1e6 * dt / grid.size());
   }
 }
 

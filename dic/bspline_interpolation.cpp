@@ -36,7 +36,8 @@ void prefilter_line(std::vector<double>& c) {
     sum /= (1.0 - zn * zn);
   }
   c[0] = sum;
-  for (int k = 1; k < n; ++k) c[static_cast<std::size_t>(k)] += z * c[static_cast<std::size_t>(k - 1)];
+  for (int k = 1; k < n; ++k)
+    c[static_cast<std::size_t>(k)] += z * c[static_cast<std::size_t>(k - 1)];
   // Anticausal initialisation.
   const auto last = static_cast<std::size_t>(n - 1);
   c[last] = (z / (z * z - 1.0)) * (z * c[last - 1] + c[last]);

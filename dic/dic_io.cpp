@@ -44,31 +44,35 @@ void attr_string(hid_t obj, const std::string& file, const char* name, const std
   const H5 space(H5Screate(H5S_SCALAR), H5Sclose, file, name);
   const H5 attr(H5Acreate2(obj, name, type.get(), space.get(), H5P_DEFAULT, H5P_DEFAULT), H5Aclose,
                 file, name);
-  if (H5Awrite(attr.get(), type.get(), value.c_str()) < 0) throw InputError(file, "HDF5 write", name);
+  if (H5Awrite(attr.get(), type.get(), value.c_str()) < 0)
+    throw InputError(file, "HDF5 write", name);
 }
 
 void attr_double(hid_t obj, const std::string& file, const char* name, double value) {
   const H5 space(H5Screate(H5S_SCALAR), H5Sclose, file, name);
   const H5 attr(H5Acreate2(obj, name, H5T_IEEE_F64LE, space.get(), H5P_DEFAULT, H5P_DEFAULT),
                 H5Aclose, file, name);
-  if (H5Awrite(attr.get(), H5T_NATIVE_DOUBLE, &value) < 0) throw InputError(file, "HDF5 write", name);
+  if (H5Awrite(attr.get(), H5T_NATIVE_DOUBLE, &value) < 0)
+    throw InputError(file, "HDF5 write", name);
 }
 
 void attr_int(hid_t obj, const std::string& file, const char* name, long long value) {
   const H5 space(H5Screate(H5S_SCALAR), H5Sclose, file, name);
   const H5 attr(H5Acreate2(obj, name, H5T_STD_I64LE, space.get(), H5P_DEFAULT, H5P_DEFAULT),
                 H5Aclose, file, name);
-  if (H5Awrite(attr.get(), H5T_NATIVE_LLONG, &value) < 0) throw InputError(file, "HDF5 write", name);
+  if (H5Awrite(attr.get(), H5T_NATIVE_LLONG, &value) < 0)
+    throw InputError(file, "HDF5 write", name);
 }
 
 template <class T>
-void dataset(hid_t file_id, const std::string& file, const char* name, const std::vector<hsize_t>& dims,
-             hid_t file_type, hid_t mem_type, const std::vector<T>& data) {
+void dataset(hid_t file_id, const std::string& file, const char* name,
+             const std::vector<hsize_t>& dims, hid_t file_type, hid_t mem_type,
+             const std::vector<T>& data) {
   const H5 space(H5Screate_simple(static_cast<int>(dims.size()), dims.data(), nullptr), H5Sclose,
                  file, name);
-  const H5 ds(H5Dcreate2(file_id, name, file_type, space.get(), H5P_DEFAULT, H5P_DEFAULT,
-                         H5P_DEFAULT),
-              H5Dclose, file, name);
+  const H5 ds(
+      H5Dcreate2(file_id, name, file_type, space.get(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT),
+      H5Dclose, file, name);
   if (H5Dwrite(ds.get(), mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data.data()) < 0)
     throw InputError(file, "HDF5 write", name);
 }
@@ -82,9 +86,10 @@ struct Column {
 
 std::vector<Column> strain_columns(bool small) {
   if (small)
-    return {{"exx", [](const FrameResult& f) -> const std::vector<double>& { return f.strain.sxx; }},
-            {"eyy", [](const FrameResult& f) -> const std::vector<double>& { return f.strain.syy; }},
-            {"exy", [](const FrameResult& f) -> const std::vector<double>& { return f.strain.sxy; }}};
+    return {
+        {"exx", [](const FrameResult& f) -> const std::vector<double>& { return f.strain.sxx; }},
+        {"eyy", [](const FrameResult& f) -> const std::vector<double>& { return f.strain.syy; }},
+        {"exy", [](const FrameResult& f) -> const std::vector<double>& { return f.strain.sxy; }}};
   return {{"exx", [](const FrameResult& f) -> const std::vector<double>& { return f.strain.exx; }},
           {"eyy", [](const FrameResult& f) -> const std::vector<double>& { return f.strain.eyy; }},
           {"exy", [](const FrameResult& f) -> const std::vector<double>& { return f.strain.exy; }}};
@@ -97,8 +102,9 @@ void write_dic_hdf5(const std::filesystem::path& path, const SequenceResult& res
   AtomicOutput out(path);
   const std::string name = path.string();
   {
-    const H5 file(H5Fcreate(out.temp_path().string().c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT),
-                  H5Fclose, name, "create");
+    const H5 file(
+        H5Fcreate(out.temp_path().string().c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT),
+        H5Fclose, name, "create");
     const hid_t root = file.get();
     attr_string(root, name, "format", kDicFormatName);
     attr_int(root, name, "schema_version", 1);
@@ -132,9 +138,12 @@ void write_dic_hdf5(const std::filesystem::path& path, const SequenceResult& res
         {"exx", [](const FrameResult& f) -> const std::vector<double>& { return f.strain.exx; }},
         {"eyy", [](const FrameResult& f) -> const std::vector<double>& { return f.strain.eyy; }},
         {"exy", [](const FrameResult& f) -> const std::vector<double>& { return f.strain.exy; }},
-        {"exx_small", [](const FrameResult& f) -> const std::vector<double>& { return f.strain.sxx; }},
-        {"eyy_small", [](const FrameResult& f) -> const std::vector<double>& { return f.strain.syy; }},
-        {"exy_small", [](const FrameResult& f) -> const std::vector<double>& { return f.strain.sxy; }}};
+        {"exx_small",
+         [](const FrameResult& f) -> const std::vector<double>& { return f.strain.sxx; }},
+        {"eyy_small",
+         [](const FrameResult& f) -> const std::vector<double>& { return f.strain.syy; }},
+        {"exy_small",
+         [](const FrameResult& f) -> const std::vector<double>& { return f.strain.sxy; }}};
     for (const auto& c : cols) {
       std::vector<double> all;
       for (const auto& f : result.frames) all.insert(all.end(), c.get(f).begin(), c.get(f).end());
@@ -181,7 +190,8 @@ void write_dic_vti(const std::filesystem::path& path, const SequenceResult& resu
     vtkNew<vtkDoubleArray> a;
     a->SetName(name);
     a->SetNumberOfValues(static_cast<vtkIdType>(values.size()));
-    for (std::size_t i = 0; i < values.size(); ++i) a->SetValue(static_cast<vtkIdType>(i), values[i]);
+    for (std::size_t i = 0; i < values.size(); ++i)
+      a->SetValue(static_cast<vtkIdType>(i), values[i]);
     img->GetPointData()->AddArray(a);
   };
   add("u", f.u);
@@ -191,7 +201,8 @@ void write_dic_vti(const std::filesystem::path& path, const SequenceResult& resu
   vtkNew<vtkUnsignedCharArray> valid;
   valid->SetName("valid");
   valid->SetNumberOfValues(static_cast<vtkIdType>(f.valid.size()));
-  for (std::size_t i = 0; i < f.valid.size(); ++i) valid->SetValue(static_cast<vtkIdType>(i), f.valid[i]);
+  for (std::size_t i = 0; i < f.valid.size(); ++i)
+    valid->SetValue(static_cast<vtkIdType>(i), f.valid[i]);
   img->GetPointData()->AddArray(valid);
   vtkNew<vtkXMLImageDataWriter> w;
   w->SetFileName(out.temp_path().string().c_str());
@@ -205,8 +216,9 @@ void write_ground_truth_hdf5(const std::filesystem::path& path, const Camera& ca
   AtomicOutput out(path);
   const std::string name = path.string();
   {
-    const H5 file(H5Fcreate(out.temp_path().string().c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT),
-                  H5Fclose, name, "create");
+    const H5 file(
+        H5Fcreate(out.temp_path().string().c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT),
+        H5Fclose, name, "create");
     const hid_t root = file.get();
     attr_string(root, name, "format", "granoscope-render-truth");
     attr_string(root, name, "code_version", code_version());
@@ -214,7 +226,8 @@ void write_ground_truth_hdf5(const std::filesystem::path& path, const Camera& ca
     attr_double(root, name, "px_per_m", camera.px_per_m);
     attr_double(root, name, "a0_m", camera.a0);
     attr_double(root, name, "b0_m", camera.b0);
-    attr_string(root, name, "reference", "frame 0 of the input; u, v in px, image axes (x right, y down)");
+    attr_string(root, name, "reference",
+                "frame 0 of the input; u, v in px, image axes (x right, y down)");
     const auto rows = static_cast<hsize_t>(camera.rows), cols = static_cast<hsize_t>(camera.cols);
     const auto nf = static_cast<hsize_t>(frames.size());
     std::vector<int> grain;
@@ -226,8 +239,10 @@ void write_ground_truth_hdf5(const std::filesystem::path& path, const Camera& ca
     std::vector<float> u, v;
     std::vector<std::uint8_t> vis;
     for (const auto& f : frames) {
-      for (auto it = f.u.begin<double>(); it != f.u.end<double>(); ++it) u.push_back(static_cast<float>(*it));
-      for (auto it = f.v.begin<double>(); it != f.v.end<double>(); ++it) v.push_back(static_cast<float>(*it));
+      for (auto it = f.u.begin<double>(); it != f.u.end<double>(); ++it)
+        u.push_back(static_cast<float>(*it));
+      for (auto it = f.v.begin<double>(); it != f.v.end<double>(); ++it)
+        v.push_back(static_cast<float>(*it));
       vis.insert(vis.end(), f.visible.begin<std::uint8_t>(), f.visible.end<std::uint8_t>());
     }
     dataset(root, name, "u", {nf, rows, cols}, H5T_IEEE_F32LE, H5T_NATIVE_FLOAT, u);

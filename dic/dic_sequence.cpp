@@ -87,8 +87,8 @@ SequenceResult correlate_sequence(const std::vector<cv::Mat>& images, const cv::
       for (int i = 0; i < out.grid.size(); ++i) {
         const auto c = static_cast<std::size_t>(i);
         double du = 0.0, dv = 0.0, z = -1.0;
-        if (prev.valid[c] &&
-            interpolate(out.grid, inc, out.grid.x(i) + prev.u[c], out.grid.y(i) + prev.v[c], du, dv, z)) {
+        if (prev.valid[c] && interpolate(out.grid, inc, out.grid.x(i) + prev.u[c],
+                                         out.grid.y(i) + prev.v[c], du, dv, z)) {
           fr.u[c] = prev.u[c] + du;
           fr.v[c] = prev.v[c] + dv;
           fr.zncc[c] = z;
@@ -99,7 +99,8 @@ SequenceResult correlate_sequence(const std::vector<cv::Mat>& images, const cv::
         }
       }
     }
-    fr.strain = plane_fit_strain(out.grid, fr.u, fr.v, fr.valid, options.strain_window_radius, subset);
+    fr.strain =
+        plane_fit_strain(out.grid, fr.u, fr.v, fr.valid, options.strain_window_radius, subset);
     out.frames.push_back(std::move(fr));
   }
   return out;

@@ -105,8 +105,9 @@ IcgnResult IcgnSolver::solve(int x0, int y0, const Shape& guess) const {
     const Shape dp = -Hinv.solve(b);
     // W <- W o W(dp)^-1
     W = W * to_matrix(dp).inverse();
-    const double norm = std::sqrt(dp[0] * dp[0] + dp[3] * dp[3] +
-                                  R2 * (dp[1] * dp[1] + dp[2] * dp[2] + dp[4] * dp[4] + dp[5] * dp[5]));
+    const double norm =
+        std::sqrt(dp[0] * dp[0] + dp[3] * dp[3] +
+                  R2 * (dp[1] * dp[1] + dp[2] * dp[2] + dp[4] * dp[4] + dp[5] * dp[5]));
     if (!std::isfinite(norm)) return res;
     if (norm < options_.tolerance) {
       res.converged = true;

@@ -31,10 +31,10 @@ struct PoiGrid {
 PoiGrid make_grid(int rows, int cols, int radius, int step, const cv::Mat& roi = {});
 
 struct DicOptions {
-  int radius = 15;          // subset half-width: subset = 2*radius+1 px
-  int search = 30;          // integer seed search half-width, px
-  int seeds_per_axis = 3;   // seed candidates on a seeds_per_axis^2 lattice over the grid
-  double zncc_min = 0.9;    // POIs below this are marked invalid and do not propagate
+  int radius = 15;         // subset half-width: subset = 2*radius+1 px
+  int search = 30;         // integer seed search half-width, px
+  int seeds_per_axis = 3;  // seed candidates on a seeds_per_axis^2 lattice over the grid
+  double zncc_min = 0.9;   // POIs below this are marked invalid and do not propagate
   int threads = 1;
   IcgnOptions icgn;
 };

@@ -27,12 +27,24 @@ void axes(View v, Eigen::Vector3d& right, Eigen::Vector3d& up, Eigen::Vector3d& 
   const Eigen::Vector3d X = Eigen::Vector3d::UnitX(), Y = Eigen::Vector3d::UnitY(),
                         Z = Eigen::Vector3d::UnitZ();
   switch (v) {
-    case View::Front: right = X, up = Z, dir = Y; break;
-    case View::Back: right = -X, up = Z, dir = -Y; break;
-    case View::Left: right = -Y, up = Z, dir = X; break;
-    case View::Right: right = Y, up = Z, dir = -X; break;
-    case View::Top: right = X, up = Y, dir = -Z; break;
-    case View::Bottom: right = X, up = -Y, dir = Z; break;
+    case View::Front:
+      right = X, up = Z, dir = Y;
+      break;
+    case View::Back:
+      right = -X, up = Z, dir = -Y;
+      break;
+    case View::Left:
+      right = -Y, up = Z, dir = X;
+      break;
+    case View::Right:
+      right = Y, up = Z, dir = -X;
+      break;
+    case View::Top:
+      right = X, up = Y, dir = -Z;
+      break;
+    case View::Bottom:
+      right = X, up = -Y, dir = Z;
+      break;
   }
 }
 
@@ -91,7 +103,8 @@ class Scene {
     return std::clamp(static_cast<int>(std::floor((v - lo) / cell_)), 0, n - 1);
   }
   std::size_t index(int ca, int cb) const {
-    return static_cast<std::size_t>(cb) * static_cast<std::size_t>(na_) + static_cast<std::size_t>(ca);
+    return static_cast<std::size_t>(cb) * static_cast<std::size_t>(na_) +
+           static_cast<std::size_t>(ca);
   }
   const Frame& frame_;
   const Camera& cam_;
@@ -132,7 +145,9 @@ Texture make_texture(std::int64_t id, std::uint64_t seed) {
   return t;
 }
 
-Eigen::Matrix3d body_to_lab(const Particle& p) { return p.orientation.normalized().toRotationMatrix(); }
+Eigen::Matrix3d body_to_lab(const Particle& p) {
+  return p.orientation.normalized().toRotationMatrix();
+}
 
 }  // namespace
 
@@ -229,7 +244,8 @@ GroundTruth ground_truth(const Frame& reference, const Frame& current, const Cam
       if (it == cur_index.end()) continue;
       const Particle& p1 = current.particles[static_cast<std::size_t>(it->second)];
       const Eigen::Vector3d body = body_to_lab(p0).transpose() * (hit - p0.position);
-      const Eigen::Vector3d moved = p1.position + body_to_lab(p1) * (body * (p1.radius / p0.radius));
+      const Eigen::Vector3d moved =
+          p1.position + body_to_lab(p1) * (body * (p1.radius / p0.radius));
       const Eigen::Vector2d q = camera.to_pixel(moved);
       gt.u.at<double>(r, c) = q.x() - c;
       gt.v.at<double>(r, c) = q.y() - r;

@@ -41,10 +41,10 @@ Camera make_camera(const Frame& frame, View view, double px_per_d50, double marg
                    const std::string& source);
 
 struct RenderOptions {
-  int supersample = 3;        // s x s rays per pixel
-  double noise_sigma = 0.0;   // additive Gaussian noise, grey levels (0..255)
-  std::uint64_t seed = 1;     // grain textures and noise
-  double background = 15.0;   // grey level where no grain is hit
+  int supersample = 3;       // s x s rays per pixel
+  double noise_sigma = 0.0;  // additive Gaussian noise, grey levels (0..255)
+  std::uint64_t seed = 1;    // grain textures and noise
+  double background = 15.0;  // grey level where no grain is hit
 };
 
 /// Grey image (CV_64F, 0..255, not quantised) of `frame`. Grains are matched across frames by

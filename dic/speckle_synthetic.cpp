@@ -43,13 +43,18 @@ SpecklePattern::SpecklePattern(double x0, double y0, double x1, double y1,
   cells_.resize(static_cast<std::size_t>(nx_) * static_cast<std::size_t>(ny_));
   for (int i = 0; i < static_cast<int>(discs_.size()); ++i) {
     const Disc& d = discs_[static_cast<std::size_t>(i)];
-    const int cx0 = std::max(0, static_cast<int>(std::floor((d.centre.x() - d.radius - x0_) / cell_)));
-    const int cx1 = std::min(nx_ - 1, static_cast<int>(std::floor((d.centre.x() + d.radius - x0_) / cell_)));
-    const int cy0 = std::max(0, static_cast<int>(std::floor((d.centre.y() - d.radius - y0_) / cell_)));
-    const int cy1 = std::min(ny_ - 1, static_cast<int>(std::floor((d.centre.y() + d.radius - y0_) / cell_)));
+    const int cx0 =
+        std::max(0, static_cast<int>(std::floor((d.centre.x() - d.radius - x0_) / cell_)));
+    const int cx1 =
+        std::min(nx_ - 1, static_cast<int>(std::floor((d.centre.x() + d.radius - x0_) / cell_)));
+    const int cy0 =
+        std::max(0, static_cast<int>(std::floor((d.centre.y() - d.radius - y0_) / cell_)));
+    const int cy1 =
+        std::min(ny_ - 1, static_cast<int>(std::floor((d.centre.y() + d.radius - y0_) / cell_)));
     for (int cy = cy0; cy <= cy1; ++cy)
       for (int cx = cx0; cx <= cx1; ++cx)
-        cells_[static_cast<std::size_t>(cy) * static_cast<std::size_t>(nx_) + static_cast<std::size_t>(cx)]
+        cells_[static_cast<std::size_t>(cy) * static_cast<std::size_t>(nx_) +
+               static_cast<std::size_t>(cx)]
             .push_back(i);
   }
 }
@@ -58,8 +63,8 @@ double SpecklePattern::intensity(const Eigen::Vector2d& X) const {
   const int cx = static_cast<int>(std::floor((X.x() - x0_) / cell_));
   const int cy = static_cast<int>(std::floor((X.y() - y0_) / cell_));
   if (cx < 0 || cy < 0 || cx >= nx_ || cy >= ny_) return background_;
-  const auto& cell =
-      cells_[static_cast<std::size_t>(cy) * static_cast<std::size_t>(nx_) + static_cast<std::size_t>(cx)];
+  const auto& cell = cells_[static_cast<std::size_t>(cy) * static_cast<std::size_t>(nx_) +
+                            static_cast<std::size_t>(cx)];
   int top = -1;
   for (const int i : cell) {
     const Disc& d = discs_[static_cast<std::size_t>(i)];
@@ -73,7 +78,8 @@ cv::Mat render_speckle(const SpecklePattern& pattern, int rows, int cols, const 
   if (rows <= 0 || cols <= 0 || params.supersample < 1)
     throw std::invalid_argument("render_speckle: bad size or supersampling");
   // Render with a margin so the blur is exact up to the image border, then crop.
-  const int margin = params.blur_sigma > 0.0 ? static_cast<int>(std::ceil(4.0 * params.blur_sigma)) : 0;
+  const int margin =
+      params.blur_sigma > 0.0 ? static_cast<int>(std::ceil(4.0 * params.blur_sigma)) : 0;
   cv::Mat full(rows + 2 * margin, cols + 2 * margin, CV_64F);
   const int s = params.supersample;
   const double inv = 1.0 / (s * s);
@@ -83,7 +89,8 @@ cv::Mat render_speckle(const SpecklePattern& pattern, int rows, int cols, const 
       double acc = 0.0;
       for (int j = 0; j < s; ++j)
         for (int i = 0; i < s; ++i) {
-          const Eigen::Vector2d x(c - margin - 0.5 + (i + 0.5) / s, r - margin - 0.5 + (j + 0.5) / s);
+          const Eigen::Vector2d x(c - margin - 0.5 + (i + 0.5) / s,
+                                  r - margin - 0.5 + (j + 0.5) / s);
           acc += pattern.intensity(inverse(x));
         }
       full.at<double>(r, c) = acc * inv;

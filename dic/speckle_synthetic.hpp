@@ -48,9 +48,9 @@ class SpecklePattern {
 using InverseMap = std::function<Eigen::Vector2d(const Eigen::Vector2d&)>;
 
 struct RenderParams {
-  int supersample = 5;        // s x s samples per pixel (box-filter antialiasing)
-  double blur_sigma = 0.6;    // Gaussian optical blur in the image plane (px); 0 = none
-  double noise_sigma = 0.0;   // additive Gaussian noise, grey levels
+  int supersample = 5;       // s x s samples per pixel (box-filter antialiasing)
+  double blur_sigma = 0.6;   // Gaussian optical blur in the image plane (px); 0 = none
+  double noise_sigma = 0.0;  // additive Gaussian noise, grey levels
   std::uint64_t noise_seed = 7;
   bool quantize_8bit = false;  // round and clip to 0..255
 };

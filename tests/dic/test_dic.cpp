@@ -72,9 +72,9 @@ TEST(Icgn, RecoversSubPixelTranslations) {
   const cv::Mat ref = render(pat, n, identity());
   for (const double t : {0.1, 0.5, 0.8}) {
     const double tx = t, ty = -0.6 * t;
-    const cv::Mat def = render(pat, n, [&](const Eigen::Vector2d& x) {
-      return Eigen::Vector2d(x.x() - tx, x.y() - ty);
-    }, 2.55, 11);
+    const cv::Mat def = render(
+        pat, n, [&](const Eigen::Vector2d& x) { return Eigen::Vector2d(x.x() - tx, x.y() - ty); },
+        2.55, 11);
     const BSplineImage spline(def);
     const IcgnSolver solver(ref, spline, 15);
     double su = 0.0, sv = 0.0;
@@ -103,9 +103,13 @@ TEST(Dic, UniformStrainAndLargeShiftFromSeeds) {
   const double c0 = 64.0, exx = 0.005, eyy = -0.003, tx = 7.4, ty = -3.2;
   const SpecklePattern pat(-20, -20, n + 20, n + 20, SpeckleParams{});
   const cv::Mat ref = render(pat, n, identity());
-  const cv::Mat def = render(pat, n, [&](const Eigen::Vector2d& x) {
-    return Eigen::Vector2d(c0 + (x.x() - c0 - tx) / (1.0 + exx), c0 + (x.y() - c0 - ty) / (1.0 + eyy));
-  }, 2.55, 12);
+  const cv::Mat def = render(
+      pat, n,
+      [&](const Eigen::Vector2d& x) {
+        return Eigen::Vector2d(c0 + (x.x() - c0 - tx) / (1.0 + exx),
+                               c0 + (x.y() - c0 - ty) / (1.0 + eyy));
+      },
+      2.55, 12);
   DicOptions opt;
   opt.radius = 12;
   opt.search = 12;
@@ -137,7 +141,8 @@ TEST(Dic, UniformStrainAndLargeShiftFromSeeds) {
     for (int i = m; i < grid.nx - m; ++i) {
       bool full = true;
       for (int jj = j - m; jj <= j + m; ++jj)
-        for (int ii = i - m; ii <= i + m; ++ii) full = full && f.valid[static_cast<std::size_t>(jj * grid.nx + ii)];
+        for (int ii = i - m; ii <= i + m; ++ii)
+          full = full && f.valid[static_cast<std::size_t>(jj * grid.nx + ii)];
       if (!full) continue;
       const auto c = static_cast<std::size_t>(j * grid.nx + i);
       ASSERT_TRUE(s.valid[c]);
@@ -157,9 +162,12 @@ TEST(Dic, ThreadCountDoesNotChangeResults) {
   const int n = 80;
   const SpecklePattern pat(-10, -10, n + 10, n + 10, SpeckleParams{});
   const cv::Mat ref = render(pat, n, identity());
-  const cv::Mat def = render(pat, n, [](const Eigen::Vector2d& x) {
-    return Eigen::Vector2d(x.x() - 0.3 - 0.01 * (x.y() - 40), x.y() + 0.2);
-  }, 2.55, 5);
+  const cv::Mat def = render(
+      pat, n,
+      [](const Eigen::Vector2d& x) {
+        return Eigen::Vector2d(x.x() - 0.3 - 0.01 * (x.y() - 40), x.y() + 0.2);
+      },
+      2.55, 5);
   DicOptions opt;
   opt.radius = 10;
   const PoiGrid grid = make_grid(n, n, opt.radius, 3);
@@ -179,7 +187,8 @@ TEST(Dic, DecorrelatedRegionIsMarkedInvalidNotGuessed) {
   const int n = 96;
   const SpecklePattern pat(-10, -10, n + 10, n + 10, SpeckleParams{});
   const cv::Mat ref = render(pat, n, identity());
-  cv::Mat def = render(pat, n, [](const Eigen::Vector2d& x) { return Eigen::Vector2d(x.x() - 0.4, x.y()); });
+  cv::Mat def =
+      render(pat, n, [](const Eigen::Vector2d& x) { return Eigen::Vector2d(x.x() - 0.4, x.y()); });
   // Replace the right third by a different speckle pattern.
   SpeckleParams other;
   other.seed = 99;
@@ -238,7 +247,8 @@ TEST(DicSequence, IncrementalAccumulatesLikeCumulative) {
       return Eigen::Vector2d(c0 + (x.x() - c0 - 0.7 * s) / (1.0 + 0.004 * s), x.y() - 0.45 * s);
     };
   };
-  const std::vector<cv::Mat> images{render(pat, n, identity()), render(pat, n, motion(1.0), 2.55, 21),
+  const std::vector<cv::Mat> images{render(pat, n, identity()),
+                                    render(pat, n, motion(1.0), 2.55, 21),
                                     render(pat, n, motion(2.0), 2.55, 22)};
   SequenceOptions opt;
   opt.dic.radius = 10;

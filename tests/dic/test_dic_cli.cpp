@@ -1,6 +1,7 @@
 // `granoscope dic` end to end on small synthetic 8-bit images, and its bad-input errors.
 #include <gtest/gtest.h>
 
+#include <unistd.h>
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
@@ -37,7 +38,7 @@ class DicCli : public ::testing::Test {
  protected:
   void SetUp() override {
     dir = fs::temp_directory_path() /
-          ("gs_dic_cli_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) + "_" +
+          ("gs_dic_cli_" + std::to_string(::getpid()) + "_" +
            ::testing::UnitTest::GetInstance()->current_test_info()->name());
     fs::remove_all(dir);
     fs::create_directories(dir);
@@ -45,11 +46,12 @@ class DicCli : public ::testing::Test {
     RenderParams rp;
     rp.noise_sigma = 1.0;
     rp.quantize_8bit = true;
-    cv::Mat ref = render_speckle(pat, 72, 80, [](const Eigen::Vector2d& x) { return x; }, rp);
+    cv::Mat ref = render_speckle(
+        pat, 72, 80, [](const Eigen::Vector2d& x) { return x; }, rp);
     rp.noise_seed = 8;
-    cv::Mat def = render_speckle(pat, 72, 80, [](const Eigen::Vector2d& x) {
-      return Eigen::Vector2d(x.x() - 1.3, x.y() - 0.4);
-    }, rp);
+    cv::Mat def = render_speckle(
+        pat, 72, 80,
+        [](const Eigen::Vector2d& x) { return Eigen::Vector2d(x.x() - 1.3, x.y() - 0.4); }, rp);
     ref.convertTo(ref, CV_8U);
     def.convertTo(def, CV_8U);
     cv::imwrite((dir / "ref.png").string(), ref);
@@ -70,9 +72,10 @@ void expect_one_line_error(const CliRun& r, const std::string& fragment) {
 }  // namespace
 
 TEST_F(DicCli, WritesHdf5CsvAndVtk) {
-  const CliRun r = granoscope("dic " + p("ref.png") + " " + p("def.png") + " " + p("def.png") +
-                               " -o " + p("out.h5") + " --subset 21 --step 4 --strain-window 5 --incremental",
-                           dir);
+  const CliRun r =
+      granoscope("dic " + p("ref.png") + " " + p("def.png") + " " + p("def.png") + " -o " +
+                     p("out.h5") + " --subset 21 --step 4 --strain-window 5 --incremental",
+                 dir);
   ASSERT_EQ(r.rc, 0) << r.err;
   EXPECT_TRUE(fs::exists(dir / "out.h5"));
   EXPECT_TRUE(fs::exists(dir / "out_0001.vti"));
@@ -110,20 +113,24 @@ TEST_F(DicCli, WritesHdf5CsvAndVtk) {
 }
 
 TEST_F(DicCli, BadInputsGiveOneLineErrors) {
-  expect_one_line_error(granoscope("dic " + p("ref.png") + " " + p("missing.png") + " -o " + p("o.h5"), dir),
-                        "missing.png: no such image file");
+  expect_one_line_error(
+      granoscope("dic " + p("ref.png") + " " + p("missing.png") + " -o " + p("o.h5"), dir),
+      "missing.png: no such image file");
   cv::imwrite(p("small.png"), cv::Mat(40, 40, CV_8U, cv::Scalar(3)));
-  expect_one_line_error(granoscope("dic " + p("ref.png") + " " + p("small.png") + " -o " + p("o.h5"), dir),
-                        "image size differs from the reference");
+  expect_one_line_error(
+      granoscope("dic " + p("ref.png") + " " + p("small.png") + " -o " + p("o.h5"), dir),
+      "image size differs from the reference");
   cv::imwrite(p("flat.png"), cv::Mat(72, 80, CV_8U, cv::Scalar(128)));
-  expect_one_line_error(granoscope("dic " + p("ref.png") + " " + p("flat.png") + " -o " + p("o.h5"), dir),
-                        "no texture");
+  expect_one_line_error(
+      granoscope("dic " + p("ref.png") + " " + p("flat.png") + " -o " + p("o.h5"), dir),
+      "no texture");
   cv::imwrite(p("roi.png"), cv::Mat(72, 80, CV_8U, cv::Scalar(0)));
-  expect_one_line_error(granoscope("dic " + p("ref.png") + " " + p("def.png") + " --roi " + p("roi.png") +
-                                       " -o " + p("o.h5"),
+  expect_one_line_error(granoscope("dic " + p("ref.png") + " " + p("def.png") + " --roi " +
+                                       p("roi.png") + " -o " + p("o.h5"),
                                    dir),
                         "ROI contains no point of interest");
-  expect_one_line_error(granoscope("dic " + p("ref.png") + " " + p("def.png") + " --subset 30 -o " + p("o.h5"), dir),
-                        "--subset: must be an odd number");
+  expect_one_line_error(
+      granoscope("dic " + p("ref.png") + " " + p("def.png") + " --subset 30 -o " + p("o.h5"), dir),
+      "--subset: must be an odd number");
   EXPECT_FALSE(fs::exists(dir / "o.h5"));
 }

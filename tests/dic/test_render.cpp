@@ -2,6 +2,7 @@
 // `granoscope render` end to end.
 #include <gtest/gtest.h>
 
+#include <unistd.h>
 #include <Eigen/Geometry>
 #include <cmath>
 #include <cstdlib>
@@ -21,7 +22,8 @@ namespace {
 gs::Frame packing(int target, std::uint64_t seed) {
   gs::Frame f;
   std::mt19937_64 rng(seed);
-  std::uniform_real_distribution<double> x(0.0, 0.03), y(0.0, 0.006), z(0.0, 0.03), r(0.0008, 0.0012);
+  std::uniform_real_distribution<double> x(0.0, 0.03), y(0.0, 0.006), z(0.0, 0.03),
+      r(0.0008, 0.0012);
   for (int tries = 0; tries < 200000 && static_cast<int>(f.particles.size()) < target; ++tries) {
     gs::Particle p;
     p.position = {x(rng), y(rng), z(rng)};
@@ -90,7 +92,8 @@ TEST(Render, RotationAboutViewAxisMovesSurfacePointsRigidly) {
   const Camera cam = make_camera(f0, View::Front, 40.0, 0.2, "test");
   gs::Frame f1 = f0;
   const double angle = 0.3;  // about +y (the view direction of the front view)
-  f1.particles[0].orientation = Eigen::Quaterniond(Eigen::AngleAxisd(angle, Eigen::Vector3d::UnitY()));
+  f1.particles[0].orientation =
+      Eigen::Quaterniond(Eigen::AngleAxisd(angle, Eigen::Vector3d::UnitY()));
   const GroundTruth gt = ground_truth(f0, f1, cam);
   const Eigen::Vector2d centre = cam.to_pixel(p.position);
   int checked = 0;
@@ -110,7 +113,8 @@ TEST(Render, RotationAboutViewAxisMovesSurfacePointsRigidly) {
 }
 
 TEST(Render, CliWritesFramesAndGroundTruth) {
-  const fs::path dir = fs::temp_directory_path() / "gs_render_cli_test";
+  const fs::path dir =
+      fs::temp_directory_path() / ("gs_render_cli_test_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir);
   gs::Trajectory t;
@@ -135,8 +139,8 @@ TEST(Render, CliWritesFramesAndGroundTruth) {
   const std::string bad = bin + " render " + (dir / "none.h5").string() + " -o " +
                           (dir / "frames").string() + " 2> /dev/null";
   EXPECT_EQ(WEXITSTATUS(std::system(bad.c_str())), 2);
-  const std::string badview = bin + " render " + (dir / "run.h5").string() + " --view diagonal -o " +
-                              (dir / "frames").string() + " 2> /dev/null";
+  const std::string badview = bin + " render " + (dir / "run.h5").string() +
+                              " --view diagonal -o " + (dir / "frames").string() + " 2> /dev/null";
   EXPECT_EQ(WEXITSTATUS(std::system(badview.c_str())), 2);
   fs::remove_all(dir);
 }
