@@ -27,6 +27,7 @@ int main(int argc, char** argv) {
   gs::cli::register_convert(app);
   gs::cli::register_figures(app);
   gs::cli::register_simulate(app);
+  gs::cli::register_dic(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -13,6 +13,7 @@ import sys
 # format attribute -> figure modules (first is the default for that format)
 FIGURES = {
     "granoscope-trajectory": ["fig_positions", "fig_history"],
+    "granoscope-dic": ["fig_dic"],
 }
 
 

@@ -1,0 +1,234 @@
+// `granoscope dic REF IMG... -o dic.h5`: subset DIC of an image sequence (dic/).
+#include <omp.h>
+
+#include <CLI/CLI.hpp>
+#include <iostream>
+#include <opencv2/imgcodecs.hpp>
+#include <string>
+#include <vector>
+
+#include "atomic_file.hpp"
+#include "commands.hpp"
+#include "dic_io.hpp"
+#include "dic_sequence.hpp"
+#include "errors.hpp"
+#include "hdf5_trajectory.hpp"
+#include "image_io.hpp"
+#include "render_frames.hpp"
+
+namespace gs::cli {
+namespace {
+
+struct DicArgs {
+  std::vector<std::string> images;
+  std::string output;
+  std::string roi;
+  int subset = 31;
+  int step = 2;
+  int strain_window = 15;
+  std::string strain = "green";
+  double zncc_min = 0.9;
+  int search = 30;
+  int threads = 0;
+  bool incremental = false;
+  bool no_csv = false;
+  bool no_vtk = false;
+};
+
+std::string size_str(const cv::Mat& m) {
+  return std::to_string(m.cols) + "x" + std::to_string(m.rows);
+}
+
+void run_dic(const DicArgs& a) {
+  if (a.images.size() < 2) throw InputError("IMAGES", "need a reference and at least one image");
+  if (a.subset < 5 || a.subset % 2 == 0)
+    throw InputError("--subset", "must be an odd number of px >= 5", std::to_string(a.subset));
+  if (a.step < 1) throw InputError("--step", "must be >= 1 px", std::to_string(a.step));
+  if (a.strain_window < 3 || a.strain_window % 2 == 0)
+    throw InputError("--strain-window", "must be an odd number of POIs >= 3",
+                     std::to_string(a.strain_window));
+  if (a.strain != "green" && a.strain != "small")
+    throw InputError("--strain", "must be green or small", a.strain);
+  if (!(a.zncc_min > -1.0 && a.zncc_min < 1.0))
+    throw InputError("--zncc-min", "must be in (-1, 1)", value_str(a.zncc_min));
+  if (a.search < 0) throw InputError("--search", "must be >= 0 px", std::to_string(a.search));
+
+  std::vector<cv::Mat> images;
+  for (const auto& p : a.images) images.push_back(dic::read_grey_image(p));
+  for (std::size_t k = 1; k < images.size(); ++k)
+    if (images[k].size() != images[0].size())
+      throw InputError(a.images[k], "image size differs from the reference",
+                       size_str(images[k]) + " vs " + size_str(images[0]));
+  for (std::size_t k = 0; k < images.size(); ++k)
+    if (dic::is_textureless(images[k]))
+      throw InputError(a.images[k], "image has no texture (uniform grey level)");
+  cv::Mat roi;
+  if (!a.roi.empty()) {
+    roi = dic::read_grey_image(a.roi);
+    if (roi.size() != images[0].size())
+      throw InputError(a.roi, "ROI mask size differs from the images",
+                       size_str(roi) + " vs " + size_str(images[0]));
+  }
+  const int radius = a.subset / 2;
+  if (images[0].cols < a.subset || images[0].rows < a.subset)
+    throw InputError(a.images[0], "image smaller than one subset", size_str(images[0]));
+
+  dic::SequenceOptions opt;
+  opt.dic.radius = radius;
+  opt.dic.search = a.search;
+  opt.dic.zncc_min = a.zncc_min;
+  opt.dic.threads = a.threads > 0 ? a.threads : omp_get_max_threads();
+  opt.step = a.step;
+  opt.strain_window_radius = a.strain_window / 2;
+  opt.incremental = a.incremental;
+
+  if (!roi.empty()) {
+    try {
+      (void)dic::make_grid(images[0].rows, images[0].cols, radius, a.step, roi);
+    } catch (const std::invalid_argument& e) {
+      throw InputError(a.roi, e.what());
+    }
+  }
+  dic::SequenceResult result;
+  try {
+    result = dic::correlate_sequence(images, roi, opt);
+  } catch (const std::runtime_error& e) {
+    throw InputError(a.images[0], "correlation failed", e.what());
+  }
+
+  dic::DicRunInfo info;
+  info.images = a.images;
+  info.subset_px = a.subset;
+  info.step_px = a.step;
+  info.strain_window_points = a.strain_window;
+  info.vsg_px = result.frames.front().strain.vsg_px;
+  info.incremental = a.incremental;
+  info.small_strain = a.strain == "small";
+  info.image_rows = images[0].rows;
+  info.image_cols = images[0].cols;
+  const std::filesystem::path out(a.output);
+  dic::write_dic_hdf5(out, result, info);
+  for (std::size_t k = 0; k < result.frames.size(); ++k) {
+    char suffix[32];
+    std::snprintf(suffix, sizeof suffix, "_%04zu", k + 1);
+    const auto base = out.parent_path() / (out.stem().string() + suffix);
+    if (!a.no_csv) dic::write_dic_csv(base.string() + ".csv", result, k, info);
+    if (!a.no_vtk) dic::write_dic_vti(base.string() + ".vti", result, k, info);
+    std::size_t nvalid = 0;
+    for (const auto v : result.frames[k].valid) nvalid += v;
+    std::cout << a.images[k + 1] << ": " << nvalid << "/" << result.frames[k].valid.size()
+              << " valid POIs\n";
+  }
+  std::cout << "wrote " << out.string() << " (subset " << a.subset << " px, step " << a.step
+            << " px, VSG " << info.vsg_px << " px)\n";
+}
+
+struct RenderArgs {
+  std::string input;
+  std::string out_dir;
+  std::string view = "front";
+  double px_per_d50 = 25.0;
+  double margin_d50 = 0.5;
+  int supersample = 3;
+  double noise = 0.0;
+  int bits = 8;
+  std::string format = "png";
+  std::uint64_t seed = 1;
+};
+
+void run_render(const RenderArgs& a) {
+  const dic::View view = dic::parse_view(a.view);
+  if (a.bits != 8 && a.bits != 16)
+    throw InputError("--bits", "must be 8 or 16", std::to_string(a.bits));
+  if (a.format != "png" && a.format != "tif")
+    throw InputError("--format", "must be png or tif", a.format);
+  if (a.supersample < 1 || a.supersample > 16)
+    throw InputError("--supersample", "must be in 1..16", std::to_string(a.supersample));
+  if (!(a.noise >= 0.0 && a.noise < 1.0))
+    throw InputError("--noise", "must be in [0, 1) (fraction of full scale)", value_str(a.noise));
+  if (!std::filesystem::is_regular_file(a.input)) throw InputError(a.input, "no such file");
+  const TrajectoryReader reader(a.input);
+  if (reader.frame_count() == 0) throw InputError(a.input, "trajectory has no frames");
+  const Frame ref = reader.frame(0);
+  const dic::Camera cam = dic::make_camera(ref, view, a.px_per_d50, a.margin_d50, a.input);
+  std::error_code ec;
+  std::filesystem::create_directories(a.out_dir, ec);
+  if (!std::filesystem::is_directory(a.out_dir))
+    throw InputError(a.out_dir, "cannot create output directory");
+  dic::RenderOptions ro;
+  ro.supersample = a.supersample;
+  ro.noise_sigma = a.noise * 255.0;
+  ro.seed = a.seed;
+  std::vector<dic::GroundTruth> truth;
+  const double full = a.bits == 8 ? 255.0 : 65535.0;
+  for (std::size_t k = 0; k < reader.frame_count(); ++k) {
+    const Frame f = k == 0 ? ref : reader.frame(k);
+    const cv::Mat img = dic::render_frame(f, cam, ro);
+    cv::Mat q;
+    img.convertTo(q, a.bits == 8 ? CV_8U : CV_16U, full / 255.0);  // rounds and saturates
+    char name[64];
+    std::snprintf(name, sizeof name, "frame_%04zu.%s", k, a.format.c_str());
+    const std::filesystem::path target = std::filesystem::path(a.out_dir) / name;
+    AtomicOutput out(target);
+    const std::string tmp =
+        out.temp_path().string() + "." + a.format;  // imwrite needs the extension
+    if (!cv::imwrite(tmp, q)) throw InputError(target.string(), "cannot write image");
+    std::filesystem::rename(tmp, out.temp_path());
+    out.commit();
+    truth.push_back(dic::ground_truth(ref, f, cam));
+  }
+  dic::write_ground_truth_hdf5(std::filesystem::path(a.out_dir) / "ground_truth.h5", cam, a.view,
+                               truth);
+  std::cout << "rendered " << reader.frame_count() << " frames " << cam.cols << "x" << cam.rows
+            << " px (" << a.px_per_d50 << " px per d50) to " << a.out_dir << "\n";
+}
+
+}  // namespace
+
+void register_dic(CLI::App& app) {
+  auto rargs = std::make_shared<RenderArgs>();
+  auto* r =
+      app.add_subcommand("render", "Speckle images of DEM frames for DIC, with exact ground truth");
+  r->add_option("input", rargs->input, "trajectory RUN.h5")->required();
+  r->add_option("-o,--output", rargs->out_dir, "output directory (frame_NNNN.png, ground_truth.h5)")
+      ->required();
+  r->add_option("--view", rargs->view, "front, back, left, right, top or bottom")
+      ->capture_default_str();
+  r->add_option("--px-per-d50", rargs->px_per_d50, "pixels per median grain diameter")
+      ->capture_default_str();
+  r->add_option("--margin", rargs->margin_d50, "margin around the grains, in d50")
+      ->capture_default_str();
+  r->add_option("--supersample", rargs->supersample, "s x s rays per pixel")->capture_default_str();
+  r->add_option("--noise", rargs->noise, "Gaussian noise sigma, fraction of full scale")
+      ->capture_default_str();
+  r->add_option("--bits", rargs->bits, "8 or 16")->capture_default_str();
+  r->add_option("--format", rargs->format, "png or tif")->capture_default_str();
+  r->add_option("--seed", rargs->seed, "grain textures and noise")->capture_default_str();
+  r->callback([rargs] { run_render(*rargs); });
+
+  auto args = std::make_shared<DicArgs>();
+  auto* c = app.add_subcommand("dic", "Subset digital image correlation of an image sequence");
+  c->add_option("images", args->images, "reference image, then the deformed images")
+      ->required()
+      ->expected(2, -1);
+  c->add_option("-o,--output", args->output, "output HDF5 file (CSV and .vti written beside)")
+      ->required();
+  c->add_option("--subset", args->subset, "subset size, px (odd)")->capture_default_str();
+  c->add_option("--step", args->step, "POI spacing, px")->capture_default_str();
+  c->add_option("--roi", args->roi, "region-of-interest mask image (non-zero = inside)");
+  c->add_flag("--incremental", args->incremental,
+              "correlate each image with the previous one and accumulate (default: cumulative)");
+  c->add_option("--strain-window", args->strain_window, "strain plane-fit window, POIs (odd)")
+      ->capture_default_str();
+  c->add_option("--strain", args->strain, "strain in CSV/VTK: green or small")
+      ->capture_default_str();
+  c->add_option("--zncc-min", args->zncc_min, "POIs below this ZNCC are invalid")
+      ->capture_default_str();
+  c->add_option("--search", args->search, "seed search half-width, px")->capture_default_str();
+  c->add_option("--threads", args->threads, "threads (0 = OpenMP default)")->capture_default_str();
+  c->add_flag("--no-csv", args->no_csv, "do not write CSV tables");
+  c->add_flag("--no-vtk", args->no_vtk, "do not write VTK images");
+  c->callback([args] { run_dic(*args); });
+}
+
+}  // namespace gs::cli

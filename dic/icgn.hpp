@@ -1,0 +1,51 @@
+// Inverse-compositional Gauss–Newton (IC-GN) subset matching with a first-order shape function
+// and the ZNSSD criterion (Pan, Li & Tong 2013). The reference subset's Hessian is precomputed;
+// each iteration interpolates the deformed subset with the bicubic B-spline.
+#pragma once
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+
+#include "bspline_interpolation.hpp"
+
+namespace gs::dic {
+
+/// First-order shape function p = (u, du/dx, du/dy, v, dv/dx, dv/dy): a reference point
+/// x0 + d maps to x0 + d + (u + ux*dx + uy*dy, v + vx*dx + vy*dy) in the deformed image.
+using Shape = Eigen::Matrix<double, 6, 1>;
+
+struct IcgnOptions {
+  int max_iterations = 20;
+  /// Stop when sqrt(du^2 + dv^2 + R^2 (dux^2 + duy^2 + dvx^2 + dvy^2)) < tolerance (px),
+  /// R = subset half-width: the largest displacement change over the subset.
+  double tolerance = 1e-3;
+};
+
+struct IcgnResult {
+  Shape p = Shape::Zero();
+  double zncc = -1.0;  // zero-normalised cross-correlation (= 1 - ZNSSD/2) at the solution
+  int iterations = 0;
+  bool converged = false;
+  bool ok = false;  // false: subset textureless or left the deformed image
+};
+
+/// IC-GN over square subsets of half-width `radius` (subset = 2*radius+1 px).
+class IcgnSolver {
+ public:
+  /// `reference` is sampled at whole pixels; `deformed` through its B-spline interpolant.
+  IcgnSolver(const cv::Mat& reference, const BSplineImage& deformed, int radius,
+             IcgnOptions options = {});
+  int radius() const { return radius_; }
+  /// Refines `guess` for the subset centred at integer pixel (x0, y0) of the reference.
+  IcgnResult solve(int x0, int y0, const Shape& guess) const;
+
+ private:
+  cv::Mat ref_;  // CV_64F
+  cv::Mat gx_;   // B-spline gradient of the reference at the pixels
+  cv::Mat gy_;
+  const BSplineImage& def_;
+  int radius_;
+  IcgnOptions options_;
+};
+
+}  // namespace gs::dic

@@ -1,0 +1,277 @@
+// DIC against exact answers on synthetic Boolean-model speckle (small images; the full accuracy
+// tables are in bench/bench_dic.cpp).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <opencv2/imgcodecs.hpp>
+#include <random>
+
+#include "bspline_interpolation.hpp"
+#include "dic_sequence.hpp"
+#include "dic_strain.hpp"
+#include "errors.hpp"
+#include "icgn.hpp"
+#include "image_io.hpp"
+#include "reliability_guided.hpp"
+#include "speckle_synthetic.hpp"
+
+using namespace gs::dic;
+
+namespace {
+
+cv::Mat render(const SpecklePattern& pat, int n, const InverseMap& inv, double noise = 2.55,
+               std::uint64_t seed = 7) {
+  RenderParams rp;
+  rp.noise_sigma = noise;
+  rp.noise_seed = seed;
+  return render_speckle(pat, n, n, inv, rp);
+}
+
+InverseMap identity() {
+  return [](const Eigen::Vector2d& x) { return x; };
+}
+
+}  // namespace
+
+TEST(BSpline, InterpolatesExactlyAtNodes) {
+  cv::Mat img(17, 23, CV_64F);
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> d(0.0, 255.0);
+  for (int r = 0; r < img.rows; ++r)
+    for (int c = 0; c < img.cols; ++c) img.at<double>(r, c) = d(rng);
+  const BSplineImage s(img);
+  for (int r = 0; r < img.rows; ++r)
+    for (int c = 0; c < img.cols; ++c) ASSERT_NEAR(s.value(c, r), img.at<double>(r, c), 1e-9);
+}
+
+TEST(BSpline, ReproducesCubicPolynomialsAwayFromBorder) {
+  auto p = [](double x, double y) {
+    return 3.0 + 0.7 * x - 0.05 * x * x + 0.002 * x * x * x + 0.4 * y - 0.01 * y * y * x +
+           0.001 * y * y * y;
+  };
+  auto px = [](double x, double y) { return 0.7 - 0.1 * x + 0.006 * x * x - 0.01 * y * y; };
+  auto py = [](double x, double y) { return 0.4 - 0.02 * y * x + 0.003 * y * y; };
+  const int n = 64;
+  cv::Mat img(n, n, CV_64F);
+  for (int r = 0; r < n; ++r)
+    for (int c = 0; c < n; ++c) img.at<double>(r, c) = p(c, r);
+  const BSplineImage s(img);
+  for (double y = 24.0; y <= 40.0; y += 0.37)
+    for (double x = 24.0; x <= 40.0; x += 0.41) {
+      const Sample v = s.sample(x, y);
+      ASSERT_NEAR(v.value, p(x, y), 1e-6) << x << "," << y;
+      ASSERT_NEAR(v.dx, px(x, y), 1e-6);
+      ASSERT_NEAR(v.dy, py(x, y), 1e-6);
+    }
+}
+
+TEST(Icgn, RecoversSubPixelTranslations) {
+  const int n = 96;
+  const SpecklePattern pat(-10, -10, n + 10, n + 10, SpeckleParams{});
+  const cv::Mat ref = render(pat, n, identity());
+  for (const double t : {0.1, 0.5, 0.8}) {
+    const double tx = t, ty = -0.6 * t;
+    const cv::Mat def = render(
+        pat, n, [&](const Eigen::Vector2d& x) { return Eigen::Vector2d(x.x() - tx, x.y() - ty); },
+        2.55, 11);
+    const BSplineImage spline(def);
+    const IcgnSolver solver(ref, spline, 15);
+    double su = 0.0, sv = 0.0;
+    int count = 0;
+    for (int y = 30; y <= 66; y += 12)
+      for (int x = 30; x <= 66; x += 12) {
+        const IcgnResult r = solver.solve(x, y, Shape::Zero());
+        ASSERT_TRUE(r.ok);
+        EXPECT_TRUE(r.converged);
+        EXPECT_GT(r.zncc, 0.99);
+        EXPECT_NEAR(r.p[0], tx, 0.03);
+        EXPECT_NEAR(r.p[3], ty, 0.03);
+        su += r.p[0] - tx;
+        sv += r.p[3] - ty;
+        ++count;
+      }
+    EXPECT_LT(std::abs(su / count), 0.01) << "mean bias in u at shift " << t;
+    EXPECT_LT(std::abs(sv / count), 0.01) << "mean bias in v at shift " << t;
+  }
+}
+
+TEST(Dic, UniformStrainAndLargeShiftFromSeeds) {
+  // x = X + t + E X about the centre: exx = 0.5%, eyy = -0.3%, plus a 7.4 px shift that only
+  // the ZNCC seed search can find.
+  const int n = 128;
+  const double c0 = 64.0, exx = 0.005, eyy = -0.003, tx = 7.4, ty = -3.2;
+  const SpecklePattern pat(-20, -20, n + 20, n + 20, SpeckleParams{});
+  const cv::Mat ref = render(pat, n, identity());
+  const cv::Mat def = render(
+      pat, n,
+      [&](const Eigen::Vector2d& x) {
+        return Eigen::Vector2d(c0 + (x.x() - c0 - tx) / (1.0 + exx),
+                               c0 + (x.y() - c0 - ty) / (1.0 + eyy));
+      },
+      2.55, 12);
+  DicOptions opt;
+  opt.radius = 12;
+  opt.search = 12;
+  const PoiGrid grid = make_grid(n, n, opt.radius, 4);
+  const DicField f = correlate(ref, def, grid, opt);
+  std::vector<double> u(f.p.size()), v(f.p.size());
+  int nvalid = 0;
+  for (std::size_t i = 0; i < f.p.size(); ++i) {
+    u[i] = f.p[i][0];
+    v[i] = f.p[i][3];
+    if (!f.valid[i]) continue;
+    ++nvalid;
+    const int idx = static_cast<int>(i);
+    const double X = grid.x(idx), Y = grid.y(idx);
+    // Skip the subsets that see the outside of the rendered pattern after the shift.
+    if (X + tx + 12 * 1.01 > n - 1) continue;
+    EXPECT_NEAR(u[i], tx + exx * (X - c0), 0.05) << X << "," << Y;
+    EXPECT_NEAR(v[i], ty + eyy * (Y - c0), 0.05) << X << "," << Y;
+  }
+  EXPECT_GT(nvalid, grid.size() * 3 / 4);
+  const int m = 5;
+  const StrainField s = plane_fit_strain(grid, u, v, f.valid, m, 2 * opt.radius + 1);
+  EXPECT_DOUBLE_EQ(s.vsg_px, 2 * m * 4 + 25);
+  // RMS and mean error over the POIs with a full window of valid POIs.
+  const double gl_xx = exx + 0.5 * exx * exx, gl_yy = eyy + 0.5 * eyy * eyy;
+  double sq = 0.0, mean_xx = 0.0;
+  int count = 0;
+  for (int j = m; j < grid.ny - m; ++j)
+    for (int i = m; i < grid.nx - m; ++i) {
+      bool full = true;
+      for (int jj = j - m; jj <= j + m; ++jj)
+        for (int ii = i - m; ii <= i + m; ++ii)
+          full = full && f.valid[static_cast<std::size_t>(jj * grid.nx + ii)];
+      if (!full) continue;
+      const auto c = static_cast<std::size_t>(j * grid.nx + i);
+      ASSERT_TRUE(s.valid[c]);
+      sq += std::pow(s.exx[c] - gl_xx, 2) + std::pow(s.eyy[c] - gl_yy, 2) + std::pow(s.exy[c], 2);
+      mean_xx += s.exx[c] - gl_xx;
+      ++count;
+    }
+  ASSERT_GT(count, 50);
+  EXPECT_LT(std::sqrt(sq / (3.0 * count)), 5e-4);
+  EXPECT_LT(std::abs(mean_xx / count), 2e-4);
+  // Small strain differs from Green–Lagrange by the quadratic terms.
+  const auto c = static_cast<std::size_t>((grid.ny / 2) * grid.nx + grid.nx / 2);
+  EXPECT_NEAR(s.exx[c] - s.sxx[c], 0.5 * (s.ux[c] * s.ux[c] + s.vx[c] * s.vx[c]), 1e-15);
+}
+
+TEST(Dic, ThreadCountDoesNotChangeResults) {
+  const int n = 80;
+  const SpecklePattern pat(-10, -10, n + 10, n + 10, SpeckleParams{});
+  const cv::Mat ref = render(pat, n, identity());
+  const cv::Mat def = render(
+      pat, n,
+      [](const Eigen::Vector2d& x) {
+        return Eigen::Vector2d(x.x() - 0.3 - 0.01 * (x.y() - 40), x.y() + 0.2);
+      },
+      2.55, 5);
+  DicOptions opt;
+  opt.radius = 10;
+  const PoiGrid grid = make_grid(n, n, opt.radius, 3);
+  opt.threads = 1;
+  const DicField a = correlate(ref, def, grid, opt);
+  opt.threads = 2;
+  const DicField b = correlate(ref, def, grid, opt);
+  ASSERT_EQ(a.p.size(), b.p.size());
+  for (std::size_t i = 0; i < a.p.size(); ++i) {
+    ASSERT_EQ(a.valid[i], b.valid[i]);
+    for (int k = 0; k < 6; ++k) ASSERT_EQ(a.p[i][k], b.p[i][k]);
+    ASSERT_EQ(a.zncc[i], b.zncc[i]);
+  }
+}
+
+TEST(Dic, DecorrelatedRegionIsMarkedInvalidNotGuessed) {
+  const int n = 96;
+  const SpecklePattern pat(-10, -10, n + 10, n + 10, SpeckleParams{});
+  const cv::Mat ref = render(pat, n, identity());
+  cv::Mat def =
+      render(pat, n, [](const Eigen::Vector2d& x) { return Eigen::Vector2d(x.x() - 0.4, x.y()); });
+  // Replace the right third by a different speckle pattern.
+  SpeckleParams other;
+  other.seed = 99;
+  const SpecklePattern pat2(-10, -10, n + 10, n + 10, other);
+  const cv::Mat junk = render(pat2, n, identity());
+  junk(cv::Rect(64, 0, 32, n)).copyTo(def(cv::Rect(64, 0, 32, n)));
+  DicOptions opt;
+  opt.radius = 8;
+  const PoiGrid grid = make_grid(n, n, opt.radius, 4);
+  const DicField f = correlate(ref, def, grid, opt);
+  int good_left = 0, left = 0;
+  for (int i = 0; i < grid.size(); ++i) {
+    const auto u = static_cast<std::size_t>(i);
+    if (grid.x(i) - opt.radius >= 64) {
+      EXPECT_FALSE(f.valid[u]) << grid.x(i);
+    }
+    const bool border = grid.y(i) - opt.radius == 0 || grid.y(i) + opt.radius == n - 1 ||
+                        grid.x(i) - opt.radius == 0;
+    if (grid.x(i) + opt.radius < 60 && !border) {
+      ++left;
+      good_left += f.valid[u] && std::abs(f.p[u][0] - 0.4) < 0.05;
+    }
+  }
+  EXPECT_EQ(good_left, left);
+}
+
+TEST(Dic, BadInputsGiveClearErrors) {
+  const int n = 64;
+  const SpecklePattern pat(-10, -10, n + 10, n + 10, SpeckleParams{});
+  const cv::Mat ref = render(pat, n, identity());
+  DicOptions opt;
+  opt.radius = 8;
+  const PoiGrid grid = make_grid(n, n, opt.radius, 4);
+  // Different sizes.
+  const cv::Mat small = ref(cv::Rect(0, 0, 60, 64)).clone();
+  EXPECT_THROW(correlate(ref, small, grid, opt), std::invalid_argument);
+  // Empty ROI.
+  const cv::Mat roi = cv::Mat::zeros(n, n, CV_8U);
+  EXPECT_THROW(make_grid(n, n, 8, 4, roi), std::invalid_argument);
+  // ROI of another size.
+  EXPECT_THROW(make_grid(n, n, 8, 4, cv::Mat::ones(10, 10, CV_8U)), std::invalid_argument);
+  // Uniform images: no texture, no seed.
+  const cv::Mat flat(n, n, CV_64F, cv::Scalar(128.0));
+  EXPECT_THROW(correlate(flat, flat, grid, opt), std::runtime_error);
+  // Missing image file.
+  EXPECT_THROW(read_grey_image("/nonexistent/ref.png"), gs::InputError);
+}
+
+TEST(DicSequence, IncrementalAccumulatesLikeCumulative) {
+  // Two steps of a shear-free stretch + translation; both modes must give the exact motion.
+  const int n = 96;
+  const double c0 = 48.0;
+  const SpecklePattern pat(-20, -20, n + 20, n + 20, SpeckleParams{});
+  auto motion = [&](double s) {
+    return [=](const Eigen::Vector2d& x) {
+      return Eigen::Vector2d(c0 + (x.x() - c0 - 0.7 * s) / (1.0 + 0.004 * s), x.y() - 0.45 * s);
+    };
+  };
+  const std::vector<cv::Mat> images{render(pat, n, identity()),
+                                    render(pat, n, motion(1.0), 2.55, 21),
+                                    render(pat, n, motion(2.0), 2.55, 22)};
+  SequenceOptions opt;
+  opt.dic.radius = 10;
+  opt.step = 4;
+  opt.strain_window_radius = 3;
+  const SequenceResult cum = correlate_sequence(images, {}, opt);
+  opt.incremental = true;
+  const SequenceResult inc = correlate_sequence(images, {}, opt);
+  ASSERT_EQ(cum.frames.size(), 2u);
+  ASSERT_EQ(inc.frames.size(), 2u);
+  int checked = 0;
+  for (int i = 0; i < cum.grid.size(); ++i) {
+    const auto c = static_cast<std::size_t>(i);
+    const double X = cum.grid.x(i);
+    if (X > 80) continue;  // subsets that see past the moved pattern's right edge
+    for (const SequenceResult* r : {&cum, &inc}) {
+      const FrameResult& f = r->frames[1];
+      if (!f.valid[c]) continue;
+      EXPECT_NEAR(f.u[c], 1.4 + 0.008 * (X - c0), 0.05) << X;
+      EXPECT_NEAR(f.v[c], 0.9, 0.05);
+      ++checked;
+    }
+  }
+  EXPECT_GT(checked, cum.grid.size());
+  EXPECT_THROW(correlate_sequence({images[0]}, {}, opt), std::invalid_argument);
+}
