@@ -75,24 +75,47 @@ Simulation::Simulation(SimulationConfig config, const std::vector<Particle>& par
 }
 
 void Simulation::rebuild_neighbors() {
-  auto old_pairs = std::move(nl_.pairs);
-  auto old_hist = std::move(hist_);
+  std::vector<ContactHistory> old = std::move(hist_);
   nl_.build(p_, walls_);
+  attach_histories(old);
+}
+
+void Simulation::attach_histories(const std::vector<ContactHistory>& old) {
+  // `old` is sorted by (a, b), as the pair list is. A contact whose pair left the list cannot be
+  // touching (the skin guarantees it), so dropping it loses nothing.
   const std::size_t np = nl_.pairs.size();
   hist_.assign(np, ContactHistory{});
   params_.resize(np);
   std::size_t o = 0;
   for (std::size_t k = 0; k < np; ++k) {
     const auto pr = nl_.pairs[k];
-    while (o < old_pairs.size() && old_pairs[o] < pr) ++o;
-    if (o < old_pairs.size() && old_pairs[o] == pr) hist_[k] = old_hist[o];
+    while (o < old.size() && std::make_pair(old[o].a, old[o].b) < pr) ++o;
+    if (o < old.size() && old[o].a == pr.first && old[o].b == pr.second) hist_[k] = old[o];
     hist_[k].a = pr.first;
     hist_[k].b = pr.second;
     const double ra = p_.radius[pr.first];
     const double rb = pr.second >= kWallBase ? ra : p_.radius[pr.second];
     params_[k] = contact_params(cfg_.material, ra, rb, cfg_.twist_beta, cfg_.twist_eta);
   }
-  // A contact whose pair left the list cannot be touching (the skin guarantees it).
+}
+
+bool Simulation::pair_geometry(std::size_t k, ContactGeometry& g, BodyMotion& m1,
+                               BodyMotion& m2) const {
+  const auto [a, b] = nl_.pairs[k];
+  if (b >= kWallBase) {
+    const WallState& w = walls_[b - kWallBase];
+    if (w.spec.shape == WallShape::Box)
+      box_sphere_geometry(w.pos, w.spec.half_extents, p_.pos[a], p_.radius[a], g);
+    else
+      plane_sphere_geometry(w.pos, w.normal, p_.pos[a], p_.radius[a], g);
+    m1 = {w.pos, w.vel,
+          w.spec.shape == WallShape::Plane ? w.spec.angular_velocity : Eigen::Vector3d::Zero()};
+    m2 = {p_.pos[a], p_.vel[a], p_.angvel[a]};
+    return true;
+  }
+  m1 = {p_.pos[a], p_.vel[a], p_.angvel[a]};
+  m2 = {p_.pos[b], p_.vel[b], p_.angvel[b]};
+  return sphere_sphere_geometry(p_.pos[a], p_.radius[a], p_.pos[b], p_.radius[b], g);
 }
 
 void Simulation::update_servos() {
@@ -117,26 +140,12 @@ void Simulation::step() {
   const int threads = std::max(1, cfg_.threads);
 #pragma omp parallel for num_threads(threads) schedule(static)
   for (std::size_t k = 0; k < np; ++k) {
-    const auto [a, b] = nl_.pairs[k];
     ContactHistory& h = hist_[k];
     ContactGeometry g;
     BodyMotion m1, m2;
-    if (b >= kWallBase) {
-      const WallState& w = walls_[b - kWallBase];
-      if (w.spec.shape == WallShape::Box)
-        box_sphere_geometry(w.pos, w.spec.half_extents, p_.pos[a], p_.radius[a], g);
-      else
-        plane_sphere_geometry(w.pos, w.normal, p_.pos[a], p_.radius[a], g);
-      m1 = {w.pos, w.vel,
-            w.spec.shape == WallShape::Plane ? w.spec.angular_velocity : Eigen::Vector3d::Zero()};
-      m2 = {p_.pos[a], p_.vel[a], p_.angvel[a]};
-    } else {
-      if (!sphere_sphere_geometry(p_.pos[a], p_.radius[a], p_.pos[b], p_.radius[b], g)) {
-        h.real = false;
-        continue;
-      }
-      m1 = {p_.pos[a], p_.vel[a], p_.angvel[a]};
-      m2 = {p_.pos[b], p_.vel[b], p_.angvel[b]};
+    if (!pair_geometry(k, g, m1, m2)) {  // coincident centres
+      h.real = false;
+      continue;
     }
     if (g.penetration < 0) {  // not touching (YADE erases the interaction)
       h.real = false;
@@ -274,17 +283,9 @@ const EnergyLedger& Simulation::energy() {
       // normal elastic energy ½·Kn·u² belongs to the initial state.
       if (nl_.stale(p_, walls_)) rebuild_neighbors();
       for (std::size_t k = 0; k < nl_.pairs.size(); ++k) {
-        const auto [a, b] = nl_.pairs[k];
         ContactGeometry g;
-        if (b >= kWallBase) {
-          const WallState& w = walls_[b - kWallBase];
-          if (w.spec.shape == WallShape::Box)
-            box_sphere_geometry(w.pos, w.spec.half_extents, p_.pos[a], p_.radius[a], g);
-          else
-            plane_sphere_geometry(w.pos, w.normal, p_.pos[a], p_.radius[a], g);
-        } else if (!sphere_sphere_geometry(p_.pos[a], p_.radius[a], p_.pos[b], p_.radius[b], g)) {
-          continue;
-        }
+        BodyMotion m1, m2;
+        if (!pair_geometry(k, g, m1, m2)) continue;
         if (g.penetration > 0)
           ledger_.initial += 0.5 * params_[k].kn * g.penetration * g.penetration;
       }
@@ -461,23 +462,8 @@ void Simulation::load_checkpoint(const std::filesystem::path& path) {
   std::vector<ContactHistory> real(nc);
   for (auto& h : real) get(in, h, file);
   // Rebuild the neighbour list from the restored state and put the histories back.
-  nl_.pairs.clear();
-  hist_.clear();
   nl_.build(p_, walls_);
-  const std::size_t np = nl_.pairs.size();
-  hist_.assign(np, ContactHistory{});
-  params_.resize(np);
-  std::size_t o = 0;
-  for (std::size_t k = 0; k < np; ++k) {
-    const auto pr = nl_.pairs[k];
-    while (o < real.size() && std::make_pair(real[o].a, real[o].b) < pr) ++o;
-    if (o < real.size() && real[o].a == pr.first && real[o].b == pr.second) hist_[k] = real[o];
-    hist_[k].a = pr.first;
-    hist_[k].b = pr.second;
-    const double ra = p_.radius[pr.first];
-    const double rb = pr.second >= kWallBase ? ra : p_.radius[pr.second];
-    params_[k] = contact_params(cfg_.material, ra, rb, cfg_.twist_beta, cfg_.twist_eta);
-  }
+  attach_histories(real);
 }
 
 }  // namespace gs::solver

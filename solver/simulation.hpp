@@ -89,6 +89,10 @@ class Simulation {
 
  private:
   void rebuild_neighbors();
+  /// Re-attaches contact histories (sorted by pair) to the current pair list.
+  void attach_histories(const std::vector<ContactHistory>& old);
+  /// Geometry and body motions of candidate pair k; false when the centres coincide.
+  bool pair_geometry(std::size_t k, ContactGeometry& g, BodyMotion& m1, BodyMotion& m2) const;
   void update_servos();
 
   SimulationConfig cfg_;
