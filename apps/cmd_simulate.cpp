@@ -87,11 +87,11 @@ std::string history_row(solver::Simulation& sim) {
   const auto& e = sim.energy();
   char buf[512];
   std::snprintf(
-      buf, sizeof buf, "%lld,%.17g,%zu,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g",
+      buf, sizeof buf, "%lld,%.17g,%zu,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g",
       static_cast<long long>(sim.step_count()), sim.time(), sim.contact_count(), e.kinetic,
-      sim.unbalanced_force(), e.elastic_normal + e.elastic_shear + e.elastic_rolling,
-      e.friction_dissipation, e.rolling_dissipation, e.damping_dissipation, e.gravity_work,
-      e.wall_work, e.residual());
+      sim.unbalanced_force(), sim.inertial_number(),
+      e.elastic_normal + e.elastic_shear + e.elastic_rolling, e.friction_dissipation,
+      e.rolling_dissipation, e.damping_dissipation, e.gravity_work, e.wall_work, e.residual());
   std::string row = buf;
   for (const auto& w : sim.walls()) {
     std::snprintf(buf, sizeof buf, ",%.17g,%.17g,%.17g,%.17g,%.17g,%.17g", w.force.x(), w.force.y(),

@@ -8,6 +8,8 @@
 #include <fstream>
 #include <limits>
 
+#include <Eigen/QR>
+
 #include "atomic_file.hpp"
 #include "contact_geometry.hpp"
 #include "errors.hpp"
@@ -243,6 +245,45 @@ double Simulation::kinetic_energy() const {
     e += 0.5 * p_.mass[i] * p_.vel[i].squaredNorm() +
          0.5 * p_.inertia[i] * p_.angvel[i].squaredNorm();
   return e;
+}
+
+double Simulation::inertial_number() const {
+  const std::size_t n = p_.size();
+  if (n < 4) return std::numeric_limits<double>::quiet_NaN();
+  // Affine fit v ≈ v0 + L·(x − x̄): L = (Σ v'x'ᵀ)(Σ x'x'ᵀ)⁻¹.
+  Eigen::Vector3d xm = Eigen::Vector3d::Zero(), vm = Eigen::Vector3d::Zero();
+  double dsum = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    xm += p_.pos[i];
+    vm += p_.vel[i];
+    dsum += 2 * p_.radius[i];
+  }
+  xm /= static_cast<double>(n);
+  vm /= static_cast<double>(n);
+  Eigen::Matrix3d xx = Eigen::Matrix3d::Zero(), vx = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d lo = p_.pos[0], hi = p_.pos[0];
+  for (std::size_t i = 0; i < n; ++i) {
+    const Eigen::Vector3d x = p_.pos[i] - xm, v = p_.vel[i] - vm;
+    xx += x * x.transpose();
+    vx += v * x.transpose();
+    lo = lo.cwiseMin((p_.pos[i].array() - p_.radius[i]).matrix());
+    hi = hi.cwiseMax((p_.pos[i].array() + p_.radius[i]).matrix());
+  }
+  const Eigen::Matrix3d L = vx * xx.completeOrthogonalDecomposition().pseudoInverse();
+  const Eigen::Matrix3d D = 0.5 * (L + L.transpose());
+  const Eigen::Matrix3d Dd = D - D.trace() / 3 * Eigen::Matrix3d::Identity();
+  const double rate = std::sqrt(2 * (Dd.array() * Dd.array()).sum());
+  // Mean stress p = tr(σ)/3 with σ = (1/V)·Σ f ⊗ l over sphere contacts (l: branch 1 → 2, f on 2).
+  double tr = 0;
+  for (const auto& h : hist_) {
+    if (!h.real || h.b >= kWallBase) continue;
+    const Eigen::Vector3d f = h.fn * h.normal + h.shear_force;
+    tr += f.dot(p_.pos[h.b] - p_.pos[h.a]);
+  }
+  const double volume = (hi - lo).prod();
+  const double pressure = tr / 3 / volume;
+  if (!(pressure > 0) || !(volume > 0)) return std::numeric_limits<double>::quiet_NaN();
+  return rate * (dsum / static_cast<double>(n)) / std::sqrt(pressure / cfg_.material.density);
 }
 
 double Simulation::unbalanced_force() const {

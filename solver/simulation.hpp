@@ -75,6 +75,11 @@ class Simulation {
   /// YADE's unbalancedForce: mean |resultant force| on free particles / mean |contact force|.
   double unbalanced_force() const;
   double kinetic_energy() const;
+  /// Global inertial number I = γ̇·d/sqrt(p/ρ): γ̇ = sqrt(2·D':D') from the least-squares
+  /// affine fit of particle velocities to positions (D its symmetric part, ' deviatoric),
+  /// d the mean diameter, p the mean stress of the contact (Love–Weber) stress over the bounding
+  /// box of the particles. NaN without contacts or under tension.
+  double inertial_number() const;
   /// Updates the stored-energy terms of the ledger and returns it.
   const EnergyLedger& energy();
   /// Throws BlowUp when the ledger residual is out of bounds (see SimulationConfig).

@@ -325,3 +325,26 @@ TEST(Physics, EnergyLedgerCatchesAnUnstableRun) {
     good.check_energy();
   }
 }
+
+// Simple-cubic lattice under uniform overlap δ, sheared at γ̇: I = γ̇·d/sqrt(p/ρ) with the
+// Love–Weber mean stress p = (Σ Fn·|l|)/(3V) computed by hand.
+TEST(Physics, InertialNumberOfAShearedLattice) {
+  const double r = 1e-3, delta = 1e-6, rate = 2.0;
+  const int n = 3;
+  std::vector<Particle> ps;
+  for (int i = 0; i < n * n * n; ++i) {
+    const Eigen::Vector3d x = Eigen::Vector3d(i % n, (i / n) % n, i / (n * n)) * (2 * r - delta);
+    ps.push_back(sphere(i, x, r, Eigen::Vector3d(rate * x.y(), 0, 0)));
+  }
+  SimulationConfig c;
+  c.material = material(1e8, 30);
+  c.dt = 1e-9;
+  Simulation sim(c, ps, {});
+  sim.step();
+  ASSERT_EQ(sim.contact_count(), 54u);  // 3·(n−1)·n²
+  const double kn = c.material.young_ec * r;
+  const double volume = std::pow((n - 1) * (2 * r - delta) + 2 * r, 3);  // bounding box
+  const double p = 54 * kn * delta * (2 * r - delta) / 3 / volume;
+  const double expected = rate * 2 * r / std::sqrt(p / c.material.density);
+  EXPECT_NEAR(sim.inertial_number() / expected, 1.0, 1e-6);
+}
