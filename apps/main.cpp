@@ -9,7 +9,8 @@
 namespace gs::cli {
 
 CLI::App& analyze_command(CLI::App& app) {
-  if (auto* existing = app.get_subcommand_no_throw("analyze")) return *existing;
+  for (auto* sub : app.get_subcommands([](CLI::App* s) { return s->get_name() == "analyze"; }))
+    return *sub;
   auto* a = app.add_subcommand("analyze", "Analyses of snapshots and trajectories");
   a->require_subcommand(1);
   return *a;
@@ -22,6 +23,7 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", gs::code_version());
   app.require_subcommand(1);
   // Subcommands, one line each (keep sorted by module):
+  gs::cli::register_analyze_strain(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

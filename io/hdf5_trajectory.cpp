@@ -167,9 +167,9 @@ std::string read_string_attr(hid_t attr, const std::string& file, const std::str
   }
   const size_t n = H5Tget_size(ftype.get());
   if (n == 0 || n > (1u << 24)) throw InputError(file, "attribute has a bad size", name);
-  std::string s(n, '\0');
+  std::string s(n + 1, '\0');  // room for the terminator of the NULLTERM memory type
   Hid mtype(H5Tcopy(H5T_C_S1), H5Tclose);
-  H5Tset_size(mtype.get(), n);
+  H5Tset_size(mtype.get(), n + 1);
   if (H5Aread(attr, mtype.get(), s.data()) < 0)
     throw InputError(file, "cannot read attribute", name);
   s.resize(std::strlen(s.c_str()));
