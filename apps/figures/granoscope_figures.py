@@ -13,6 +13,8 @@ import sys
 # format attribute -> figure modules (first is the default for that format)
 FIGURES = {
     "granoscope-trajectory": ["fig_positions"],
+    "granoscope-strain": ["fig_strain"],
+    "granoscope-voidcells": ["fig_strain"],
 }
 
 

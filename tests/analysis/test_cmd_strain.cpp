@@ -168,6 +168,21 @@ TEST(CmdStrain, VoidCellsPeriodic2DFromVelocities) {
   }
   const auto alpha = read_doubles(dir / "v2.h5", "/cells/alpha");
   for (double a : alpha) EXPECT_NEAR(a, 1.0, 1e-10);
+  // Non-affine motion for the figures: random particle jitter on top of l.
+  std::normal_distribution<double> jitter(0.0, 2e-6);
+  for (auto& p : t.frames[1].particles)
+    p.position.head<2>() += Eigen::Vector2d(jitter(rng), jitter(rng));
+  gs::write_hdf5_trajectory(dir / "run3.h5", t);
+  ASSERT_EQ(run("analyze voidcells " + (dir / "run3.h5").string() + " --to 1 -o " +
+                    (dir / "v3.h5").string(),
+                dir / "log"),
+            0);
+  const auto w = read_doubles(dir / "v3.h5", "/cells/w");
+  for (double x : w) EXPECT_TRUE(std::isfinite(x));
+  if (const char* keep = std::getenv("GS_KEEP_TEST_OUTPUT")) {  // e.g. to try the figures
+    fs::copy_file(dir / "v3.h5", fs::path(keep) / "voidcells_demo.h5",
+                  fs::copy_options::overwrite_existing);
+  }
   fs::remove_all(dir);
 }
 
