@@ -1,5 +1,6 @@
 // Tests of analysis/tet_strain: exact gradients for affine fields (3D tets, 2D triangles).
 #include <gtest/gtest.h>
+#include <omp.h>
 
 #include <Eigen/Geometry>
 #include <cmath>
@@ -174,6 +175,25 @@ TEST(TriangleStrain, AffineFieldExactBagiEq4) {
   auto dup = x;
   dup[10] = dup[11];
   EXPECT_THROW(delaunay_triangles(dup), std::invalid_argument);
+}
+
+TEST(TetStrain, SameResultForAnyThreadCount) {
+  const auto x = random_points(3000, 8);
+  std::vector<Eigen::Vector3d> u(x.size());
+  std::mt19937_64 rng(9);
+  std::normal_distribution<double> g(0.0, 1e-5);
+  for (auto& v : u) v = Eigen::Vector3d(g(rng), g(rng), g(rng));
+  const int saved = omp_get_max_threads();
+  omp_set_num_threads(1);
+  const auto a = tet_strain(x, u);
+  omp_set_num_threads(4);
+  const auto b = tet_strain(x, u);
+  omp_set_num_threads(saved);
+  ASSERT_EQ(a.simplices, b.simplices);
+  for (std::size_t t = 0; t < a.gradient.size(); ++t) ASSERT_EQ(a.gradient[t], b.gradient[t]);
+  for (std::size_t i = 0; i < x.size(); ++i)
+    ASSERT_EQ(a.particle_gradient[i], b.particle_gradient[i]);
+  EXPECT_EQ(a.mean_gradient, b.mean_gradient);
 }
 
 }  // namespace
