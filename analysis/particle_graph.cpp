@@ -56,6 +56,10 @@ ParticleGraph make_particle_graph(std::vector<Eigen::Vector2d> positions,
                                 static_cast<int>(-std::round(f.y())));
     }
     g.edges.push_back(e);
+    if (!(g.branch(g.edges.size() - 1).squaredNorm() > 0.0)) {
+      throw std::invalid_argument("contacting particles with coincident centres (indices " +
+                                  std::to_string(a) + " and " + std::to_string(b) + ")");
+    }
   }
   return g;
 }

@@ -34,7 +34,8 @@ struct ParticleGraph {
 
 /// Graph from index pairs. Self pairs are rejected, repeated pairs merged. In a periodic cell the
 /// shift of each edge is the minimum image of x_b - x_a. Throws std::invalid_argument on an
-/// index out of range, a self pair, or non-finite positions.
+/// index out of range, a self pair, non-finite positions, or a contact between coincident centres
+/// (its direction, needed to order the edges around a vertex, is undefined).
 ParticleGraph make_particle_graph(std::vector<Eigen::Vector2d> positions,
                                   const std::vector<std::pair<std::int32_t, std::int32_t>>& pairs,
                                   bool periodic = false,

@@ -17,6 +17,9 @@ TEST(ParticleGraph, MergesPairsAndRejectsBadOnes) {
   EXPECT_THROW(make_particle_graph(x, {{0, 3}}), std::invalid_argument);
   EXPECT_THROW(make_particle_graph(x, {{0, 1}}, true, Eigen::Matrix2d::Zero()),
                std::invalid_argument);
+  const std::vector<Eigen::Vector2d> dup{{0, 0}, {1, 0}, {1, 0}};
+  EXPECT_THROW(make_particle_graph(dup, {{1, 2}}), std::invalid_argument);
+  EXPECT_NO_THROW(make_particle_graph(dup, {{0, 1}, {0, 2}}));  // duplicates not in contact
 }
 
 TEST(ParticleGraph, PeriodicMinimumImage) {
