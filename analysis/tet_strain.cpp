@@ -4,10 +4,12 @@
 #include <CGAL/Delaunay_triangulation_2.h>
 #include <CGAL/Delaunay_triangulation_3.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Regular_triangulation_3.h>
 #include <CGAL/Triangulation_vertex_base_with_info_2.h>
 #include <CGAL/Triangulation_vertex_base_with_info_3.h>
 
 #include <Eigen/LU>
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <map>
@@ -22,6 +24,12 @@ using K = CGAL::Exact_predicates_inexact_constructions_kernel;
 using Vb3 = CGAL::Triangulation_vertex_base_with_info_3<std::int32_t, K>;
 using Tds3 = CGAL::Triangulation_data_structure_3<Vb3>;
 using Delaunay3 = CGAL::Delaunay_triangulation_3<K, Tds3>;
+using RVb =
+    CGAL::Triangulation_vertex_base_with_info_3<std::int32_t, K,
+                                                CGAL::Regular_triangulation_vertex_base_3<K>>;
+using RCb = CGAL::Regular_triangulation_cell_base_3<K>;
+using RTds = CGAL::Triangulation_data_structure_3<RVb, RCb>;
+using Regular3 = CGAL::Regular_triangulation_3<K, RTds>;
 using Vb2 = CGAL::Triangulation_vertex_base_with_info_2<std::int32_t, K>;
 using Tds2 = CGAL::Triangulation_data_structure_2<Vb2>;
 using Delaunay2 = CGAL::Delaunay_triangulation_2<K, Tds2>;
@@ -120,6 +128,51 @@ std::vector<std::array<std::int32_t, 4>> delaunay_tetrahedra(
   return tets;
 }
 
+std::vector<std::array<std::int32_t, 4>> regular_tetrahedra(
+    const std::vector<Eigen::Vector3d>& points, const std::vector<double>& radii) {
+  if (radii.size() != points.size()) {
+    throw std::invalid_argument("one radius per point needed (" + std::to_string(radii.size()) +
+                                " for " + std::to_string(points.size()) + ")");
+  }
+  for (std::size_t i = 0; i < radii.size(); ++i) {
+    if (!(radii[i] > 0.0) || !std::isfinite(radii[i])) {
+      throw std::invalid_argument("radius not positive (point " + std::to_string(i) + ")");
+    }
+  }
+  // Delaunay first: the same checks (count, finite, coplanar, duplicates) with the same messages.
+  if (points.size() < 4) {
+    throw std::invalid_argument("Delaunay tetrahedra need at least 4 points (" +
+                                std::to_string(points.size()) + ")");
+  }
+  check_finite(points, "particle centre");
+  {
+    std::vector<std::vector<double>> keys;
+    keys.reserve(points.size());
+    for (const auto& p : points) keys.push_back({p.x(), p.y(), p.z()});
+    std::sort(keys.begin(), keys.end());
+    if (std::adjacent_find(keys.begin(), keys.end()) != keys.end()) throw_duplicate(points);
+  }
+  std::vector<std::pair<K::Weighted_point_3, std::int32_t>> pts;
+  pts.reserve(points.size());
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    pts.emplace_back(K::Weighted_point_3(K::Point_3(points[i].x(), points[i].y(), points[i].z()),
+                                         radii[i] * radii[i]),
+                     static_cast<std::int32_t>(i));
+  }
+  const Regular3 rt(pts.begin(), pts.end());
+  if (rt.dimension() < 3) {
+    throw std::invalid_argument("all particle centres are coplanar (dimension " +
+                                std::to_string(rt.dimension()) + ")");
+  }
+  std::vector<std::array<std::int32_t, 4>> tets;
+  tets.reserve(rt.number_of_finite_cells());
+  for (auto c = rt.finite_cells_begin(); c != rt.finite_cells_end(); ++c) {
+    tets.push_back(
+        {c->vertex(0)->info(), c->vertex(1)->info(), c->vertex(2)->info(), c->vertex(3)->info()});
+  }
+  return tets;
+}
+
 std::vector<std::array<std::int32_t, 3>> delaunay_triangles(
     const std::vector<Eigen::Vector2d>& points) {
   if (points.size() < 3) {
@@ -174,7 +227,8 @@ SimplexStrain tet_strain(const std::vector<Eigen::Vector3d>& reference,
   SimplexStrain r;
   r.dim = 3;
   auto t0 = std::chrono::steady_clock::now();
-  r.simplices = delaunay_tetrahedra(reference);
+  r.simplices = options.radii.empty() ? delaunay_tetrahedra(reference)
+                                      : regular_tetrahedra(reference, options.radii);
   r.seconds_delaunay = seconds_since(t0);
 
   t0 = std::chrono::steady_clock::now();

@@ -20,6 +20,10 @@ namespace gs::analysis {
 
 struct SimplexStrainOptions {
   double min_quality = 0.02;  // simplices below are flagged slivers, excluded from averages
+  /// 3D only, optional: particle radii; the mesh is then the regular (weighted Delaunay)
+  /// triangulation with weights r^2 (radical / power tessellation dual). A particle hidden by
+  /// overlapping neighbours gets no tetrahedron and particle_valid = 0.
+  std::vector<double> radii;
 };
 
 /// Result for a d-dimensional mesh (d = 3: tets, 4 vertices; d = 2: triangles, 3 vertices;
@@ -44,6 +48,11 @@ struct SimplexStrain {
 /// centres (the message names the first duplicate pair: a displacement there is ambiguous).
 std::vector<std::array<std::int32_t, 4>> delaunay_tetrahedra(
     const std::vector<Eigen::Vector3d>& points);
+
+/// Regular (weighted Delaunay) tetrahedra with weights radii^2; same errors, plus radii of the
+/// wrong size or not positive and finite. Hidden points take part in no tetrahedron.
+std::vector<std::array<std::int32_t, 4>> regular_tetrahedra(
+    const std::vector<Eigen::Vector3d>& points, const std::vector<double>& radii);
 
 /// Delaunay triangles of the (x, y) coordinates, counterclockwise. Same errors in 2D (fewer than
 /// 3 points, all collinear, duplicate centres).

@@ -250,6 +250,7 @@ struct StrainArgs {
   double min_quality = 0.02;
   std::vector<double> slab_origin, slab_normal, slab_axis;
   double slab_thickness = 0.0, slab_d50 = 0.0;
+  bool weighted = false;
 };
 
 void run_strain(const StrainArgs& a) {
@@ -261,6 +262,8 @@ void run_strain(const StrainArgs& a) {
   SimplexStrain r;
   std::vector<std::int32_t> index = m.index;
   std::vector<Eigen::Vector3d> x3;
+  analysis::SimplexStrainOptions options;
+  options.min_quality = a.min_quality;
   try {
     if (m.frame.two_d || slab) {
       std::vector<Eigen::Vector2d> x2, u2;
@@ -284,10 +287,14 @@ void run_strain(const StrainArgs& a) {
           u2.push_back(m.u[i].head<2>());
         }
       }
-      r = analysis::triangle_strain(x2, u2, {.min_quality = a.min_quality});
+      r = analysis::triangle_strain(x2, u2, options);
       for (const auto& p : x2) x3.emplace_back(p.x(), p.y(), 0.0);
     } else {
-      r = analysis::tet_strain(m.x, m.u, {.min_quality = a.min_quality});
+      if (a.weighted) {
+        for (const auto k : m.index)
+          options.radii.push_back(m.frame.particles[static_cast<std::size_t>(k)].radius);
+      }
+      r = analysis::tet_strain(m.x, m.u, options);
       x3 = m.x;
     }
   } catch (const std::invalid_argument& e) {
@@ -301,6 +308,7 @@ void run_strain(const StrainArgs& a) {
   h.attr("frame_to", static_cast<long long>(a.to.value_or(-1)));
   h.attr("min_quality", a.min_quality);
   h.attr("slab", static_cast<long long>(slab ? 1 : 0));
+  h.attr("weighted", static_cast<long long>(options.radii.empty() ? 0 : 1));
   h.group("/particles");
   h.group("/simplices");
   std::vector<std::int64_t> ids;
@@ -483,6 +491,8 @@ void register_analyze_strain(CLI::App& app) {
                   "without it the velocities of --from are used");
     s->add_option("--min-quality", a->min_quality,
                   "simplices of lower quality are slivers, excluded from averages (0.02)");
+    s->add_flag("--weighted", a->weighted,
+                "3D: regular (weighted Delaunay) triangulation with weights radius^2");
     s->add_option("--slab-origin", a->slab_origin, "slab mid-plane point x y z")->expected(3);
     s->add_option("--slab-normal", a->slab_normal, "slab normal x y z")->expected(3);
     s->add_option("--slab-axis", a->slab_axis, "in-plane x axis x y z")->expected(3);

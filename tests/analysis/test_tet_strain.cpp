@@ -109,7 +109,9 @@ TEST(TetStrain, SliversFlaggedAndExcluded) {
   // flagged and they never enter the averages.
   auto x = random_points(400, 3);
   std::vector<Eigen::Vector3d> u(x.size(), Eigen::Vector3d::Zero());
-  const auto r = tet_strain(x, u, {.min_quality = 0.1});
+  SimplexStrainOptions opt;
+  opt.min_quality = 0.1;
+  const auto r = tet_strain(x, u, opt);
   std::size_t slivers = 0;
   for (std::size_t t = 0; t < r.simplices.size(); ++t) {
     EXPECT_EQ(r.sliver[t] != 0, r.quality[t] < 0.1);
@@ -175,6 +177,38 @@ TEST(TriangleStrain, AffineFieldExactBagiEq4) {
   auto dup = x;
   dup[10] = dup[11];
   EXPECT_THROW(delaunay_triangles(dup), std::invalid_argument);
+}
+
+TEST(TetStrain, RegularTriangulationWeightedByRadius) {
+  auto x = random_points(1500, 12);
+  std::mt19937_64 rng(13);
+  std::uniform_real_distribution<double> ur(1e-4, 4e-4);
+  std::vector<double> radii(x.size());
+  for (auto& r : radii) r = ur(rng);
+  Eigen::Matrix3d h;
+  h << 0.002, -0.001, 0.004, 0.003, 0.001, -0.002, 0.0, 0.005, -0.003;
+  std::vector<Eigen::Vector3d> u(x.size());
+  for (std::size_t i = 0; i < x.size(); ++i) u[i] = h * x[i];
+  SimplexStrainOptions opt;
+  opt.radii = radii;
+  const auto r = tet_strain(x, u, opt);
+  const auto d = delaunay_tetrahedra(x);
+  EXPECT_NE(r.simplices, d);  // the weights change the mesh
+  for (std::size_t t = 0; t < r.simplices.size(); ++t) {
+    if (!r.sliver[t]) {
+      EXPECT_LT(rel(r.gradient[t], h), 1e-12);
+    }
+  }
+  EXPECT_LT(rel(r.mean_gradient, h), 1e-12);
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    if (r.particle_valid[i]) {
+      EXPECT_LT(rel(r.particle_gradient[i], h), 1e-12);
+    }
+  }
+  opt.radii[3] = -1.0;
+  EXPECT_THROW(tet_strain(x, u, opt), std::invalid_argument);
+  radii.pop_back();
+  EXPECT_THROW(regular_tetrahedra(x, radii), std::invalid_argument);
 }
 
 TEST(TetStrain, SameResultForAnyThreadCount) {
