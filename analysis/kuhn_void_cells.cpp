@@ -333,6 +333,16 @@ Eigen::Matrix2d bagi_triangle_gradient(const std::array<Eigen::Vector2d, 3>& x,
   return -l / (6.0 * area);
 }
 
+double alignment(const Eigen::Matrix2d& local, const Eigen::Matrix2d& mean) {
+  const double a = local.norm(), b = mean.norm();                                    // eq 19
+  return a > 0.0 && b > 0.0 ? (local.array() * mean.array()).sum() / (a * b) : 0.0;  // eq 18
+}
+
+double normalised_vorticity(const Eigen::Matrix2d& local, const Eigen::Matrix2d& mean) {
+  const double b = mean.norm();
+  return b > 0.0 ? -(local(0, 1) - local(1, 0)) / b : 0.0;  // eq 20
+}
+
 VoidCellDeformation void_cell_deformation(const ParticleGraph& g, const VoidCellGraph& cells,
                                           const std::vector<Eigen::Vector2d>& velocity, double d50,
                                           const Eigen::Matrix2d& cell_rate) {
@@ -372,10 +382,8 @@ VoidCellDeformation void_cell_deformation(const ParticleGraph& g, const VoidCell
   r.alpha.assign(cells.cells.size(), 0.0);
   r.w.assign(cells.cells.size(), 0.0);
   for (std::size_t i = 0; i < cells.cells.size(); ++i) {
-    const auto& l = r.gradient[i];
-    const double li = l.norm();
-    if (li > 0.0 && norm > 0.0) r.alpha[i] = (l.array() * r.mean.array()).sum() / (li * norm);
-    if (norm > 0.0) r.w[i] = -(l(0, 1) - l(1, 0)) / norm;  // eq 20
+    r.alpha[i] = alignment(r.gradient[i], r.mean);
+    r.w[i] = normalised_vorticity(r.gradient[i], r.mean);
   }
   r.relative_velocity_scale = d50 * std::abs(r.mean(1, 1));
   if (!(r.relative_velocity_scale > 0.0)) r.relative_velocity_scale = d50 * norm;

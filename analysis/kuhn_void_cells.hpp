@@ -54,6 +54,11 @@ Eigen::Matrix2d void_cell_gradient(const std::vector<Eigen::Vector2d>& x,
 Eigen::Matrix2d bagi_triangle_gradient(const std::array<Eigen::Vector2d, 3>& x,
                                        const std::array<Eigen::Vector2d, 3>& v);
 
+/// Eq 18-19: alignment of a local gradient with the average one; 0 where either is zero.
+double alignment(const Eigen::Matrix2d& local, const Eigen::Matrix2d& mean);
+/// Eq 20: normalised vorticity -(L12 - L21) / |L-bar|; 0 where |L-bar| = 0.
+double normalised_vorticity(const Eigen::Matrix2d& local, const Eigen::Matrix2d& mean);
+
 struct VoidCellDeformation {
   std::vector<Eigen::Matrix2d> gradient;           // L^i per cell (eq 7)
   Eigen::Matrix2d mean = Eigen::Matrix2d::Zero();  // L-bar (eq 3)

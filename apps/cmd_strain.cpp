@@ -337,6 +337,16 @@ void run_strain(const StrainArgs& a) {
   h.data("/simplices/sliver", r.sliver);
   h.data("/simplices/gradient", flat(r.gradient, 3), 9);
   h.data("/mean_gradient", flat({r.mean_gradient}, 3), 3);
+  if (r.dim == 2) {  // triangle (Bagi eq 4) variant of seed 002's alpha and w maps
+    std::vector<double> alpha, w;
+    const Eigen::Matrix2d mean = r.mean_gradient.topLeftCorner<2, 2>();
+    for (const auto& gt : r.gradient) {
+      alpha.push_back(analysis::alignment(gt.topLeftCorner<2, 2>(), mean));
+      w.push_back(analysis::normalised_vorticity(gt.topLeftCorner<2, 2>(), mean));
+    }
+    h.data("/simplices/alpha", alpha);
+    h.data("/simplices/w", w);
+  }
   h.commit();
   if (!a.vtu.empty()) write_strain_vtu(a.vtu, x3, r);
   std::size_t slivers = 0;

@@ -52,6 +52,12 @@ def _strain(f, out_dir):
         ax.set_title(name)
         fig.colorbar(sc, ax=ax, shrink=0.8)
     written.append(figutil.save(fig, out_dir, "strain_maps.png"))
+    if "simplices/alpha" in f:  # 2D: triangle (Bagi eq 4) variant of Figs 8-9
+        tri = f["simplices/vertices"][()]
+        sliver = f["simplices/sliver"][()].astype(bool)
+        polys = [pos[t, :2] for t in tri[~sliver]]
+        written += _alpha_w_maps(polys, f["simplices/alpha"][()][~sliver],
+                                 f["simplices/w"][()][~sliver], out_dir, "strain_triangles")
     fig, ax = plt.subplots(figsize=(5, 4))
     ax.hist(shear[valid], bins=60, color="0.3")
     ax.set_xlabel("equivalent shear strain")
@@ -73,8 +79,22 @@ def _voidcells(f, out_dir):
     pos = f["particles/position"][()]
     active = f["particles/active"][()].astype(bool)
     vrel = f["particles/relative_velocity"][()]
-    written = []
+    written = _alpha_w_maps(polys, alpha, w, out_dir, "voidcells")
 
+    # Fig. 10: relative velocities (eq 21).
+    fig, ax = plt.subplots(figsize=(6, 6))
+    ax.add_collection(PolyCollection(polys, facecolors="none", edgecolors="0.8", linewidths=0.2))
+    ax.quiver(pos[active, 0], pos[active, 1], vrel[active, 0], vrel[active, 1], angles="xy",
+              width=0.002)
+    ax.autoscale_view()
+    ax.set_aspect("equal")
+    ax.set_title("relative velocity (eq 21)")
+    written.append(figutil.save(fig, out_dir, "voidcells_relative_velocity.png"))
+    return written
+
+
+def _alpha_w_maps(polys, alpha, w, out_dir, prefix):
+    written = []
     # Fig. 8: alignment alpha, white for alpha <= 0.
     fig, ax = plt.subplots(figsize=(6, 6))
     pc = PolyCollection(polys, array=np.clip(alpha, 0, 1), cmap="Greys", edgecolors="0.6",
@@ -87,7 +107,7 @@ def _voidcells(f, out_dir):
                  % (float(np.mean(alpha)) if alpha.size else 0.0,
                     100.0 * float(np.mean(alpha <= 0)) if alpha.size else 0.0))
     fig.colorbar(pc, ax=ax, shrink=0.8)
-    written.append(figutil.save(fig, out_dir, "voidcells_alpha.png"))
+    written.append(figutil.save(fig, out_dir, prefix + "_alpha.png"))
 
     # Fig. 9: vorticity w, grey scale that accentuates direction and de-emphasises magnitude.
     fig, ax = plt.subplots(figsize=(6, 6))
@@ -100,15 +120,5 @@ def _voidcells(f, out_dir):
     ax.set_aspect("equal")
     ax.set_title("vorticity w (eq 20): tanh(w / median|w|); black clockwise")
     fig.colorbar(pc, ax=ax, shrink=0.8)
-    written.append(figutil.save(fig, out_dir, "voidcells_w.png"))
-
-    # Fig. 10: relative velocities (eq 21).
-    fig, ax = plt.subplots(figsize=(6, 6))
-    ax.add_collection(PolyCollection(polys, facecolors="none", edgecolors="0.8", linewidths=0.2))
-    ax.quiver(pos[active, 0], pos[active, 1], vrel[active, 0], vrel[active, 1], angles="xy",
-              width=0.002)
-    ax.autoscale_view()
-    ax.set_aspect("equal")
-    ax.set_title("relative velocity (eq 21)")
-    written.append(figutil.save(fig, out_dir, "voidcells_relative_velocity.png"))
+    written.append(figutil.save(fig, out_dir, prefix + "_w.png"))
     return written

@@ -198,8 +198,17 @@ TEST(CmdStrain, VoidCellsPeriodic2DFromVelocities) {
             0);
   const auto w = read_doubles(dir / "v3.h5", "/cells/w");
   for (double x : w) EXPECT_TRUE(std::isfinite(x));
+  // The triangle (Bagi eq 4) variant of the same motion: 2D strain with alpha and w.
+  ASSERT_EQ(
+      run("analyze strain " + (dir / "run3.h5").string() + " --to 1 -o " + (dir / "t3.h5").string(),
+          dir / "log"),
+      0);
+  EXPECT_EQ(read_doubles(dir / "t3.h5", "/simplices/alpha").size(),
+            read_doubles(dir / "t3.h5", "/simplices/measure").size());
   if (const char* keep = std::getenv("GS_KEEP_TEST_OUTPUT")) {  // e.g. to try the figures
     fs::copy_file(dir / "v3.h5", fs::path(keep) / "voidcells_demo.h5",
+                  fs::copy_options::overwrite_existing);
+    fs::copy_file(dir / "t3.h5", fs::path(keep) / "triangles_demo.h5",
                   fs::copy_options::overwrite_existing);
   }
   fs::remove_all(dir);
