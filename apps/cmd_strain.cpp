@@ -241,6 +241,35 @@ void write_strain_vtu(const fs::path& path, const std::vector<Eigen::Vector3d>& 
   out.commit();
 }
 
+void write_voidcells_vtu(const fs::path& path, const std::vector<double>& polygon,
+                         const std::vector<std::int64_t>& offsets,
+                         const std::vector<std::pair<const char*, std::vector<double>>>& data) {
+  vtkNew<vtkPoints> pts;
+  pts->SetDataTypeToDouble();
+  for (std::size_t i = 0; i + 1 < polygon.size(); i += 2) {
+    pts->InsertNextPoint(polygon[i], polygon[i + 1], 0.0);
+  }
+  vtkNew<vtkUnstructuredGrid> grid;
+  grid->SetPoints(pts);
+  grid->Allocate(static_cast<vtkIdType>(offsets.size()));
+  for (std::size_t c = 0; c + 1 < offsets.size(); ++c) {
+    std::vector<vtkIdType> ids;
+    for (auto k = offsets[c]; k < offsets[c + 1]; ++k) ids.push_back(static_cast<vtkIdType>(k));
+    grid->InsertNextCell(VTK_POLYGON, static_cast<vtkIdType>(ids.size()), ids.data());
+  }
+  for (const auto& [name, values] : data) {
+    const auto comps = static_cast<int>(values.size() / (offsets.size() - 1));
+    grid->GetCellData()->AddArray(vtk_array(name, comps, values));
+  }
+  AtomicOutput out(path);
+  vtkNew<vtkXMLUnstructuredGridWriter> w;
+  w->SetFileName(out.temp_path().c_str());
+  w->SetInputData(grid);
+  w->SetDataModeToBinary();
+  if (w->Write() != 1) throw InputError(path.string(), "cannot write VTU output");
+  out.commit();
+}
+
 // ---- strain -------------------------------------------------------------------------------
 
 struct StrainArgs {
@@ -360,7 +389,7 @@ void run_strain(const StrainArgs& a) {
 // ---- voidcells ----------------------------------------------------------------------------
 
 struct VoidArgs {
-  std::string input, output;
+  std::string input, output, vtu;
   long from = 0;
   std::optional<long> to;
   double d50 = 0.0;
@@ -476,6 +505,10 @@ void run_voidcells(const VoidArgs& a) {
   h.data("/mean_gradient", mean, 2);
   h.attr("relative_velocity_scale", d.relative_velocity_scale);
   h.commit();
+  if (!a.vtu.empty() && !cells.cells.empty()) {
+    write_voidcells_vtu(a.vtu, poly, offsets,
+                        {{"area", area}, {"alpha", d.alpha}, {"w", d.w}, {"gradient", grad}});
+  }
   std::cout << "voidcells: L " << cells.faces << " M " << cells.edges << " N " << cells.vertices
             << " (Euler " << cells.euler() << "), removed isolated " << cells.removed_isolated
             << " pendant " << cells.removed_pendant << " peninsular " << cells.removed_peninsular
@@ -521,6 +554,7 @@ void register_analyze_strain(CLI::App& app) {
     s->add_option("--from", a->from, "frame index (default 0)");
     s->add_option("--to", a->to, "target frame: displacements instead of velocities");
     s->add_option("--d50", a->d50, "D50 for eq 21 in m (default: from the frame)");
+    s->add_option("--vtu", a->vtu, "also write the void-cell polygons with cell data (VTU)");
     s->callback([a] { run_voidcells(*a); });
   }
 }

@@ -110,6 +110,8 @@ TEST(CmdStrain, ThreeDAffineBetweenFramesMatchedById) {
   if (const char* keep = std::getenv("GS_KEEP_TEST_OUTPUT")) {  // e.g. to try the figures
     fs::copy_file(dir / "s.h5", fs::path(keep) / "strain_demo.h5",
                   fs::copy_options::overwrite_existing);
+    fs::copy_file(dir / "s.vtu", fs::path(keep) / "strain_demo.vtu",
+                  fs::copy_options::overwrite_existing);
   }
   fs::remove_all(dir);
 }
@@ -193,9 +195,10 @@ TEST(CmdStrain, VoidCellsPeriodic2DFromVelocities) {
     p.position.head<2>() += Eigen::Vector2d(jitter(rng), jitter(rng));
   gs::write_hdf5_trajectory(dir / "run3.h5", t);
   ASSERT_EQ(run("analyze voidcells " + (dir / "run3.h5").string() + " --to 1 -o " +
-                    (dir / "v3.h5").string(),
+                    (dir / "v3.h5").string() + " --vtu " + (dir / "v3.vtu").string(),
                 dir / "log"),
             0);
+  EXPECT_TRUE(fs::exists(dir / "v3.vtu"));
   const auto w = read_doubles(dir / "v3.h5", "/cells/w");
   for (double x : w) EXPECT_TRUE(std::isfinite(x));
   // The triangle (Bagi eq 4) variant of the same motion: 2D strain with alpha and w.
@@ -209,6 +212,8 @@ TEST(CmdStrain, VoidCellsPeriodic2DFromVelocities) {
     fs::copy_file(dir / "v3.h5", fs::path(keep) / "voidcells_demo.h5",
                   fs::copy_options::overwrite_existing);
     fs::copy_file(dir / "t3.h5", fs::path(keep) / "triangles_demo.h5",
+                  fs::copy_options::overwrite_existing);
+    fs::copy_file(dir / "v3.vtu", fs::path(keep) / "voidcells_demo.vtu",
                   fs::copy_options::overwrite_existing);
   }
   fs::remove_all(dir);
