@@ -393,6 +393,7 @@ struct VoidArgs {
   long from = 0;
   std::optional<long> to;
   double d50 = 0.0;
+  std::vector<double> cell_gradient;  // velocity gradient of a periodic cell, row-major 2x2
 };
 
 void run_voidcells(const VoidArgs& a) {
@@ -433,8 +434,15 @@ void run_voidcells(const VoidArgs& a) {
                            std::to_string(cells.euler()) + ", expected",
                        std::to_string(cells.expected_euler));
     }
-    // A fixed periodic cell is assumed for velocities; between frames the cell change is used.
+    // Periodic images move with the cell: from velocities the cell velocity gradient given on
+    // the command line (default 0: fixed cell); between frames the change of the cell.
     Eigen::Matrix2d rate = Eigen::Matrix2d::Zero();
+    if (a.cell_gradient.size() == 4) {
+      if (a.to) throw InputError(a.input, "--cell-velocity-gradient is for velocities, not --to");
+      const Eigen::Matrix2d lc{{a.cell_gradient[0], a.cell_gradient[1]},
+                               {a.cell_gradient[2], a.cell_gradient[3]}};
+      rate = lc * f.domain.cell.topLeftCorner<2, 2>();
+    }
     if (a.to && f.domain.periodic) {
       TrajectoryReader reader(a.input);
       const Frame t = reader.frame(static_cast<std::size_t>(*a.to));
@@ -555,6 +563,10 @@ void register_analyze_strain(CLI::App& app) {
     s->add_option("--to", a->to, "target frame: displacements instead of velocities");
     s->add_option("--d50", a->d50, "D50 for eq 21 in m (default: from the frame)");
     s->add_option("--vtu", a->vtu, "also write the void-cell polygons with cell data (VTU)");
+    s->add_option("--cell-velocity-gradient", a->cell_gradient,
+                  "periodic cell, velocity mode: cell velocity gradient L11 L12 L21 L22 (1/s); "
+                  "images of a particle move with v + L (cell shift)")
+        ->expected(4);
     s->callback([a] { run_voidcells(*a); });
   }
 }

@@ -170,6 +170,16 @@ TEST(CmdStrain, VoidCellsPeriodic2DFromVelocities) {
                 dir / "log"),
             0);
   EXPECT_EQ(read_format(dir / "v.h5"), "granoscope-voidcells");
+  // With the cell velocity gradient l the image velocities are consistent: exact l per cell.
+  ASSERT_EQ(run("analyze voidcells " + (dir / "run.h5").string() +
+                    " --cell-velocity-gradient 0 0.02 -0.01 0.005 -o " + (dir / "vl.h5").string(),
+                dir / "log"),
+            0);
+  const auto gl = read_doubles(dir / "vl.h5", "/cells/gradient");
+  ASSERT_GT(gl.size(), 40u);
+  for (std::size_t i = 0; i < gl.size(); ++i) {
+    EXPECT_NEAR(gl[i], l((i % 4) / 2, i % 2), 1e-12 * l.norm()) << i;
+  }
   // Two frames: the cell deforms with l, particles follow affinely -> every cell has gradient l.
   gs::Frame g = f;
   for (auto& p : g.particles) p.position.head<2>() += l * p.position.head<2>();
