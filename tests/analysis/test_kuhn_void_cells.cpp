@@ -44,6 +44,12 @@ ParticleGraph fig4_graph() {
   x.emplace_back(1.6, 1.6);
   e.emplace_back(4, 18);
   e.emplace_back(18, 19);
+  x.emplace_back(0.3, 0.3);  // 20, 21, 22: island triangle floating inside the cell [0,1]^2
+  x.emplace_back(0.7, 0.3);
+  x.emplace_back(0.5, 0.7);
+  e.emplace_back(20, 21);
+  e.emplace_back(21, 22);
+  e.emplace_back(22, 20);
   return make_particle_graph(x, e);
 }
 
@@ -53,7 +59,7 @@ TEST(KuhnVoidCells, Fig4RemovalsAndEuler) {
   EXPECT_EQ(c.removed_isolated, 1);
   EXPECT_EQ(c.removed_pendant, 4);
   EXPECT_EQ(c.removed_peninsular, 3);
-  EXPECT_EQ(c.removed_island, 3);
+  EXPECT_EQ(c.removed_island, 6);
   EXPECT_EQ(c.vertices, 9);
   EXPECT_EQ(c.edges, 12);
   EXPECT_EQ(c.faces, 4);
@@ -65,7 +71,7 @@ TEST(KuhnVoidCells, Fig4RemovalsAndEuler) {
     EXPECT_DOUBLE_EQ(cell.area, 1.0);
   }
   for (int v = 0; v < 9; ++v) EXPECT_TRUE(c.vertex_active[static_cast<std::size_t>(v)]);
-  for (std::size_t v = 9; v < 20; ++v) EXPECT_FALSE(c.vertex_active[v]);
+  for (std::size_t v = 9; v < 23; ++v) EXPECT_FALSE(c.vertex_active[v]);
 }
 
 // Contacts from a random point set: Delaunay edges shorter than `cut` x mean spacing (a random
@@ -190,7 +196,7 @@ TEST(KuhnVoidCells, DegenerateInput) {
   const auto g2 = fig4_graph();
   const auto c = find_void_cells(g2);
   const auto d =
-      void_cell_deformation(g2, c, std::vector<Eigen::Vector2d>(20, Eigen::Vector2d::Zero()), 1.0);
+      void_cell_deformation(g2, c, std::vector<Eigen::Vector2d>(23, Eigen::Vector2d::Zero()), 1.0);
   for (std::size_t i = 0; i < c.cells.size(); ++i) {
     EXPECT_EQ(d.alpha[i], 0.0);
     EXPECT_EQ(d.w[i], 0.0);
