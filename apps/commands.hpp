@@ -22,5 +22,7 @@ void register_dic(CLI::App& app);  // dic (apps/cmd_dic.cpp)
 
 /// `granoscope analyze` parent; analyses register below it (analyze hhd, analyze strain, ...).
 CLI::App& analyze_command(CLI::App& app);
+/// `granoscope analyze strain` and `granoscope analyze voidcells` (apps/cmd_strain.cpp).
+void register_analyze_strain(CLI::App& app);
 
 }  // namespace gs::cli

@@ -14,6 +14,8 @@ import sys
 FIGURES = {
     "granoscope-trajectory": ["fig_positions", "fig_history"],
     "granoscope-dic": ["fig_dic"],
+    "granoscope-strain": ["fig_strain"],
+    "granoscope-voidcells": ["fig_strain"],
 }
 
 

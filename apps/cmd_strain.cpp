@@ -1,0 +1,574 @@
+// `granoscope analyze strain` (Delaunay tetrahedra in 3D, triangles in 2D or on a projected
+// slab) and `granoscope analyze voidcells` (2D Kuhn void cells, seed 002). Motion between two
+// frames of a RUN.h5 matched by particle id, or the velocities of one frame. Outputs: HDF5
+// (root attribute format = granoscope-strain / granoscope-voidcells, for `granoscope figures`)
+// and optionally VTU, each written under a temporary name and renamed.
+#include <hdf5.h>
+#include <vtkCellArray.h>
+#include <vtkCellData.h>
+#include <vtkDoubleArray.h>
+#include <vtkIdTypeArray.h>
+#include <vtkNew.h>
+#include <vtkPointData.h>
+#include <vtkPoints.h>
+#include <vtkUnsignedCharArray.h>
+#include <vtkUnstructuredGrid.h>
+#include <vtkXMLUnstructuredGridWriter.h>
+
+#include <CLI/CLI.hpp>
+#include <Eigen/LU>
+#include <cmath>
+#include <filesystem>
+#include <iostream>
+#include <optional>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "atomic_file.hpp"
+#include "commands.hpp"
+#include "errors.hpp"
+#include "grain_size.hpp"
+#include "hdf5_trajectory.hpp"
+#include "kuhn_void_cells.hpp"
+#include "particle_graph.hpp"
+#include "slab_projection.hpp"
+#include "snapshot.hpp"
+#include "tet_strain.hpp"
+
+namespace gs::cli {
+namespace {
+
+namespace fs = std::filesystem;
+using analysis::SimplexStrain;
+
+// ---- motion between frames or from velocities -------------------------------------------------
+
+struct Motion {
+  Frame frame;                        // reference frame (particles in file order)
+  std::vector<std::int32_t> index;    // particles of `frame` that take part
+  std::vector<Eigen::Vector3d> x, u;  // their positions and displacements / velocities
+  std::string kind;                   // "displacement" or "velocity"
+};
+
+Motion read_motion(const std::string& path, long from, std::optional<long> to) {
+  if (!fs::exists(path)) throw InputError(path, "no such file");
+  TrajectoryReader reader(path);
+  const auto n = static_cast<long>(reader.frame_count());
+  const auto check = [&](long i, const char* what) {
+    if (i < 0 || i >= n) {
+      throw InputError(path, std::string(what) + " frame out of range 0.." + std::to_string(n - 1),
+                       std::to_string(i));
+    }
+  };
+  check(from, "reference");
+  Motion m;
+  m.frame = reader.frame(static_cast<std::size_t>(from));
+  if (!to) {
+    m.kind = "velocity";
+    for (std::size_t i = 0; i < m.frame.particles.size(); ++i) {
+      m.index.push_back(static_cast<std::int32_t>(i));
+      m.x.push_back(m.frame.particles[i].position);
+      m.u.push_back(m.frame.particles[i].velocity);
+    }
+    return m;
+  }
+  check(*to, "target");
+  m.kind = "displacement";
+  const Frame other = reader.frame(static_cast<std::size_t>(*to));
+  std::unordered_map<std::int64_t, std::size_t> by_id;
+  for (std::size_t i = 0; i < other.particles.size(); ++i) by_id.emplace(other.particles[i].id, i);
+  const bool periodic = m.frame.domain.periodic;
+  const Eigen::Matrix3d cell = m.frame.domain.cell;
+  const Eigen::Matrix3d inv = periodic ? Eigen::Matrix3d(cell.inverse()) : Eigen::Matrix3d::Zero();
+  for (std::size_t i = 0; i < m.frame.particles.size(); ++i) {
+    const auto it = by_id.find(m.frame.particles[i].id);
+    if (it == by_id.end()) continue;  // particle gone: not matched
+    Eigen::Vector3d d = other.particles[it->second].position - m.frame.particles[i].position;
+    if (periodic) {  // wrapped across the cell: minimum image
+      Eigen::Vector3d f = inv * d;
+      if (m.frame.two_d) f.z() = 0.0;
+      d -= cell * f.array().round().matrix();
+    }
+    m.index.push_back(static_cast<std::int32_t>(i));
+    m.x.push_back(m.frame.particles[i].position);
+    m.u.push_back(d);
+  }
+  if (m.index.empty()) throw InputError(path, "no particle id common to both frames");
+  return m;
+}
+
+// ---- HDF5 output ---------------------------------------------------------------------------
+
+class H5 {
+ public:
+  H5(hid_t id, herr_t (*close)(hid_t)) : id_(id), close_(close) {}
+  H5(const H5&) = delete;
+  H5& operator=(const H5&) = delete;
+  ~H5() {
+    if (id_ >= 0) close_(id_);
+  }
+  hid_t get() const { return id_; }
+
+ private:
+  hid_t id_;
+  herr_t (*close_)(hid_t);
+};
+
+class H5Out {
+ public:
+  H5Out(const fs::path& path, const std::string& format)
+      : out_(path),
+        file_(H5Fcreate(out_.temp_path().c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT),
+              H5Fclose) {
+    if (file_.get() < 0) throw InputError(path.string(), "cannot create output file");
+    attr("format", format);
+    attr("code_version", code_version());
+  }
+  void attr(const std::string& name, const std::string& value) {
+    H5 type(H5Tcopy(H5T_C_S1), H5Tclose);
+    H5Tset_size(type.get(), std::max<std::size_t>(1, value.size()));
+    H5 space(H5Screate(H5S_SCALAR), H5Sclose);
+    H5 a(H5Acreate2(file_.get(), name.c_str(), type.get(), space.get(), H5P_DEFAULT, H5P_DEFAULT),
+         H5Aclose);
+    const std::string buf = value.empty() ? std::string(1, '\0') : value;
+    if (a.get() < 0 || H5Awrite(a.get(), type.get(), buf.data()) < 0) fail(name);
+  }
+  void attr(const std::string& name, double value) { attr_num(name, H5T_NATIVE_DOUBLE, &value); }
+  void attr(const std::string& name, long long value) { attr_num(name, H5T_NATIVE_LLONG, &value); }
+  void group(const std::string& name) {
+    H5 g(H5Gcreate2(file_.get(), name.c_str(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose);
+    if (g.get() < 0) fail(name);
+  }
+  template <class T>
+  void data(const std::string& name, const std::vector<T>& v, hsize_t cols = 1) {
+    const hid_t type = std::is_same_v<T, double>         ? H5T_NATIVE_DOUBLE
+                       : std::is_same_v<T, std::int64_t> ? H5T_NATIVE_INT64
+                       : std::is_same_v<T, std::int32_t> ? H5T_NATIVE_INT32
+                                                         : H5T_NATIVE_UINT8;
+    const hsize_t dims[2] = {cols > 0 ? v.size() / cols : 0, cols};
+    H5 space(H5Screate_simple(cols == 1 ? 1 : 2, dims, nullptr), H5Sclose);
+    H5 d(H5Dcreate2(file_.get(), name.c_str(), type, space.get(), H5P_DEFAULT, H5P_DEFAULT,
+                    H5P_DEFAULT),
+         H5Dclose);
+    if (d.get() < 0 ||
+        (!v.empty() && H5Dwrite(d.get(), type, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data()) < 0)) {
+      fail(name);
+    }
+  }
+  void commit() {
+    if (H5Fflush(file_.get(), H5F_SCOPE_GLOBAL) < 0) fail("flush");
+    out_.commit();
+  }
+
+ private:
+  void attr_num(const std::string& name, hid_t type, const void* value) {
+    H5 space(H5Screate(H5S_SCALAR), H5Sclose);
+    H5 a(H5Acreate2(file_.get(), name.c_str(), type, space.get(), H5P_DEFAULT, H5P_DEFAULT),
+         H5Aclose);
+    if (a.get() < 0 || H5Awrite(a.get(), type, value) < 0) fail(name);
+  }
+  [[noreturn]] void fail(const std::string& what) {
+    throw InputError(out_.target().string(), "cannot write HDF5 output", what);
+  }
+  AtomicOutput out_;
+  H5 file_;
+};
+
+std::vector<double> flat(const std::vector<Eigen::Matrix3d>& m, int dim) {
+  std::vector<double> out;
+  out.reserve(m.size() * static_cast<std::size_t>(dim * dim));
+  for (const auto& a : m)
+    for (int i = 0; i < dim; ++i)
+      for (int j = 0; j < dim; ++j) out.push_back(a(i, j));  // row-major H_ij
+  return out;
+}
+
+// ---- VTU output ----------------------------------------------------------------------------
+
+vtkNew<vtkDoubleArray> vtk_array(const char* name, int comps, const std::vector<double>& v) {
+  vtkNew<vtkDoubleArray> a;
+  a->SetName(name);
+  a->SetNumberOfComponents(comps);
+  a->SetNumberOfTuples(static_cast<vtkIdType>(v.size() / static_cast<std::size_t>(comps)));
+  for (std::size_t i = 0; i < v.size(); ++i) a->SetValue(static_cast<vtkIdType>(i), v[i]);
+  return a;
+}
+
+void write_strain_vtu(const fs::path& path, const std::vector<Eigen::Vector3d>& x,
+                      const SimplexStrain& r) {
+  vtkNew<vtkPoints> pts;
+  pts->SetDataTypeToDouble();
+  for (const auto& p : x) pts->InsertNextPoint(p.x(), p.y(), p.z());
+  vtkNew<vtkUnstructuredGrid> grid;
+  grid->SetPoints(pts);
+  const int nv = r.dim + 1;
+  grid->Allocate(static_cast<vtkIdType>(r.simplices.size()));
+  for (const auto& s : r.simplices) {
+    vtkIdType ids[4] = {s[0], s[1], s[2], s[3]};
+    grid->InsertNextCell(r.dim == 3 ? VTK_TETRA : VTK_TRIANGLE, nv, ids);
+  }
+  std::vector<double> vol, shear, sliver, quality;
+  for (std::size_t t = 0; t < r.simplices.size(); ++t) {
+    const auto m = analysis::strain_measures(r.gradient[t], r.dim);
+    vol.push_back(m.volumetric);
+    shear.push_back(m.equivalent_shear);
+    sliver.push_back(r.sliver[t]);
+    quality.push_back(r.quality[t]);
+  }
+  grid->GetCellData()->AddArray(vtk_array("volumetric_strain", 1, vol));
+  grid->GetCellData()->AddArray(vtk_array("equivalent_shear_strain", 1, shear));
+  grid->GetCellData()->AddArray(vtk_array("quality", 1, quality));
+  grid->GetCellData()->AddArray(vtk_array("sliver", 1, sliver));
+  grid->GetCellData()->AddArray(vtk_array("gradient", 9, flat(r.gradient, 3)));
+  std::vector<double> pvol, pshear, valid;
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    const auto m = analysis::strain_measures(r.particle_gradient[i], r.dim);
+    pvol.push_back(m.volumetric);
+    pshear.push_back(m.equivalent_shear);
+    valid.push_back(r.particle_valid[i]);
+  }
+  grid->GetPointData()->AddArray(vtk_array("volumetric_strain", 1, pvol));
+  grid->GetPointData()->AddArray(vtk_array("equivalent_shear_strain", 1, pshear));
+  grid->GetPointData()->AddArray(vtk_array("valid", 1, valid));
+  grid->GetPointData()->AddArray(vtk_array("gradient", 9, flat(r.particle_gradient, 3)));
+  AtomicOutput out(path);
+  vtkNew<vtkXMLUnstructuredGridWriter> w;
+  w->SetFileName(out.temp_path().c_str());
+  w->SetInputData(grid);
+  w->SetDataModeToBinary();
+  if (w->Write() != 1) throw InputError(path.string(), "cannot write VTU output");
+  out.commit();
+}
+
+void write_voidcells_vtu(const fs::path& path, const std::vector<double>& polygon,
+                         const std::vector<std::int64_t>& offsets,
+                         const std::vector<std::pair<const char*, std::vector<double>>>& data) {
+  vtkNew<vtkPoints> pts;
+  pts->SetDataTypeToDouble();
+  for (std::size_t i = 0; i + 1 < polygon.size(); i += 2) {
+    pts->InsertNextPoint(polygon[i], polygon[i + 1], 0.0);
+  }
+  vtkNew<vtkUnstructuredGrid> grid;
+  grid->SetPoints(pts);
+  grid->Allocate(static_cast<vtkIdType>(offsets.size()));
+  for (std::size_t c = 0; c + 1 < offsets.size(); ++c) {
+    std::vector<vtkIdType> ids;
+    for (auto k = offsets[c]; k < offsets[c + 1]; ++k) ids.push_back(static_cast<vtkIdType>(k));
+    grid->InsertNextCell(VTK_POLYGON, static_cast<vtkIdType>(ids.size()), ids.data());
+  }
+  for (const auto& [name, values] : data) {
+    const auto comps = static_cast<int>(values.size() / (offsets.size() - 1));
+    grid->GetCellData()->AddArray(vtk_array(name, comps, values));
+  }
+  AtomicOutput out(path);
+  vtkNew<vtkXMLUnstructuredGridWriter> w;
+  w->SetFileName(out.temp_path().c_str());
+  w->SetInputData(grid);
+  w->SetDataModeToBinary();
+  if (w->Write() != 1) throw InputError(path.string(), "cannot write VTU output");
+  out.commit();
+}
+
+// ---- strain -------------------------------------------------------------------------------
+
+struct StrainArgs {
+  std::string input, output, vtu;
+  long from = 0;
+  std::optional<long> to;
+  double min_quality = 0.02;
+  std::vector<double> slab_origin, slab_normal, slab_axis;
+  double slab_thickness = 0.0, slab_d50 = 0.0;
+  bool weighted = false;
+};
+
+void run_strain(const StrainArgs& a) {
+  if (!(a.min_quality >= 0.0 && a.min_quality < 1.0)) {
+    throw InputError(a.input, "--min-quality must be in [0, 1)", value_str(a.min_quality));
+  }
+  const Motion m = read_motion(a.input, a.from, a.to);
+  const bool slab = !a.slab_normal.empty() || a.slab_thickness > 0.0 || a.slab_d50 > 0.0;
+  SimplexStrain r;
+  std::vector<std::int32_t> index = m.index;
+  std::vector<Eigen::Vector3d> x3;
+  analysis::SimplexStrainOptions options;
+  options.min_quality = a.min_quality;
+  try {
+    if (m.frame.two_d || slab) {
+      std::vector<Eigen::Vector2d> x2, u2;
+      if (slab) {
+        if (m.frame.two_d) throw InputError(a.input, "--slab needs a 3D frame");
+        analysis::Slab s;
+        if (a.slab_origin.size() == 3) s.origin = Eigen::Vector3d(a.slab_origin.data());
+        if (a.slab_normal.size() == 3) s.normal = Eigen::Vector3d(a.slab_normal.data());
+        if (a.slab_axis.size() == 3) s.axis1 = Eigen::Vector3d(a.slab_axis.data());
+        s.thickness = a.slab_thickness;
+        if (a.slab_d50 > 0.0) s.thickness = a.slab_d50 * analysis::d50(m.frame);
+        const auto p = analysis::project_slab(m.x, m.u, s);
+        std::vector<std::int32_t> sub;
+        for (const auto k : p.index) sub.push_back(index[static_cast<std::size_t>(k)]);
+        index = sub;
+        x2 = p.position;
+        u2 = p.vector;
+      } else {
+        for (std::size_t i = 0; i < m.x.size(); ++i) {
+          x2.push_back(m.x[i].head<2>());
+          u2.push_back(m.u[i].head<2>());
+        }
+      }
+      r = analysis::triangle_strain(x2, u2, options);
+      for (const auto& p : x2) x3.emplace_back(p.x(), p.y(), 0.0);
+    } else {
+      if (a.weighted) {
+        for (const auto k : m.index)
+          options.radii.push_back(m.frame.particles[static_cast<std::size_t>(k)].radius);
+      }
+      r = analysis::tet_strain(m.x, m.u, options);
+      x3 = m.x;
+    }
+  } catch (const std::invalid_argument& e) {
+    throw InputError(a.input, e.what());
+  }
+  H5Out h(a.output, "granoscope-strain");
+  h.attr("source", a.input);
+  h.attr("motion", m.kind);
+  h.attr("dim", static_cast<long long>(r.dim));
+  h.attr("frame_from", static_cast<long long>(a.from));
+  h.attr("frame_to", static_cast<long long>(a.to.value_or(-1)));
+  h.attr("min_quality", a.min_quality);
+  h.attr("slab", static_cast<long long>(slab ? 1 : 0));
+  h.attr("weighted", static_cast<long long>(options.radii.empty() ? 0 : 1));
+  h.group("/particles");
+  h.group("/simplices");
+  std::vector<std::int64_t> ids;
+  std::vector<double> pos, vol, shear, rot;
+  for (std::size_t i = 0; i < index.size(); ++i) {
+    ids.push_back(m.frame.particles[static_cast<std::size_t>(index[i])].id);
+    for (int c = 0; c < 3; ++c) pos.push_back(x3[i](c));
+    const auto s = analysis::strain_measures(r.particle_gradient[i], r.dim);
+    vol.push_back(s.volumetric);
+    shear.push_back(s.equivalent_shear);
+    rot.push_back(s.rotation(1, 0));  // in-plane rotation (about z); 3D: see gradient
+  }
+  h.data("/particles/id", ids);
+  h.data("/particles/position", pos, 3);
+  h.data("/particles/gradient", flat(r.particle_gradient, 3), 9);
+  h.data("/particles/valid", r.particle_valid);
+  h.data("/particles/volumetric_strain", vol);
+  h.data("/particles/equivalent_shear_strain", shear);
+  h.data("/particles/rotation_xy", rot);
+  std::vector<std::int32_t> simp;
+  for (const auto& s : r.simplices)
+    for (int k = 0; k < r.dim + 1; ++k) simp.push_back(s[static_cast<std::size_t>(k)]);
+  h.data("/simplices/vertices", simp, static_cast<hsize_t>(r.dim + 1));
+  h.data("/simplices/measure", r.measure);
+  h.data("/simplices/quality", r.quality);
+  h.data("/simplices/sliver", r.sliver);
+  h.data("/simplices/gradient", flat(r.gradient, 3), 9);
+  h.data("/mean_gradient", flat({r.mean_gradient}, 3), 3);
+  if (r.dim == 2) {  // triangle (Bagi eq 4) variant of seed 002's alpha and w maps
+    std::vector<double> alpha, w;
+    const Eigen::Matrix2d mean = r.mean_gradient.topLeftCorner<2, 2>();
+    for (const auto& gt : r.gradient) {
+      alpha.push_back(analysis::alignment(gt.topLeftCorner<2, 2>(), mean));
+      w.push_back(analysis::normalised_vorticity(gt.topLeftCorner<2, 2>(), mean));
+    }
+    h.data("/simplices/alpha", alpha);
+    h.data("/simplices/w", w);
+  }
+  h.commit();
+  if (!a.vtu.empty()) write_strain_vtu(a.vtu, x3, r);
+  std::size_t slivers = 0;
+  for (auto s : r.sliver) slivers += s;
+  std::cout << "strain: " << index.size() << " particles, " << r.simplices.size()
+            << (r.dim == 3 ? " tetrahedra" : " triangles") << " (" << slivers
+            << " slivers), time delaunay " << r.seconds_delaunay << " s, gradients "
+            << r.seconds_gradients << " s, averaging " << r.seconds_averaging << " s\n";
+}
+
+// ---- voidcells ----------------------------------------------------------------------------
+
+struct VoidArgs {
+  std::string input, output, vtu;
+  long from = 0;
+  std::optional<long> to;
+  double d50 = 0.0;
+  std::vector<double> cell_gradient;  // velocity gradient of a periodic cell, row-major 2x2
+};
+
+void run_voidcells(const VoidArgs& a) {
+  const Motion m = read_motion(a.input, a.from, a.to);
+  if (!m.frame.two_d) {
+    throw InputError(a.input,
+                     "void cells need a 2D frame (two_d is false); use `analyze strain "
+                     "--slab-...` for 3D data");
+  }
+  const double d50 = a.d50 > 0.0 ? a.d50 : analysis::d50(m.frame);
+  // Particles without a match in the target frame get no motion: they are left out.
+  Frame f = m.frame;
+  std::vector<Eigen::Vector2d> v(f.particles.size(), Eigen::Vector2d::Zero());
+  std::vector<std::uint8_t> matched(f.particles.size(), 0);
+  for (std::size_t k = 0; k < m.index.size(); ++k) {
+    v[static_cast<std::size_t>(m.index[k])] = m.u[k].head<2>();
+    matched[static_cast<std::size_t>(m.index[k])] = 1;
+  }
+  std::vector<Contact> kept;
+  std::unordered_map<std::int64_t, std::size_t> by_id;
+  for (std::size_t i = 0; i < f.particles.size(); ++i) by_id.emplace(f.particles[i].id, i);
+  for (const auto& c : f.contacts) {
+    const auto i1 = by_id.find(c.id1), i2 = by_id.find(c.id2);
+    if (i1 != by_id.end() && i2 != by_id.end() && (!matched[i1->second] || !matched[i2->second]))
+      continue;
+    kept.push_back(c);
+  }
+  f.contacts = kept;
+  analysis::VoidCellGraph cells;
+  analysis::VoidCellDeformation d;
+  analysis::ParticleGraph g;
+  try {
+    g = analysis::particle_graph(f);
+    cells = analysis::find_void_cells(g);
+    if (cells.euler() != cells.expected_euler) {
+      throw InputError(a.input,
+                       "particle graph is not planar: Euler L - M + N = " +
+                           std::to_string(cells.euler()) + ", expected",
+                       std::to_string(cells.expected_euler));
+    }
+    // Periodic images move with the cell: from velocities the cell velocity gradient given on
+    // the command line (default 0: fixed cell); between frames the change of the cell.
+    Eigen::Matrix2d rate = Eigen::Matrix2d::Zero();
+    if (a.cell_gradient.size() == 4) {
+      if (a.to) throw InputError(a.input, "--cell-velocity-gradient is for velocities, not --to");
+      const Eigen::Matrix2d lc{{a.cell_gradient[0], a.cell_gradient[1]},
+                               {a.cell_gradient[2], a.cell_gradient[3]}};
+      rate = lc * f.domain.cell.topLeftCorner<2, 2>();
+    }
+    if (a.to && f.domain.periodic) {
+      TrajectoryReader reader(a.input);
+      const Frame t = reader.frame(static_cast<std::size_t>(*a.to));
+      rate = (t.domain.cell - f.domain.cell).topLeftCorner<2, 2>();
+    }
+    d = analysis::void_cell_deformation(g, cells, v, d50, rate);
+  } catch (const std::invalid_argument& e) {
+    throw InputError(a.input, e.what());
+  }
+  H5Out h(a.output, "granoscope-voidcells");
+  h.attr("source", a.input);
+  h.attr("motion", m.kind);
+  h.attr("frame_from", static_cast<long long>(a.from));
+  h.attr("frame_to", static_cast<long long>(a.to.value_or(-1)));
+  h.attr("d50", d50);
+  h.attr("faces", static_cast<long long>(cells.faces));
+  h.attr("edges", static_cast<long long>(cells.edges));
+  h.attr("vertices", static_cast<long long>(cells.vertices));
+  h.attr("euler", static_cast<long long>(cells.euler()));
+  h.attr("removed_isolated", static_cast<long long>(cells.removed_isolated));
+  h.attr("removed_pendant", static_cast<long long>(cells.removed_pendant));
+  h.attr("removed_peninsular", static_cast<long long>(cells.removed_peninsular));
+  h.attr("removed_island", static_cast<long long>(cells.removed_island));
+  h.attr("periodic", static_cast<long long>(g.periodic ? 1 : 0));
+  h.group("/cells");
+  h.group("/particles");
+  std::vector<std::int64_t> offsets{0};
+  std::vector<std::int32_t> verts;
+  std::vector<double> poly, area, centroid, grad, alpha, w;
+  for (std::size_t i = 0; i < cells.cells.size(); ++i) {
+    const auto& c = cells.cells[i];
+    for (std::size_t k = 0; k < c.vertices.size(); ++k) {
+      verts.push_back(c.vertices[k]);
+      const Eigen::Vector2d p =
+          g.position[static_cast<std::size_t>(c.vertices[k])] + g.cell * c.image[k].cast<double>();
+      poly.push_back(p.x());
+      poly.push_back(p.y());
+    }
+    offsets.push_back(static_cast<std::int64_t>(verts.size()));
+    area.push_back(c.area);
+    centroid.push_back(c.centroid.x());
+    centroid.push_back(c.centroid.y());
+    for (int r = 0; r < 2; ++r)
+      for (int q = 0; q < 2; ++q) grad.push_back(d.gradient[i](r, q));
+  }
+  h.data("/cells/offsets", offsets);
+  h.data("/cells/vertices", verts);
+  h.data("/cells/polygon", poly, 2);
+  h.data("/cells/area", area);
+  h.data("/cells/centroid", centroid, 2);
+  h.data("/cells/gradient", grad, 4);
+  h.data("/cells/alpha", d.alpha);
+  h.data("/cells/w", d.w);
+  std::vector<std::int64_t> ids;
+  std::vector<double> pos, vrel;
+  for (std::size_t k = 0; k < f.particles.size(); ++k) {
+    ids.push_back(f.particles[k].id);
+    pos.push_back(g.position[k].x());
+    pos.push_back(g.position[k].y());
+    vrel.push_back(d.relative_velocity[k].x());
+    vrel.push_back(d.relative_velocity[k].y());
+  }
+  h.data("/particles/id", ids);
+  h.data("/particles/position", pos, 2);
+  h.data("/particles/active", cells.vertex_active);
+  h.data("/particles/relative_velocity", vrel, 2);
+  std::vector<double> mean{d.mean(0, 0), d.mean(0, 1), d.mean(1, 0), d.mean(1, 1)};
+  h.data("/mean_gradient", mean, 2);
+  h.attr("relative_velocity_scale", d.relative_velocity_scale);
+  h.commit();
+  if (!a.vtu.empty() && !cells.cells.empty()) {
+    write_voidcells_vtu(a.vtu, poly, offsets,
+                        {{"area", area}, {"alpha", d.alpha}, {"w", d.w}, {"gradient", grad}});
+  }
+  std::cout << "voidcells: L " << cells.faces << " M " << cells.edges << " N " << cells.vertices
+            << " (Euler " << cells.euler() << "), removed isolated " << cells.removed_isolated
+            << " pendant " << cells.removed_pendant << " peninsular " << cells.removed_peninsular
+            << " island " << cells.removed_island << "\n";
+}
+
+}  // namespace
+
+void register_analyze_strain(CLI::App& app) {
+  auto& analyze = analyze_command(app);
+  {
+    auto a = std::make_shared<StrainArgs>();
+    auto* s = analyze.add_subcommand(
+        "strain",
+        "Local strain on a Delaunay mesh of particle centres (3D tetrahedra, 2D "
+        "triangles, or a slab projected onto its plane)");
+    s->add_option("input", a->input, "RUN.h5 trajectory")->required();
+    s->add_option("-o,--output", a->output, "output HDF5 (format granoscope-strain)")->required();
+    s->add_option("--vtu", a->vtu, "also write a VTU mesh with cell and point data");
+    s->add_option("--from", a->from, "reference frame index (default 0)");
+    s->add_option("--to", a->to,
+                  "target frame: displacement from --from to --to matched by id; "
+                  "without it the velocities of --from are used");
+    s->add_option("--min-quality", a->min_quality,
+                  "simplices of lower quality are slivers, excluded from averages (0.02)");
+    s->add_flag("--weighted", a->weighted,
+                "3D: regular (weighted Delaunay) triangulation with weights radius^2");
+    s->add_option("--slab-origin", a->slab_origin, "slab mid-plane point x y z")->expected(3);
+    s->add_option("--slab-normal", a->slab_normal, "slab normal x y z")->expected(3);
+    s->add_option("--slab-axis", a->slab_axis, "in-plane x axis x y z")->expected(3);
+    s->add_option("--slab-thickness", a->slab_thickness, "slab thickness in m");
+    s->add_option("--slab-d50", a->slab_d50, "slab thickness in units of d50 (seed 000: 5)");
+    s->callback([a] { run_strain(*a); });
+  }
+  {
+    auto a = std::make_shared<VoidArgs>();
+    auto* s = analyze.add_subcommand("voidcells",
+                                     "Kuhn void cells of a 2D frame: per-cell velocity gradient, "
+                                     "alignment alpha, vorticity w, relative velocity");
+    s->add_option("input", a->input, "RUN.h5 trajectory (2D frames with contacts)")->required();
+    s->add_option("-o,--output", a->output, "output HDF5 (format granoscope-voidcells)")
+        ->required();
+    s->add_option("--from", a->from, "frame index (default 0)");
+    s->add_option("--to", a->to, "target frame: displacements instead of velocities");
+    s->add_option("--d50", a->d50, "D50 for eq 21 in m (default: from the frame)");
+    s->add_option("--vtu", a->vtu, "also write the void-cell polygons with cell data (VTU)");
+    s->add_option("--cell-velocity-gradient", a->cell_gradient,
+                  "periodic cell, velocity mode: cell velocity gradient L11 L12 L21 L22 (1/s); "
+                  "images of a particle move with v + L (cell shift)")
+        ->expected(4);
+    s->callback([a] { run_voidcells(*a); });
+  }
+}
+
+}  // namespace gs::cli
