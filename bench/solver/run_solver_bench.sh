@@ -46,6 +46,7 @@ dt_s = 1.0e-6
 damping = 0.08
 gravity_m_s2 = [0.0, 0.0, -9.81]
 steps = 20000
+max_overlap_ratio = 0.5
 [output]
 every = 100000
 history_every = 1000
