@@ -3,17 +3,6 @@
 // frames of a RUN.h5 matched by particle id, or the velocities of one frame. Outputs: HDF5
 // (root attribute format = granoscope-strain / granoscope-voidcells, for `granoscope figures`)
 // and optionally VTU, each written under a temporary name and renamed.
-#include <hdf5.h>
-#include <vtkCellArray.h>
-#include <vtkCellData.h>
-#include <vtkDoubleArray.h>
-#include <vtkIdTypeArray.h>
-#include <vtkNew.h>
-#include <vtkPointData.h>
-#include <vtkPoints.h>
-#include <vtkUnsignedCharArray.h>
-#include <vtkUnstructuredGrid.h>
-#include <vtkXMLUnstructuredGridWriter.h>
 
 #include <CLI/CLI.hpp>
 #include <Eigen/LU>
@@ -25,9 +14,10 @@
 #include <unordered_map>
 #include <vector>
 
-#include "atomic_file.hpp"
 #include "commands.hpp"
 #include "errors.hpp"
+#include "field_output.hpp"
+#include "frame_motion.hpp"
 #include "grain_size.hpp"
 #include "hdf5_trajectory.hpp"
 #include "kuhn_void_cells.hpp"
@@ -42,138 +32,14 @@ namespace {
 namespace fs = std::filesystem;
 using analysis::SimplexStrain;
 
-// ---- motion between frames or from velocities -------------------------------------------------
+// ---- outputs ------------------------------------------------------------------------------
 
-struct Motion {
-  Frame frame;                        // reference frame (particles in file order)
-  std::vector<std::int32_t> index;    // particles of `frame` that take part
-  std::vector<Eigen::Vector3d> x, u;  // their positions and displacements / velocities
-  std::string kind;                   // "displacement" or "velocity"
-};
-
-Motion read_motion(const std::string& path, long from, std::optional<long> to) {
-  if (!fs::exists(path)) throw InputError(path, "no such file");
-  TrajectoryReader reader(path);
-  const auto n = static_cast<long>(reader.frame_count());
-  const auto check = [&](long i, const char* what) {
-    if (i < 0 || i >= n) {
-      throw InputError(path, std::string(what) + " frame out of range 0.." + std::to_string(n - 1),
-                       std::to_string(i));
-    }
-  };
-  check(from, "reference");
-  Motion m;
-  m.frame = reader.frame(static_cast<std::size_t>(from));
-  if (!to) {
-    m.kind = "velocity";
-    for (std::size_t i = 0; i < m.frame.particles.size(); ++i) {
-      m.index.push_back(static_cast<std::int32_t>(i));
-      m.x.push_back(m.frame.particles[i].position);
-      m.u.push_back(m.frame.particles[i].velocity);
-    }
-    return m;
-  }
-  check(*to, "target");
-  m.kind = "displacement";
-  const Frame other = reader.frame(static_cast<std::size_t>(*to));
-  std::unordered_map<std::int64_t, std::size_t> by_id;
-  for (std::size_t i = 0; i < other.particles.size(); ++i) by_id.emplace(other.particles[i].id, i);
-  const bool periodic = m.frame.domain.periodic;
-  const Eigen::Matrix3d cell = m.frame.domain.cell;
-  const Eigen::Matrix3d inv = periodic ? Eigen::Matrix3d(cell.inverse()) : Eigen::Matrix3d::Zero();
-  for (std::size_t i = 0; i < m.frame.particles.size(); ++i) {
-    const auto it = by_id.find(m.frame.particles[i].id);
-    if (it == by_id.end()) continue;  // particle gone: not matched
-    Eigen::Vector3d d = other.particles[it->second].position - m.frame.particles[i].position;
-    if (periodic) {  // wrapped across the cell: minimum image
-      Eigen::Vector3d f = inv * d;
-      if (m.frame.two_d) f.z() = 0.0;
-      d -= cell * f.array().round().matrix();
-    }
-    m.index.push_back(static_cast<std::int32_t>(i));
-    m.x.push_back(m.frame.particles[i].position);
-    m.u.push_back(d);
-  }
-  if (m.index.empty()) throw InputError(path, "no particle id common to both frames");
-  return m;
+/// Row-major n × cols dataset.
+template <class T>
+void write_rows(H5FieldFile& h, const std::string& name, const std::vector<T>& v,
+                std::size_t cols) {
+  h.write(name, v, {cols > 0 ? v.size() / cols : 0, cols});
 }
-
-// ---- HDF5 output ---------------------------------------------------------------------------
-
-class H5 {
- public:
-  H5(hid_t id, herr_t (*close)(hid_t)) : id_(id), close_(close) {}
-  H5(const H5&) = delete;
-  H5& operator=(const H5&) = delete;
-  ~H5() {
-    if (id_ >= 0) close_(id_);
-  }
-  hid_t get() const { return id_; }
-
- private:
-  hid_t id_;
-  herr_t (*close_)(hid_t);
-};
-
-class H5Out {
- public:
-  H5Out(const fs::path& path, const std::string& format)
-      : out_(path),
-        file_(H5Fcreate(out_.temp_path().c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT),
-              H5Fclose) {
-    if (file_.get() < 0) throw InputError(path.string(), "cannot create output file");
-    attr("format", format);
-    attr("code_version", code_version());
-  }
-  void attr(const std::string& name, const std::string& value) {
-    H5 type(H5Tcopy(H5T_C_S1), H5Tclose);
-    H5Tset_size(type.get(), std::max<std::size_t>(1, value.size()));
-    H5 space(H5Screate(H5S_SCALAR), H5Sclose);
-    H5 a(H5Acreate2(file_.get(), name.c_str(), type.get(), space.get(), H5P_DEFAULT, H5P_DEFAULT),
-         H5Aclose);
-    const std::string buf = value.empty() ? std::string(1, '\0') : value;
-    if (a.get() < 0 || H5Awrite(a.get(), type.get(), buf.data()) < 0) fail(name);
-  }
-  void attr(const std::string& name, double value) { attr_num(name, H5T_NATIVE_DOUBLE, &value); }
-  void attr(const std::string& name, long long value) { attr_num(name, H5T_NATIVE_LLONG, &value); }
-  void group(const std::string& name) {
-    H5 g(H5Gcreate2(file_.get(), name.c_str(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose);
-    if (g.get() < 0) fail(name);
-  }
-  template <class T>
-  void data(const std::string& name, const std::vector<T>& v, hsize_t cols = 1) {
-    const hid_t type = std::is_same_v<T, double>         ? H5T_NATIVE_DOUBLE
-                       : std::is_same_v<T, std::int64_t> ? H5T_NATIVE_INT64
-                       : std::is_same_v<T, std::int32_t> ? H5T_NATIVE_INT32
-                                                         : H5T_NATIVE_UINT8;
-    const hsize_t dims[2] = {cols > 0 ? v.size() / cols : 0, cols};
-    H5 space(H5Screate_simple(cols == 1 ? 1 : 2, dims, nullptr), H5Sclose);
-    H5 d(H5Dcreate2(file_.get(), name.c_str(), type, space.get(), H5P_DEFAULT, H5P_DEFAULT,
-                    H5P_DEFAULT),
-         H5Dclose);
-    if (d.get() < 0 ||
-        (!v.empty() && H5Dwrite(d.get(), type, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data()) < 0)) {
-      fail(name);
-    }
-  }
-  void commit() {
-    if (H5Fflush(file_.get(), H5F_SCOPE_GLOBAL) < 0) fail("flush");
-    out_.commit();
-  }
-
- private:
-  void attr_num(const std::string& name, hid_t type, const void* value) {
-    H5 space(H5Screate(H5S_SCALAR), H5Sclose);
-    H5 a(H5Acreate2(file_.get(), name.c_str(), type, space.get(), H5P_DEFAULT, H5P_DEFAULT),
-         H5Aclose);
-    if (a.get() < 0 || H5Awrite(a.get(), type, value) < 0) fail(name);
-  }
-  [[noreturn]] void fail(const std::string& what) {
-    throw InputError(out_.target().string(), "cannot write HDF5 output", what);
-  }
-  AtomicOutput out_;
-  H5 file_;
-};
 
 std::vector<double> flat(const std::vector<Eigen::Matrix3d>& m, int dim) {
   std::vector<double> out;
@@ -184,30 +50,10 @@ std::vector<double> flat(const std::vector<Eigen::Matrix3d>& m, int dim) {
   return out;
 }
 
-// ---- VTU output ----------------------------------------------------------------------------
-
-vtkNew<vtkDoubleArray> vtk_array(const char* name, int comps, const std::vector<double>& v) {
-  vtkNew<vtkDoubleArray> a;
-  a->SetName(name);
-  a->SetNumberOfComponents(comps);
-  a->SetNumberOfTuples(static_cast<vtkIdType>(v.size() / static_cast<std::size_t>(comps)));
-  for (std::size_t i = 0; i < v.size(); ++i) a->SetValue(static_cast<vtkIdType>(i), v[i]);
-  return a;
-}
-
 void write_strain_vtu(const fs::path& path, const std::vector<Eigen::Vector3d>& x,
                       const SimplexStrain& r) {
-  vtkNew<vtkPoints> pts;
-  pts->SetDataTypeToDouble();
-  for (const auto& p : x) pts->InsertNextPoint(p.x(), p.y(), p.z());
-  vtkNew<vtkUnstructuredGrid> grid;
-  grid->SetPoints(pts);
-  const int nv = r.dim + 1;
-  grid->Allocate(static_cast<vtkIdType>(r.simplices.size()));
-  for (const auto& s : r.simplices) {
-    vtkIdType ids[4] = {s[0], s[1], s[2], s[3]};
-    grid->InsertNextCell(r.dim == 3 ? VTK_TETRA : VTK_TRIANGLE, nv, ids);
-  }
+  std::vector<std::vector<std::int64_t>> cells;
+  for (const auto& s : r.simplices) cells.emplace_back(s.begin(), s.begin() + r.dim + 1);
   std::vector<double> vol, shear, sliver, quality;
   for (std::size_t t = 0; t < r.simplices.size(); ++t) {
     const auto m = analysis::strain_measures(r.gradient[t], r.dim);
@@ -216,11 +62,6 @@ void write_strain_vtu(const fs::path& path, const std::vector<Eigen::Vector3d>& 
     sliver.push_back(r.sliver[t]);
     quality.push_back(r.quality[t]);
   }
-  grid->GetCellData()->AddArray(vtk_array("volumetric_strain", 1, vol));
-  grid->GetCellData()->AddArray(vtk_array("equivalent_shear_strain", 1, shear));
-  grid->GetCellData()->AddArray(vtk_array("quality", 1, quality));
-  grid->GetCellData()->AddArray(vtk_array("sliver", 1, sliver));
-  grid->GetCellData()->AddArray(vtk_array("gradient", 9, flat(r.gradient, 3)));
   std::vector<double> pvol, pshear, valid;
   for (std::size_t i = 0; i < x.size(); ++i) {
     const auto m = analysis::strain_measures(r.particle_gradient[i], r.dim);
@@ -228,46 +69,33 @@ void write_strain_vtu(const fs::path& path, const std::vector<Eigen::Vector3d>& 
     pshear.push_back(m.equivalent_shear);
     valid.push_back(r.particle_valid[i]);
   }
-  grid->GetPointData()->AddArray(vtk_array("volumetric_strain", 1, pvol));
-  grid->GetPointData()->AddArray(vtk_array("equivalent_shear_strain", 1, pshear));
-  grid->GetPointData()->AddArray(vtk_array("valid", 1, valid));
-  grid->GetPointData()->AddArray(vtk_array("gradient", 9, flat(r.particle_gradient, 3)));
-  AtomicOutput out(path);
-  vtkNew<vtkXMLUnstructuredGridWriter> w;
-  w->SetFileName(out.temp_path().c_str());
-  w->SetInputData(grid);
-  w->SetDataModeToBinary();
-  if (w->Write() != 1) throw InputError(path.string(), "cannot write VTU output");
-  out.commit();
+  write_vtu_mesh(path, x, r.dim == 3 ? 10 : 5, cells,
+                 {{"volumetric_strain", 1, pvol},
+                  {"equivalent_shear_strain", 1, pshear},
+                  {"valid", 1, valid},
+                  {"gradient", 9, flat(r.particle_gradient, 3)}},
+                 {{"volumetric_strain", 1, vol},
+                  {"equivalent_shear_strain", 1, shear},
+                  {"quality", 1, quality},
+                  {"sliver", 1, sliver},
+                  {"gradient", 9, flat(r.gradient, 3)}});
 }
 
 void write_voidcells_vtu(const fs::path& path, const std::vector<double>& polygon,
                          const std::vector<std::int64_t>& offsets,
                          const std::vector<std::pair<const char*, std::vector<double>>>& data) {
-  vtkNew<vtkPoints> pts;
-  pts->SetDataTypeToDouble();
-  for (std::size_t i = 0; i + 1 < polygon.size(); i += 2) {
-    pts->InsertNextPoint(polygon[i], polygon[i + 1], 0.0);
-  }
-  vtkNew<vtkUnstructuredGrid> grid;
-  grid->SetPoints(pts);
-  grid->Allocate(static_cast<vtkIdType>(offsets.size()));
+  std::vector<Eigen::Vector3d> pts;
+  for (std::size_t i = 0; i + 1 < polygon.size(); i += 2)
+    pts.emplace_back(polygon[i], polygon[i + 1], 0.0);
+  std::vector<std::vector<std::int64_t>> cells;
   for (std::size_t c = 0; c + 1 < offsets.size(); ++c) {
-    std::vector<vtkIdType> ids;
-    for (auto k = offsets[c]; k < offsets[c + 1]; ++k) ids.push_back(static_cast<vtkIdType>(k));
-    grid->InsertNextCell(VTK_POLYGON, static_cast<vtkIdType>(ids.size()), ids.data());
+    cells.emplace_back();
+    for (auto k = offsets[c]; k < offsets[c + 1]; ++k) cells.back().push_back(k);
   }
-  for (const auto& [name, values] : data) {
-    const auto comps = static_cast<int>(values.size() / (offsets.size() - 1));
-    grid->GetCellData()->AddArray(vtk_array(name, comps, values));
-  }
-  AtomicOutput out(path);
-  vtkNew<vtkXMLUnstructuredGridWriter> w;
-  w->SetFileName(out.temp_path().c_str());
-  w->SetInputData(grid);
-  w->SetDataModeToBinary();
-  if (w->Write() != 1) throw InputError(path.string(), "cannot write VTU output");
-  out.commit();
+  std::vector<VtkArray> cell_data;
+  for (const auto& [name, values] : data)
+    cell_data.push_back({name, static_cast<int>(values.size() / cells.size()), values});
+  write_vtu_mesh(path, pts, 7, cells, {}, cell_data);
 }
 
 // ---- strain -------------------------------------------------------------------------------
@@ -286,7 +114,7 @@ void run_strain(const StrainArgs& a) {
   if (!(a.min_quality >= 0.0 && a.min_quality < 1.0)) {
     throw InputError(a.input, "--min-quality must be in [0, 1)", value_str(a.min_quality));
   }
-  const Motion m = read_motion(a.input, a.from, a.to);
+  const FrameMotion m = read_frame_motion(a.input, a.from, a.to);
   const bool slab = !a.slab_normal.empty() || a.slab_thickness > 0.0 || a.slab_d50 > 0.0;
   SimplexStrain r;
   std::vector<std::int32_t> index = m.index;
@@ -329,7 +157,7 @@ void run_strain(const StrainArgs& a) {
   } catch (const std::invalid_argument& e) {
     throw InputError(a.input, e.what());
   }
-  H5Out h(a.output, "granoscope-strain");
+  H5FieldFile h(a.output, "granoscope-strain");
   h.attr("source", a.input);
   h.attr("motion", m.kind);
   h.attr("dim", static_cast<long long>(r.dim));
@@ -350,22 +178,22 @@ void run_strain(const StrainArgs& a) {
     shear.push_back(s.equivalent_shear);
     rot.push_back(s.rotation(1, 0));  // in-plane rotation (about z); 3D: see gradient
   }
-  h.data("/particles/id", ids);
-  h.data("/particles/position", pos, 3);
-  h.data("/particles/gradient", flat(r.particle_gradient, 3), 9);
-  h.data("/particles/valid", r.particle_valid);
-  h.data("/particles/volumetric_strain", vol);
-  h.data("/particles/equivalent_shear_strain", shear);
-  h.data("/particles/rotation_xy", rot);
+  h.write("/particles/id", ids);
+  write_rows(h, "/particles/position", pos, 3);
+  write_rows(h, "/particles/gradient", flat(r.particle_gradient, 3), 9);
+  h.write("/particles/valid", r.particle_valid);
+  h.write("/particles/volumetric_strain", vol);
+  h.write("/particles/equivalent_shear_strain", shear);
+  h.write("/particles/rotation_xy", rot);
   std::vector<std::int32_t> simp;
   for (const auto& s : r.simplices)
     for (int k = 0; k < r.dim + 1; ++k) simp.push_back(s[static_cast<std::size_t>(k)]);
-  h.data("/simplices/vertices", simp, static_cast<hsize_t>(r.dim + 1));
-  h.data("/simplices/measure", r.measure);
-  h.data("/simplices/quality", r.quality);
-  h.data("/simplices/sliver", r.sliver);
-  h.data("/simplices/gradient", flat(r.gradient, 3), 9);
-  h.data("/mean_gradient", flat({r.mean_gradient}, 3), 3);
+  write_rows(h, "/simplices/vertices", simp, static_cast<std::size_t>(r.dim + 1));
+  h.write("/simplices/measure", r.measure);
+  h.write("/simplices/quality", r.quality);
+  h.write("/simplices/sliver", r.sliver);
+  write_rows(h, "/simplices/gradient", flat(r.gradient, 3), 9);
+  write_rows(h, "/mean_gradient", flat({r.mean_gradient}, 3), 3);
   if (r.dim == 2) {  // triangle (Bagi eq 4) variant of seed 002's alpha and w maps
     std::vector<double> alpha, w;
     const Eigen::Matrix2d mean = r.mean_gradient.topLeftCorner<2, 2>();
@@ -373,8 +201,8 @@ void run_strain(const StrainArgs& a) {
       alpha.push_back(analysis::alignment(gt.topLeftCorner<2, 2>(), mean));
       w.push_back(analysis::normalised_vorticity(gt.topLeftCorner<2, 2>(), mean));
     }
-    h.data("/simplices/alpha", alpha);
-    h.data("/simplices/w", w);
+    h.write("/simplices/alpha", alpha);
+    h.write("/simplices/w", w);
   }
   h.commit();
   if (!a.vtu.empty()) write_strain_vtu(a.vtu, x3, r);
@@ -397,7 +225,7 @@ struct VoidArgs {
 };
 
 void run_voidcells(const VoidArgs& a) {
-  const Motion m = read_motion(a.input, a.from, a.to);
+  const FrameMotion m = read_frame_motion(a.input, a.from, a.to);
   if (!m.frame.two_d) {
     throw InputError(a.input,
                      "void cells need a 2D frame (two_d is false); use `analyze strain "
@@ -444,15 +272,14 @@ void run_voidcells(const VoidArgs& a) {
       rate = lc * f.domain.cell.topLeftCorner<2, 2>();
     }
     if (a.to && f.domain.periodic) {
-      TrajectoryReader reader(a.input);
-      const Frame t = reader.frame(static_cast<std::size_t>(*a.to));
+      const Frame t = read_frame(a.input, *a.to);
       rate = (t.domain.cell - f.domain.cell).topLeftCorner<2, 2>();
     }
     d = analysis::void_cell_deformation(g, cells, v, d50, rate);
   } catch (const std::invalid_argument& e) {
     throw InputError(a.input, e.what());
   }
-  H5Out h(a.output, "granoscope-voidcells");
+  H5FieldFile h(a.output, "granoscope-voidcells");
   h.attr("source", a.input);
   h.attr("motion", m.kind);
   h.attr("frame_from", static_cast<long long>(a.from));
@@ -488,14 +315,14 @@ void run_voidcells(const VoidArgs& a) {
     for (int r = 0; r < 2; ++r)
       for (int q = 0; q < 2; ++q) grad.push_back(d.gradient[i](r, q));
   }
-  h.data("/cells/offsets", offsets);
-  h.data("/cells/vertices", verts);
-  h.data("/cells/polygon", poly, 2);
-  h.data("/cells/area", area);
-  h.data("/cells/centroid", centroid, 2);
-  h.data("/cells/gradient", grad, 4);
-  h.data("/cells/alpha", d.alpha);
-  h.data("/cells/w", d.w);
+  h.write("/cells/offsets", offsets);
+  h.write("/cells/vertices", verts);
+  write_rows(h, "/cells/polygon", poly, 2);
+  h.write("/cells/area", area);
+  write_rows(h, "/cells/centroid", centroid, 2);
+  write_rows(h, "/cells/gradient", grad, 4);
+  h.write("/cells/alpha", d.alpha);
+  h.write("/cells/w", d.w);
   std::vector<std::int64_t> ids;
   std::vector<double> pos, vrel;
   for (std::size_t k = 0; k < f.particles.size(); ++k) {
@@ -505,12 +332,12 @@ void run_voidcells(const VoidArgs& a) {
     vrel.push_back(d.relative_velocity[k].x());
     vrel.push_back(d.relative_velocity[k].y());
   }
-  h.data("/particles/id", ids);
-  h.data("/particles/position", pos, 2);
-  h.data("/particles/active", cells.vertex_active);
-  h.data("/particles/relative_velocity", vrel, 2);
+  h.write("/particles/id", ids);
+  write_rows(h, "/particles/position", pos, 2);
+  h.write("/particles/active", cells.vertex_active);
+  write_rows(h, "/particles/relative_velocity", vrel, 2);
   std::vector<double> mean{d.mean(0, 0), d.mean(0, 1), d.mean(1, 0), d.mean(1, 1)};
-  h.data("/mean_gradient", mean, 2);
+  write_rows(h, "/mean_gradient", mean, 2);
   h.attr("relative_velocity_scale", d.relative_velocity_scale);
   h.commit();
   if (!a.vtu.empty() && !cells.cells.empty()) {

@@ -1,0 +1,314 @@
+#include "field_output.hpp"
+
+#include <hdf5.h>
+#include <vtkCellArray.h>
+#include <vtkCellData.h>
+#include <vtkDoubleArray.h>
+#include <vtkImageData.h>
+#include <vtkNew.h>
+#include <vtkPointData.h>
+#include <vtkPoints.h>
+#include <vtkPolyData.h>
+#include <vtkUnstructuredGrid.h>
+#include <vtkXMLImageDataWriter.h>
+#include <vtkXMLPolyDataWriter.h>
+#include <vtkXMLUnstructuredGridWriter.h>
+
+#include <algorithm>
+#include <numeric>
+
+#include "atomic_file.hpp"
+#include "errors.hpp"
+#include "snapshot.hpp"
+
+namespace gs {
+namespace {
+
+// Owns one HDF5 handle; a negative id is an error naming the file and the object.
+class Handle {
+ public:
+  Handle(hid_t id, herr_t (*close)(hid_t), const std::string& file, const std::string& what)
+      : id_(id), close_(close) {
+    if (id < 0) throw InputError(file, "cannot write HDF5 output", what);
+  }
+  Handle(const Handle&) = delete;
+  Handle& operator=(const Handle&) = delete;
+  ~Handle() { close_(id_); }
+  hid_t get() const { return id_; }
+
+ private:
+  hid_t id_;
+  herr_t (*close_)(hid_t);
+};
+
+template <class T>
+struct H5Type;
+template <>
+struct H5Type<double> {
+  static hid_t file() { return H5T_IEEE_F64LE; }
+  static hid_t mem() { return H5T_NATIVE_DOUBLE; }
+};
+template <>
+struct H5Type<float> {
+  static hid_t file() { return H5T_IEEE_F32LE; }
+  static hid_t mem() { return H5T_NATIVE_FLOAT; }
+};
+template <>
+struct H5Type<std::int64_t> {
+  static hid_t file() { return H5T_STD_I64LE; }
+  static hid_t mem() { return H5T_NATIVE_INT64; }
+};
+template <>
+struct H5Type<std::int32_t> {
+  static hid_t file() { return H5T_STD_I32LE; }
+  static hid_t mem() { return H5T_NATIVE_INT32; }
+};
+template <>
+struct H5Type<std::uint8_t> {
+  static hid_t file() { return H5T_STD_U8LE; }
+  static hid_t mem() { return H5T_NATIVE_UINT8; }
+};
+
+vtkNew<vtkDoubleArray> to_vtk(const VtkArray& a, std::size_t tuples, const std::string& file) {
+  const auto comps = static_cast<std::size_t>(std::max(1, a.components));
+  if (a.values.size() != tuples * comps) {
+    throw InputError(file, "VTK array " + a.name + " has the wrong length",
+                     std::to_string(a.values.size()) + " != " + std::to_string(tuples * comps));
+  }
+  vtkNew<vtkDoubleArray> v;
+  v->SetName(a.name.c_str());
+  v->SetNumberOfComponents(static_cast<int>(comps));
+  v->SetNumberOfTuples(static_cast<vtkIdType>(tuples));
+  for (std::size_t i = 0; i < a.values.size(); ++i)
+    v->SetValue(static_cast<vtkIdType>(i), a.values[i]);
+  return v;
+}
+
+vtkNew<vtkPoints> to_points(const std::vector<Eigen::Vector3d>& points) {
+  vtkNew<vtkPoints> pts;
+  pts->SetDataTypeToDouble();
+  pts->SetNumberOfPoints(static_cast<vtkIdType>(points.size()));
+  for (std::size_t i = 0; i < points.size(); ++i)
+    pts->SetPoint(static_cast<vtkIdType>(i), points[i].x(), points[i].y(), points[i].z());
+  return pts;
+}
+
+template <class Writer, class Data>
+void write_vtk(const std::filesystem::path& path, Data& data) {
+  AtomicOutput out(path);
+  vtkNew<Writer> w;
+  w->SetFileName(out.temp_path().string().c_str());
+  w->SetInputData(data);
+  w->SetDataModeToBinary();
+  if (w->Write() != 1) throw InputError(path.string(), "cannot write VTK output");
+  out.commit();
+}
+
+}  // namespace
+
+struct H5FieldFile::Impl {
+  explicit Impl(const std::filesystem::path& path)
+      : out(path),
+        name(path.string()),
+        file(H5Fcreate(out.temp_path().string().c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT),
+             H5Fclose, path.string(), "create") {}
+  AtomicOutput out;
+  std::string name;
+  Handle file;
+
+  hid_t object(const std::string& path) const {
+    return H5Oopen(file.get(), path.c_str(), H5P_DEFAULT);
+  }
+
+  void ensure_parents(const std::string& path) {
+    for (std::size_t p = path.find('/', 1); p != std::string::npos; p = path.find('/', p + 1)) {
+      const std::string g = path.substr(0, p);
+      if (H5Lexists(file.get(), g.c_str(), H5P_DEFAULT) <= 0) {
+        Handle(H5Gcreate2(file.get(), g.c_str(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose,
+               name, g);
+      }
+    }
+  }
+
+  template <class T>
+  void write(const std::string& path, const std::vector<T>& v, std::vector<std::size_t> dims) {
+    if (dims.empty()) dims = {v.size()};
+    const std::size_t n =
+        std::accumulate(dims.begin(), dims.end(), std::size_t{1}, std::multiplies<>());
+    if (n != v.size()) {
+      throw InputError(name, "dataset " + path + " shape does not match its data",
+                       std::to_string(n) + " != " + std::to_string(v.size()));
+    }
+    ensure_parents(path);
+    std::vector<hsize_t> hd(dims.begin(), dims.end());
+    const Handle space(H5Screate_simple(static_cast<int>(hd.size()), hd.data(), nullptr), H5Sclose,
+                       name, path);
+    const Handle plist(H5Pcreate(H5P_DATASET_CREATE), H5Pclose, name, path);
+    if (n >= 4096) {  // large arrays: chunked (about 1 MiB along the first axis) and compressed
+      std::vector<hsize_t> chunk(hd);
+      const std::size_t row = n / std::max<std::size_t>(1, dims[0]);
+      chunk[0] = std::clamp<hsize_t>((1u << 20) / sizeof(T) / std::max<std::size_t>(1, row), 1,
+                                     std::max<hsize_t>(1, hd[0]));
+      H5Pset_chunk(plist.get(), static_cast<int>(chunk.size()), chunk.data());
+      H5Pset_deflate(plist.get(), 1);
+    }
+    const Handle ds(H5Dcreate2(file.get(), path.c_str(), H5Type<T>::file(), space.get(),
+                               H5P_DEFAULT, plist.get(), H5P_DEFAULT),
+                    H5Dclose, name, path);
+    if (n > 0 &&
+        H5Dwrite(ds.get(), H5Type<T>::mem(), H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data()) < 0) {
+      throw InputError(name, "cannot write HDF5 output", path);
+    }
+  }
+
+  void attr(const std::string& attr_name, hid_t file_type, hid_t mem_type, const void* value,
+            const std::string& obj_path) {
+    const Handle obj(object(obj_path), H5Oclose, name, obj_path);
+    if (H5Aexists(obj.get(), attr_name.c_str()) > 0) H5Adelete(obj.get(), attr_name.c_str());
+    const Handle space(H5Screate(H5S_SCALAR), H5Sclose, name, attr_name);
+    const Handle a(
+        H5Acreate2(obj.get(), attr_name.c_str(), file_type, space.get(), H5P_DEFAULT, H5P_DEFAULT),
+        H5Aclose, name, attr_name);
+    if (H5Awrite(a.get(), mem_type, value) < 0)
+      throw InputError(name, "cannot write HDF5 output", attr_name);
+  }
+};
+
+H5FieldFile::H5FieldFile(const std::filesystem::path& path, const std::string& format)
+    : impl_(std::make_unique<Impl>(path)) {
+  attr("format", format);
+  attr("code_version", code_version());
+}
+
+H5FieldFile::~H5FieldFile() = default;
+
+void H5FieldFile::attr(const std::string& name, const std::string& value,
+                       const std::string& object) {
+  const Handle type(H5Tcopy(H5T_C_S1), H5Tclose, impl_->name, name);
+  H5Tset_size(type.get(), std::max<std::size_t>(1, value.size()));
+  H5Tset_strpad(type.get(), H5T_STR_NULLTERM);
+  const std::string buf = value.empty() ? std::string(1, '\0') : value;
+  impl_->attr(name, type.get(), type.get(), buf.data(), object);
+}
+
+void H5FieldFile::attr(const std::string& name, double value, const std::string& object) {
+  impl_->attr(name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &value, object);
+}
+
+void H5FieldFile::attr(const std::string& name, long long value, const std::string& object) {
+  impl_->attr(name, H5T_STD_I64LE, H5T_NATIVE_LLONG, &value, object);
+}
+
+void H5FieldFile::group(const std::string& name) {
+  impl_->ensure_parents(name + "/");
+}
+
+void H5FieldFile::write(const std::string& name, const std::vector<double>& v,
+                        const std::vector<std::size_t>& dims) {
+  impl_->write(name, v, dims);
+}
+void H5FieldFile::write(const std::string& name, const std::vector<float>& v,
+                        const std::vector<std::size_t>& dims) {
+  impl_->write(name, v, dims);
+}
+void H5FieldFile::write(const std::string& name, const std::vector<std::int64_t>& v,
+                        const std::vector<std::size_t>& dims) {
+  impl_->write(name, v, dims);
+}
+void H5FieldFile::write(const std::string& name, const std::vector<std::int32_t>& v,
+                        const std::vector<std::size_t>& dims) {
+  impl_->write(name, v, dims);
+}
+void H5FieldFile::write(const std::string& name, const std::vector<std::uint8_t>& v,
+                        const std::vector<std::size_t>& dims) {
+  impl_->write(name, v, dims);
+}
+
+void H5FieldFile::write(const std::string& name, const std::vector<Eigen::Vector3d>& v) {
+  std::vector<double> flat;
+  flat.reserve(3 * v.size());
+  for (const auto& x : v) flat.insert(flat.end(), {x.x(), x.y(), x.z()});
+  impl_->write(name, flat, {v.size(), 3});
+}
+
+void H5FieldFile::write(const std::string& name, const std::vector<Eigen::Matrix3d>& v) {
+  std::vector<double> flat;
+  flat.reserve(9 * v.size());
+  for (const auto& m : v)
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) flat.push_back(m(i, j));
+  impl_->write(name, flat, {v.size(), 3, 3});
+}
+
+void H5FieldFile::commit() {
+  if (H5Fflush(impl_->file.get(), H5F_SCOPE_GLOBAL) < 0)
+    throw InputError(impl_->name, "cannot write HDF5 output", "flush");
+  impl_->out.commit();
+}
+
+const std::filesystem::path& H5FieldFile::target() const {
+  return impl_->out.target();
+}
+
+void write_vtu_mesh(const std::filesystem::path& path, const std::vector<Eigen::Vector3d>& points,
+                    int vtk_cell_type, const std::vector<std::vector<std::int64_t>>& cells,
+                    const std::vector<VtkArray>& point_data,
+                    const std::vector<VtkArray>& cell_data) {
+  vtkNew<vtkUnstructuredGrid> grid;
+  grid->SetPoints(to_points(points));
+  grid->Allocate(static_cast<vtkIdType>(cells.size()));
+  std::vector<vtkIdType> ids;
+  for (const auto& c : cells) {
+    ids.assign(c.begin(), c.end());
+    for (const auto id : ids) {
+      if (id < 0 || id >= static_cast<vtkIdType>(points.size()))
+        throw InputError(path.string(), "VTU cell refers to a missing point", std::to_string(id));
+    }
+    grid->InsertNextCell(vtk_cell_type, static_cast<vtkIdType>(ids.size()), ids.data());
+  }
+  for (const auto& a : point_data)
+    grid->GetPointData()->AddArray(to_vtk(a, points.size(), path.string()));
+  for (const auto& a : cell_data)
+    grid->GetCellData()->AddArray(to_vtk(a, cells.size(), path.string()));
+  write_vtk<vtkXMLUnstructuredGridWriter>(path, grid);
+}
+
+void write_vtp_polylines(const std::filesystem::path& path,
+                         const std::vector<Eigen::Vector3d>& points,
+                         const std::vector<std::vector<std::int64_t>>& lines,
+                         const std::vector<VtkArray>& point_data,
+                         const std::vector<VtkArray>& cell_data) {
+  vtkNew<vtkPolyData> poly;
+  poly->SetPoints(to_points(points));
+  vtkNew<vtkCellArray> cells;
+  std::vector<vtkIdType> ids;
+  for (const auto& l : lines) {
+    ids.assign(l.begin(), l.end());
+    for (const auto id : ids) {
+      if (id < 0 || id >= static_cast<vtkIdType>(points.size()))
+        throw InputError(path.string(), "VTP line refers to a missing point", std::to_string(id));
+    }
+    cells->InsertNextCell(static_cast<vtkIdType>(ids.size()), ids.data());
+  }
+  poly->SetLines(cells);
+  for (const auto& a : point_data)
+    poly->GetPointData()->AddArray(to_vtk(a, points.size(), path.string()));
+  for (const auto& a : cell_data)
+    poly->GetCellData()->AddArray(to_vtk(a, lines.size(), path.string()));
+  write_vtk<vtkXMLPolyDataWriter>(path, poly);
+}
+
+void write_vti_image(const std::filesystem::path& path, const Eigen::Vector3d& origin,
+                     const Eigen::Vector3d& spacing, const std::array<int, 3>& dims,
+                     const std::vector<VtkArray>& point_data) {
+  vtkNew<vtkImageData> img;
+  img->SetDimensions(dims[0], dims[1], dims[2]);
+  img->SetOrigin(origin.x(), origin.y(), origin.z());
+  img->SetSpacing(spacing.x(), spacing.y(), spacing.z());
+  const auto n = static_cast<std::size_t>(dims[0]) * static_cast<std::size_t>(dims[1]) *
+                 static_cast<std::size_t>(dims[2]);
+  for (const auto& a : point_data) img->GetPointData()->AddArray(to_vtk(a, n, path.string()));
+  write_vtk<vtkXMLImageDataWriter>(path, img);
+}
+
+}  // namespace gs
