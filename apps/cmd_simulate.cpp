@@ -107,7 +107,7 @@ Index read_index(const fs::path& path) {
   std::string k, v;
   while (in >> k >> v) index[k] = v;
   for (const char* key : {"step", "programme", "frames", "last_frame", "last_frame_step",
-                          "history_rows", "curve_rows", "prep_rows", "state"})
+                          "last_curve_step", "history_rows", "curve_rows", "prep_rows", "state"})
     if (!index.count(key)) throw InputError(path.string(), "incomplete checkpoint index", key);
   return index;
 }
@@ -189,16 +189,21 @@ void run(const Args& a) {
   std::int64_t last_frame_step = -1;
   Index ck;
 
+  std::int64_t last_curve_step = -1;
   auto curve_for = [&](std::size_t i) -> CsvOutput& {
     return programmes[i]->name() == "preparation" ? prep_curve : curve;
   };
   auto open_curve = [&](std::size_t i) {
     const std::string h = programmes[i]->curve_header();
     if (!h.empty()) curve_for(i).create(h);
+    last_curve_step = -1;
   };
   auto curve_row = [&] {
     CsvOutput& c = curve_for(k);
-    if (c.open()) c.append(programmes[k]->curve_row(sim));
+    if (c.open() && last_curve_step != sim.step_count()) {
+      c.append(programmes[k]->curve_row(sim));
+      last_curve_step = sim.step_count();
+    }
   };
   auto write_frame = [&] {
     if (!writer) writer.emplace(traj, meta, TrajectoryWriter::Options{.discard_unfinished = false});
@@ -216,6 +221,7 @@ void run(const Args& a) {
                {"frames", std::to_string(writer ? writer->frames_written() : 0)},
                {"last_frame", std::to_string(last_frame)},
                {"last_frame_step", std::to_string(last_frame_step)},
+               {"last_curve_step", std::to_string(last_curve_step)},
                {"history_rows", std::to_string(history.rows())},
                {"curve_rows", std::to_string(curve.open() ? curve.rows() : 0)},
                {"prep_rows", std::to_string(prep_curve.open() ? prep_curve.rows() : 0)},
@@ -242,6 +248,7 @@ void run(const Args& a) {
     programmes[k]->load_state(extra);
     last_frame = as_int(ck, "last_frame", ckpt_index);
     last_frame_step = as_int(ck, "last_frame_step", ckpt_index);
+    last_curve_step = as_int(ck, "last_curve_step", ckpt_index);
     const auto frames = static_cast<std::size_t>(as_int(ck, "frames", ckpt_index));
     if (frames > 0)
       writer.emplace(TrajectoryWriter::resume(traj, frames, {.discard_unfinished = false}));
@@ -277,6 +284,7 @@ void run(const Args& a) {
       if (programmes[k]->finished(sim)) {
         const std::string sum = programmes[k]->summary(sim);
         if (!sum.empty()) std::printf("%s\n", sum.c_str());
+        curve_row();  // the state at the programme's end
         if (k + 1 == programmes.size()) break;
         if (programmes[k]->name() == "preparation") {
           prep_curve.finish();
@@ -296,6 +304,7 @@ void run(const Args& a) {
       }
       if (max_step > 0 && sim.step_count() >= max_step) break;
       programmes[k]->control(sim);
+      if (programmes[k]->finished(sim)) continue;  // ended by its control (a stage check)
       sim.step();
       const std::int64_t s = sim.step_count();
       if (s % scene.output.history_every == 0) {
@@ -336,7 +345,6 @@ void run(const Args& a) {
   // Final rows and frame, unless the last step already wrote them.
   const std::int64_t s = sim.step_count();
   if (s % scene.output.history_every != 0) history.append(history_row(sim));
-  if (s % scene.output.curve_every != 0) curve_row();
   if (programmes[k]->name() != "preparation" && last_frame_step != s) write_frame();
   history.finish();
   curve.finish();

@@ -52,11 +52,10 @@ double solid_volume(const Simulation& sim) {
 
 SpecimenGauge cuboid_gauge() {
   SpecimenGauge g;
+  g.box = [](const Simulation& sim) { return std::make_pair(cuboid_lo(sim), cuboid_hi(sim)); };
   g.servo_walls = {kXmin, kXmax, kYmin, kYmax, kZmin, kZmax};
   g.inward = [](const Simulation&, std::size_t w) { return cuboid_inward(w); };
   g.area_m2 = [](const Simulation& sim, std::size_t w) { return cuboid_face_area(sim, w); };
-  g.volume_m3 = [](const Simulation& sim) { return (cuboid_hi(sim) - cuboid_lo(sim)).prod(); };
-  g.solid_volume_m3 = [](const Simulation& sim) { return solid_volume(sim); };
   return g;
 }
 

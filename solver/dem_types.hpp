@@ -66,6 +66,8 @@ struct WallState {
   Eigen::Vector3d vel = Eigen::Vector3d::Zero();
   Eigen::Vector3d force = Eigen::Vector3d::Zero(), torque = Eigen::Vector3d::Zero();
   bool active = true;  // an inactive wall touches nothing (e.g. replaced by a membrane)
+  double contact_stiffness = 0;  // Σ Kn of its contacts in the last step, N/m
+  std::size_t contacts = 0;      // its contacts in the last step
 };
 
 /// History of one contact (YADE's CohFrictPhys + ScGeom state that survives between steps).

@@ -54,13 +54,11 @@ SpecimenGauge shear_box_gauge(const ShearBoxGeometry& g, const ShearBoxWalls& w)
   const std::size_t platen = w.platen;
   gauge.inward = [](const Simulation&, std::size_t) { return Eigen::Vector3d(0, 0, -1); };
   gauge.area_m2 = [area](const Simulation&, std::size_t) { return area; };
-  gauge.volume_m3 = [area, t, platen](const Simulation& sim) {
-    return area * (sim.walls()[platen].pos.z() - 0.5 * t);
-  };
-  gauge.solid_volume_m3 = [](const Simulation& sim) {
-    double v = 0;
-    for (const double r : sim.particles().radius) v += 4.0 / 3.0 * M_PI * r * r * r;
-    return v;
+  const Eigen::Vector2d footprint(g.length_m, g.width_m);
+  gauge.box = [footprint, t, platen](const Simulation& sim) {
+    return std::make_pair(
+        Eigen::Vector3d::Zero().eval(),
+        Eigen::Vector3d(footprint.x(), footprint.y(), sim.walls()[platen].pos.z() - 0.5 * t));
   };
   return gauge;
 }

@@ -120,7 +120,10 @@ std::vector<std::unique_ptr<LoadingProgramme>> scene_programmes(Scene& s) {
       throw InputError(s.file.string(), std::string("[direct_shear]: ") + e.what());
     }
   }
+  const double inset = max_diameter(s.particles);  // the loose layer along a wall
+  s.triaxial.core_inset_m = s.plane_strain.core_inset_m = inset;
   if (s.preparation) {
+    if (s.preparation->core_inset_m < 0) s.preparation->core_inset_m = inset;
     try {
       out.push_back(std::make_unique<SpecimenPreparation>(*s.preparation, *gauge, test_friction));
     } catch (const std::invalid_argument& e) {

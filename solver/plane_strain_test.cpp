@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "cuboid_walls.hpp"
+#include "specimen_preparation.hpp"
 #include "triaxial_test.hpp"
 
 namespace gs::solver {
@@ -73,7 +74,8 @@ std::int64_t PlaneStrainTest::frame_index(const Simulation& sim) const {
 
 std::string PlaneStrainTest::curve_header() const {
   return "step,time_s,eps1_shortening,eps_v_dilation,sigma1_Pa,sigma2_Pa,sigma3_Pa,p_Pa,q_Pa,"
-         "sin_phi,phi_deg,void_ratio,width_m,coordination,inertial_number,unbalanced_force,"
+         "sin_phi,phi_deg,void_ratio,core_void_ratio,width_m,coordination,inertial_number,"
+         "unbalanced_force,"
          "membrane_particles";
 }
 
@@ -102,14 +104,27 @@ std::string PlaneStrainTest::curve_row(const Simulation& sim) const {
     std::cerr << "warning: plane_strain: inertial number " << inertial << " exceeds "
               << spec_.inertial_warning << " (not quasi-static; lower the strain rate)\n";
   }
+  // Core: between the mean membrane positions and the caps / plane-strain walls, inset.
+  double xm = 0, xp = 0;
+  std::size_t hits = 0;
+  for (std::size_t b = 0; b < m.x_minus.size(); ++b) {
+    if (!std::isfinite(m.x_minus[b])) continue;
+    xm += m.x_minus[b];
+    xp += m.x_plus[b];
+    ++hits;
+  }
+  const double in = spec_.core_inset_m;
+  const Eigen::Vector3d clo(xm / std::max<std::size_t>(1, hits) + in, lo.y() + in, lo.z() + in);
+  const Eigen::Vector3d chi(xp / std::max<std::size_t>(1, hits) - in, hi.y() - in, hi.z() - in);
+  const double e_core = box_void_ratio(sim.particles(), clo, chi);
   char buf[512];
   std::snprintf(buf, sizeof buf,
-                "%lld,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.6g,%.6g,%.6g,"
-                "%zu",
+                "%lld,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.6g,%.6g,"
+                "%.6g,%zu",
                 static_cast<long long>(sim.step_count()), sim.time(), axial_strain(sim),
                 (m.volume_m3 - v0_) / v0_, s1, s2, s3, p, q, (s1 - s3) / (s1 + s3), phi,
-                m.volume_m3 / solid_volume(sim) - 1, width, coordination_number(sim), inertial,
-                sim.unbalanced_force(), m.particle.size());
+                m.volume_m3 / solid_volume(sim) - 1, e_core, width, coordination_number(sim),
+                inertial, sim.unbalanced_force(), m.particle.size());
   return buf;
 }
 

@@ -20,7 +20,8 @@ struct PlaneStrainSpec {
   double membrane_stencil_m = 0;  // slope stencil half-width (0: d50)
   std::int64_t refresh_steps = 20;
   double inertial_warning = 1e-4;
-  double d50_m = 0;  // 0: mean diameter
+  double d50_m = 0;         // 0: mean diameter
+  double core_inset_m = 0;  // core void ratio: box inset by this from the boundaries
 };
 
 class PlaneStrainTest final : public LoadingProgramme {

@@ -168,9 +168,9 @@ void read_lab_sections(const Reader& r, const toml::table& root, Scene& s) {
   if (!s.test.empty() && (prep || s.specimen)) {
     auto& p = s.preparation.emplace();
     r.only(prep, "preparation",
-           {"pressure_Pa", "void_ratio", "friction_start_deg", "friction_factor", "stage_steps",
-            "check_every", "stress_tolerance", "unbalanced_force", "kinetic_ratio", "servo_gain",
-            "max_wall_speed_m_s", "deposition", "max_steps"});
+           {"pressure_Pa", "void_ratio", "core_inset_m", "friction_start_deg", "friction_factor",
+            "stage_steps", "check_every", "stress_tolerance", "unbalanced_force", "kinetic_ratio",
+            "servo_gain", "max_wall_speed_m_s", "deposition", "max_steps"});
     // Default: the stress of the test (σc, or σn of the direct shear).
     const double test_stress = s.test == "triaxial"       ? s.triaxial.confining_Pa
                                : s.test == "plane_strain" ? s.plane_strain.confining_Pa
@@ -179,6 +179,7 @@ void read_lab_sections(const Reader& r, const toml::table& root, Scene& s) {
     if (p.pressure_Pa < 0) r.fail("preparation.pressure_Pa", "negative", value_str(p.pressure_Pa));
     p.void_ratio_target = r.number(prep, "preparation", "void_ratio", false,
                                    s.specimen ? s.specimen->void_ratio : -1);
+    p.core_inset_m = r.number(prep, "preparation", "core_inset_m", false, -1);
     p.friction_start_deg = r.number(prep, "preparation", "friction_start_deg", false, -1);
     p.friction_factor =
         r.positive(prep, "preparation", "friction_factor", false, p.friction_factor);

@@ -107,16 +107,7 @@ void Simulation::attach_histories(const std::vector<ContactHistory>& old) {
 }
 
 std::pair<double, std::size_t> Simulation::wall_stiffness(std::size_t w) const {
-  const auto code = kWallBase + static_cast<std::uint32_t>(w);
-  double k = 0;
-  std::size_t count = 0;
-  for (std::size_t c = 0; c < hist_.size(); ++c) {
-    if (hist_[c].real && hist_[c].b == code) {
-      k += params_[c].kn;
-      ++count;
-    }
-  }
-  return {k, count};
+  return {walls_.at(w).contact_stiffness, walls_[w].contacts};
 }
 
 void Simulation::set_friction_deg(double friction_deg) {
@@ -199,6 +190,8 @@ void Simulation::step() {
   for (auto& w : walls_) {
     w.force.setZero();
     w.torque.setZero();
+    w.contact_stiffness = 0;
+    w.contacts = 0;
   }
   double max_overlap_ratio = 0;
   for (std::size_t k = 0; k < np; ++k) {
@@ -210,6 +203,8 @@ void Simulation::step() {
     if (b >= kWallBase) {
       WallState& w = walls_[b - kWallBase];
       w.force += L.force1;
+      w.contact_stiffness += params_[k].kn;
+      ++w.contacts;
       w.torque += L.arm1;
       w.torque += -L.moment;
       p_.force[a] += -L.force1;
@@ -502,6 +497,10 @@ void Simulation::save_checkpoint(const std::filesystem::path& path,
       put(o, w.normal);
       put(o, w.vel);
       put(o, static_cast<std::uint8_t>(w.active));
+      put(o, w.force);  // loads of the last step: what a servo reads before the next one
+      put(o, w.torque);
+      put(o, w.contact_stiffness);
+      put(o, static_cast<std::uint64_t>(w.contacts));
     }
     // Contact histories of real contacts, sorted by pair.
     std::vector<ContactHistory> real;
@@ -553,6 +552,12 @@ std::string Simulation::load_checkpoint(const std::filesystem::path& path) {
     std::uint8_t active = 1;
     get(in, active, file);
     w.active = active != 0;
+    get(in, w.force, file);
+    get(in, w.torque, file);
+    get(in, w.contact_stiffness, file);
+    std::uint64_t contacts = 0;
+    get(in, contacts, file);
+    w.contacts = static_cast<std::size_t>(contacts);
   }
   std::uint64_t nc = 0;
   get(in, nc, file);

@@ -2,7 +2,10 @@
 
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <stdexcept>
+
+#include "sphere_box_volume.hpp"
 
 namespace gs::solver {
 
@@ -16,14 +19,38 @@ SpecimenPreparation::SpecimenPreparation(PreparationSpec spec, SpecimenGauge gau
     throw std::invalid_argument("preparation needs a pressure or deposition");
 }
 
+double box_void_ratio(const ParticleState& p, const Eigen::Vector3d& lo,
+                      const Eigen::Vector3d& hi) {
+  double solid = 0;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const Eigen::Vector3d& c = p.pos[i];
+    const double r = p.radius[i];
+    if (((c.array() - r) >= lo.array()).all() && ((c.array() + r) <= hi.array()).all())
+      solid += 4.0 / 3.0 * M_PI * r * r * r;  // wholly inside
+    else if (((c.array() + r) > lo.array()).all() && ((c.array() - r) < hi.array()).all())
+      solid += analysis::sphere_box_volume(c, r, lo, hi);
+  }
+  return (hi - lo).prod() / solid - 1;
+}
+
 double SpecimenPreparation::void_ratio(const Simulation& sim) const {
-  return gauge_.volume_m3(sim) / gauge_.solid_volume_m3(sim) - 1;
+  const auto [lo, hi] = gauge_.box(sim);
+  return box_void_ratio(sim.particles(), lo, hi);
+}
+
+double SpecimenPreparation::core_void_ratio(const Simulation& sim) const {
+  auto [lo, hi] = gauge_.box(sim);
+  lo.array() += spec_.core_inset_m;
+  hi.array() -= spec_.core_inset_m;
+  if (((hi - lo).array() <= 0).any()) return std::numeric_limits<double>::quiet_NaN();
+  return box_void_ratio(sim.particles(), lo, hi);
 }
 
 void SpecimenPreparation::start(Simulation& sim) {
   first_step_ = stage_start_ = sim.step_count();
   friction_ = spec_.friction_start_deg >= 0 ? spec_.friction_start_deg : test_friction_;
   sim.set_friction_deg(friction_);
+  lowest_friction_ = friction_;
   gravity_saved_ = sim.config().gravity;
   if (spec_.deposition) {
     stage_ = kDeposition;
@@ -60,11 +87,12 @@ void SpecimenPreparation::next_stage(Simulation& sim) {
   }
   if (stage_ == kCompaction || stage_ == kLowering) {
     const bool dense_enough =
-        spec_.void_ratio_target < 0 || void_ratio(sim) <= spec_.void_ratio_target;
+        spec_.void_ratio_target < 0 || core_void_ratio(sim) <= spec_.void_ratio_target;
     if (!dense_enough && friction_ > 0) {
       stage_ = kLowering;
       friction_ *= spec_.friction_factor;
       if (friction_ < spec_.friction_floor_deg) friction_ = 0;
+      lowest_friction_ = friction_;
       sim.set_friction_deg(friction_);
       return;
     }
@@ -108,7 +136,8 @@ double SpecimenPreparation::progress(const Simulation& sim) const {
 }
 
 std::string SpecimenPreparation::curve_header() const {
-  std::string h = "step,time_s,stage,friction_deg,void_ratio,unbalanced_force,kinetic_J";
+  std::string h =
+      "step,time_s,stage,friction_deg,void_ratio,core_void_ratio,unbalanced_force,kinetic_J";
   for (std::size_t k = 0; k < gauge_.servo_walls.size(); ++k)
     h += ",wall" + std::to_string(gauge_.servo_walls[k]) + "_stress_Pa";
   return h;
@@ -116,10 +145,10 @@ std::string SpecimenPreparation::curve_header() const {
 
 std::string SpecimenPreparation::curve_row(const Simulation& sim) const {
   char buf[256];
-  std::snprintf(buf, sizeof buf, "%lld,%.9g,%lld,%.9g,%.9g,%.6g,%.6g",
+  std::snprintf(buf, sizeof buf, "%lld,%.9g,%lld,%.9g,%.9g,%.9g,%.6g,%.6g",
                 static_cast<long long>(sim.step_count()), sim.time(),
-                static_cast<long long>(stage_), friction_, void_ratio(sim), sim.unbalanced_force(),
-                sim.kinetic_energy());
+                static_cast<long long>(stage_), friction_, void_ratio(sim), core_void_ratio(sim),
+                sim.unbalanced_force(), sim.kinetic_energy());
   std::string row = buf;
   for (const auto w : gauge_.servo_walls) {
     std::snprintf(buf, sizeof buf, ",%.9g",
@@ -132,10 +161,10 @@ std::string SpecimenPreparation::curve_row(const Simulation& sim) const {
 std::string SpecimenPreparation::summary(const Simulation& sim) const {
   char buf[256];
   std::snprintf(buf, sizeof buf,
-                "preparation: %lld steps, void ratio %.4f (target %.4f), friction while "
-                "compacting ended at %.3g deg",
-                static_cast<long long>(sim.step_count() - first_step_), void_ratio(sim),
-                spec_.void_ratio_target, friction_);
+                "preparation: %lld steps, void ratio %.4f in the core (%.4g m from the walls; "
+                "target %.4f), %.4f over the whole box; friction lowered to %.3g deg",
+                static_cast<long long>(sim.step_count() - first_step_), core_void_ratio(sim),
+                spec_.core_inset_m, spec_.void_ratio_target, void_ratio(sim), lowest_friction_);
   return buf;
 }
 
@@ -145,6 +174,7 @@ std::string SpecimenPreparation::save_state() const {
   st.set("stage_start", stage_start_);
   st.set("first_step", first_step_);
   st.set("friction", friction_);
+  st.set("lowest_friction", lowest_friction_);
   st.set("gx", gravity_saved_.x());
   st.set("gy", gravity_saved_.y());
   st.set("gz", gravity_saved_.z());
@@ -157,6 +187,7 @@ void SpecimenPreparation::load_state(const std::string& state) {
   stage_start_ = st.integer("stage_start");
   first_step_ = st.integer("first_step");
   friction_ = st.number("friction");
+  lowest_friction_ = st.number("lowest_friction");
   gravity_saved_ = {st.number("gx"), st.number("gy"), st.number("gz")};
 }
 

@@ -27,6 +27,8 @@ struct PreparationSpec {
   double kinetic_ratio = 1e-3;      // kinetic / elastic energy threshold
   double servo_gain = 0.25;         // fraction of the stress error removed per step
   double max_wall_speed_m_s = 0.1;
+  double core_inset_m = 0;  // void ratio of the core box inset by this from the walls (0: whole
+                            // box); walls loosen the layer of grains they touch
   bool deposition = false;  // first let the cloud settle under gravity
   Eigen::Vector3d deposition_gravity = Eigen::Vector3d(0, 0, -9.81);
   std::int64_t max_steps = 0;  // 0: no limit
@@ -35,12 +37,15 @@ struct PreparationSpec {
 /// How a test measures its specimen: the walls the servo drives with their inward normals and
 /// loaded areas, and the specimen volume (all may change as the walls move).
 struct SpecimenGauge {
+  /// The specimen box between the walls (lo, hi).
+  std::function<std::pair<Eigen::Vector3d, Eigen::Vector3d>(const Simulation&)> box;
   std::vector<std::size_t> servo_walls;
   std::function<Eigen::Vector3d(const Simulation&, std::size_t wall)> inward;
   std::function<double(const Simulation&, std::size_t wall)> area_m2;
-  std::function<double(const Simulation&)> volume_m3;
-  std::function<double(const Simulation&)> solid_volume_m3;
 };
+
+/// Void ratio of the box [lo, hi] from the exact sphere–box intersection volumes.
+double box_void_ratio(const ParticleState& p, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi);
 
 class SpecimenPreparation final : public LoadingProgramme {
  public:
@@ -60,7 +65,9 @@ class SpecimenPreparation final : public LoadingProgramme {
 
   enum Stage : std::int64_t { kDeposition = 0, kCompaction, kLowering, kSettling, kDone };
   Stage stage() const { return static_cast<Stage>(stage_); }
+  /// Void ratio of the whole box and of its core (the box inset by core_inset_m).
   double void_ratio(const Simulation& sim) const;
+  double core_void_ratio(const Simulation& sim) const;
   double friction_deg() const { return friction_; }
 
  private:
@@ -73,7 +80,7 @@ class SpecimenPreparation final : public LoadingProgramme {
   std::int64_t stage_ = kCompaction;
   std::int64_t stage_start_ = 0;  // step at which the stage began
   std::int64_t first_step_ = 0;
-  double friction_ = 0;
+  double friction_ = 0, lowest_friction_ = 0;
   Eigen::Vector3d gravity_saved_ = Eigen::Vector3d::Zero();
 };
 

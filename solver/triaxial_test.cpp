@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "cuboid_walls.hpp"
+#include "specimen_preparation.hpp"
 
 namespace gs::solver {
 
@@ -86,7 +87,8 @@ std::int64_t TriaxialTest::frame_index(const Simulation& sim) const {
 
 std::string TriaxialTest::curve_header() const {
   return "step,time_s,eps1_shortening,eps2_shortening,eps3_shortening,eps_v_dilation,"
-         "sigma1_Pa,sigma2_Pa,sigma3_Pa,p_Pa,q_Pa,sin_phi,phi_deg,void_ratio,coordination,"
+         "sigma1_Pa,sigma2_Pa,sigma3_Pa,p_Pa,q_Pa,sin_phi,phi_deg,void_ratio,core_void_ratio,"
+         "coordination,"
          "inertial_number,unbalanced_force";
 }
 
@@ -108,13 +110,15 @@ std::string TriaxialTest::curve_row(const Simulation& sim) const {
               << " (not quasi-static; lower the strain rate)\n";
   }
   const double e = size.prod() / solid_volume(sim) - 1;
+  const Eigen::Vector3d inset = Eigen::Vector3d::Constant(spec_.core_inset_m);
+  const double e_core = box_void_ratio(sim.particles(), lo + inset, hi - inset);
   char buf[512];
   std::snprintf(buf, sizeof buf,
-                "%lld,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.6g,%.6g,"
-                "%.6g",
+                "%lld,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.6g,"
+                "%.6g,%.6g",
                 static_cast<long long>(sim.step_count()), sim.time(), e1,
                 (size0_.y() - size.y()) / size0_.y(), (size0_.x() - size.x()) / size0_.x(),
-                volumetric_strain(sim), s[0], s[1], s[2], p, q, sin_phi, phi, e,
+                volumetric_strain(sim), s[0], s[1], s[2], p, q, sin_phi, phi, e, e_core,
                 coordination_number(sim), inertial, sim.unbalanced_force());
   return buf;
 }

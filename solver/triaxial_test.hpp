@@ -17,7 +17,8 @@ struct TriaxialSpec {
   double servo_gain = 0.25;
   double max_wall_speed_m_s = 0.1;
   double inertial_warning = 1e-4;
-  double d50_m = 0;  // for the inertial number (0: mean diameter)
+  double d50_m = 0;         // for the inertial number (0: mean diameter)
+  double core_inset_m = 0;  // core void ratio: box inset by this from the boundaries
 };
 
 class TriaxialTest final : public LoadingProgramme {
