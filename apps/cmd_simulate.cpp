@@ -155,10 +155,14 @@ void run(const Args& a) {
   solver::Scene scene = solver::load_scene(a.scene);
   auto programmes = solver::scene_programmes(scene);
   if (a.threads > 0) scene.config.threads = a.threads;
-  const std::int64_t max_step = a.steps >= 0 ? a.steps : (scene.test.empty() ? scene.steps : 0);
-  if (scene.test.empty()) programmes.clear();
-  if (scene.test.empty())
-    programmes.push_back(std::make_unique<solver::FixedSteps>(max_step, scene.output.every));
+  // Where the run stops at the latest: --steps, or a plain scene's own number of steps.
+  std::optional<std::int64_t> stop_at;
+  if (a.steps >= 0) stop_at = a.steps;
+  if (scene.test.empty()) {
+    if (!stop_at) stop_at = scene.steps;
+    programmes.clear();
+    programmes.push_back(std::make_unique<solver::FixedSteps>(*stop_at, scene.output.every));
+  }
   const fs::path out = a.out.empty() ? fs::path("out") / scene.name : fs::path(a.out);
   std::error_code ec;
   fs::create_directories(out, ec);
@@ -202,6 +206,7 @@ void run(const Args& a) {
     CsvOutput& c = curve_for(k);
     if (c.open() && last_curve_step != sim.step_count()) {
       c.append(programmes[k]->curve_row(sim));
+      c.flush();  // a few rows per thousand steps: keep them readable while the run goes on
       last_curve_step = sim.step_count();
     }
   };
@@ -302,7 +307,7 @@ void run(const Args& a) {
         write_frame();
         continue;
       }
-      if (max_step > 0 && sim.step_count() >= max_step) break;
+      if (stop_at && sim.step_count() >= *stop_at) break;
       programmes[k]->control(sim);
       if (programmes[k]->finished(sim)) continue;  // ended by its control (a stage check)
       sim.step();
