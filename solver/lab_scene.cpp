@@ -79,6 +79,7 @@ std::vector<std::unique_ptr<LoadingProgramme>> scene_programmes(Scene& s) {
     }
     s.walls = cuboid_planes(lo, hi, s.wall_friction_deg);
     gauge = cuboid_gauge();
+    s.triaxial.core_inset_m = s.plane_strain.core_inset_m = max_diameter(s.particles);
     if (s.test == "triaxial") {
       s.triaxial.d50_m = mean_diameter(s.particles);
       test = std::make_unique<TriaxialTest>(s.triaxial);
@@ -121,7 +122,6 @@ std::vector<std::unique_ptr<LoadingProgramme>> scene_programmes(Scene& s) {
     }
   }
   const double inset = max_diameter(s.particles);  // the loose layer along a wall
-  s.triaxial.core_inset_m = s.plane_strain.core_inset_m = inset;
   if (s.preparation) {
     if (s.preparation->core_inset_m < 0) s.preparation->core_inset_m = inset;
     try {

@@ -109,7 +109,7 @@ std::string TriaxialTest::curve_row(const Simulation& sim) const {
               << spec_.inertial_warning << " at eps1 = " << e1
               << " (not quasi-static; lower the strain rate)\n";
   }
-  const double e = size.prod() / solid_volume(sim) - 1;
+  const double e = box_void_ratio(sim.particles(), lo, hi);
   const Eigen::Vector3d inset = Eigen::Vector3d::Constant(spec_.core_inset_m);
   const double e_core = box_void_ratio(sim.particles(), lo + inset, hi - inset);
   char buf[512];

@@ -73,6 +73,12 @@ TEST(LabScenes, TriaxialPhasesCurveAndFrames) {
   EXPECT_EQ(t.frames[0].step, specimen.frames[0].step);
   EXPECT_EQ(t.frames.back().step, static_cast<std::int64_t>(c.at(c.rows.size() - 1, "step")));
   EXPECT_GE(c.at(c.rows.size() - 1, "eps1_shortening"), 0.02);
+  // The loading starts from the prepared state: same void ratios (box and core, the core inset
+  // by dmax from the walls is denser).
+  const std::size_t p_end = prep.rows.size() - 1;
+  EXPECT_NEAR(c.at(0, "void_ratio"), prep.at(p_end, "void_ratio"), 1e-8);
+  EXPECT_NEAR(c.at(0, "core_void_ratio"), prep.at(p_end, "core_void_ratio"), 1e-8);
+  EXPECT_LT(c.at(0, "core_void_ratio"), c.at(0, "void_ratio"));
   for (std::size_t i = 0; i < c.rows.size(); ++i) {
     const double s1 = c.at(i, "sigma1_Pa"), s3 = c.at(i, "sigma3_Pa");
     // Mobilised friction: sin φ = (σ1 − σ3)/(σ1 + σ3), φ in degrees.
