@@ -43,6 +43,7 @@ struct WallSpec {
   double servo_gain = 0;          // m/s per Pa of stress error
   double servo_max_velocity = 0;  // m/s cap
   double friction_deg = -1;       // wall–sphere friction angle; negative: the material's
+  bool active = true;             // false: starts switched off (a later stage turns it on)
 };
 
 /// Per-particle state, structure of arrays (index = particle index, not id).
@@ -65,7 +66,7 @@ struct WallState {
   Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
   Eigen::Vector3d vel = Eigen::Vector3d::Zero();
   Eigen::Vector3d force = Eigen::Vector3d::Zero(), torque = Eigen::Vector3d::Zero();
-  bool active = true;  // an inactive wall touches nothing (e.g. replaced by a membrane)
+  bool active = true;            // an inactive wall touches nothing (e.g. replaced by a membrane)
   double contact_stiffness = 0;  // Σ Kn of its contacts in the last step, N/m
   std::size_t contacts = 0;      // its contacts in the last step
 };

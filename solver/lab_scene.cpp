@@ -78,6 +78,10 @@ std::vector<std::unique_ptr<LoadingProgramme>> scene_programmes(Scene& s) {
       std::tie(lo, hi) = particle_bounds(f);
     }
     s.walls = cuboid_planes(lo, hi, s.wall_friction_deg);
+    if (s.test == "plane_strain") {
+      const auto clamps = membrane_clamps();
+      s.walls.insert(s.walls.end(), clamps.begin(), clamps.end());
+    }
     gauge = cuboid_gauge();
     s.triaxial.core_inset_m = s.plane_strain.core_inset_m = max_diameter(s.particles);
     if (s.test == "triaxial") {

@@ -11,6 +11,23 @@
 
 namespace gs::solver {
 
+namespace {
+constexpr std::size_t kClamp = 6;  // first clamp wall: x− bottom, x+ bottom, x− top, x+ top
+}
+
+std::vector<WallSpec> membrane_clamps() {
+  std::vector<WallSpec> w(4);
+  const char* names[4] = {"clamp x- bottom", "clamp x+ bottom", "clamp x- top", "clamp x+ top"};
+  for (int k = 0; k < 4; ++k) {
+    w[static_cast<std::size_t>(k)].name = names[k];
+    w[static_cast<std::size_t>(k)].shape = WallShape::Box;
+    w[static_cast<std::size_t>(k)].half_extents = Eigen::Vector3d::Constant(1e-3);
+    w[static_cast<std::size_t>(k)].friction_deg = 0;
+    w[static_cast<std::size_t>(k)].active = false;
+  }
+  return w;
+}
+
 PlaneStrainTest::PlaneStrainTest(PlaneStrainSpec spec) : spec_(spec) {
   if (!(spec_.confining_Pa > 0)) throw std::invalid_argument("confining pressure must be positive");
   if (!(spec_.strain_rate_1_s > 0)) throw std::invalid_argument("strain rate must be positive");
@@ -25,7 +42,7 @@ MembraneLoads PlaneStrainTest::membrane(const Simulation& sim) const {
   m.pressure_Pa = spec_.confining_Pa;
   m.bin_m = spec_.membrane_bin_m > 0 ? spec_.membrane_bin_m : 0.5 * d50_;
   m.normal_stencil_m = spec_.membrane_stencil_m > 0 ? spec_.membrane_stencil_m : d50_;
-  return membrane_loads(sim.particles(), lo.y(), hi.y(), lo.z(), hi.z(), m);
+  return membrane_loads(sim.particles(), lo.y(), hi.y(), lo.z() + clamp_, hi.z() - clamp_, m);
 }
 
 void PlaneStrainTest::refresh(Simulation& sim) {
@@ -44,15 +61,37 @@ void PlaneStrainTest::start(Simulation& sim) {
     d50_ = d / static_cast<double>(std::max<std::size_t>(1, sim.particles().size()));
   }
   for (std::size_t f = 0; f < 6; ++f) sim.walls()[f].vel.setZero();
+  // Clamps where the x walls meet the caps; then the x walls give way to the membranes.
+  const Eigen::Vector3d lo = cuboid_lo(sim), hi = cuboid_hi(sim);
+  clamp_ = spec_.clamp_height_m > 0 ? spec_.clamp_height_m : d50_;
+  b0_ = hi.x() - lo.x();
+  const double t = d50_;  // clamp thickness (outside the specimen)
+  const Eigen::Vector3d half(0.5 * t, 0.5 * (hi.y() - lo.y()) + t, 0.5 * clamp_);
+  for (int k = 0; k < 4; ++k) {
+    WallState& w = sim.walls().at(kClamp + static_cast<std::size_t>(k));
+    const double x = (k % 2 == 0) ? lo.x() - 0.5 * t : hi.x() + 0.5 * t;
+    const double z = (k < 2) ? lo.z() + 0.5 * clamp_ : hi.z() - 0.5 * clamp_;
+    w.spec.half_extents = half;
+    w.pos = Eigen::Vector3d(x, 0.5 * (lo.y() + hi.y()), z);
+    sim.set_wall_active(kClamp + static_cast<std::size_t>(k), true);
+  }
   sim.set_wall_active(kXmin, false);
   sim.set_wall_active(kXmax, false);
-  h0_ = cuboid_hi(sim).z() - cuboid_lo(sim).z();
-  v0_ = membrane(sim).volume_m3;
+  h0_ = hi.z() - lo.z();
+  v0_ = volume(sim);
   start_step_ = sim.step_count();
 }
 
+double PlaneStrainTest::volume(const Simulation& sim) const {
+  const double depth = cuboid_hi(sim).y() - cuboid_lo(sim).y();
+  return membrane(sim).volume_m3 + 2 * clamp_ * b0_ * depth;
+}
+
 void PlaneStrainTest::control(Simulation& sim) {
-  sim.walls()[kZmax].vel = spec_.strain_rate_1_s * h0_ * cuboid_inward(kZmax);
+  const Eigen::Vector3d v = spec_.strain_rate_1_s * h0_ * cuboid_inward(kZmax);
+  sim.walls()[kZmax].vel = v;
+  sim.walls()[kClamp + 2].vel = v;  // the top clamps move with the top cap
+  sim.walls()[kClamp + 3].vel = v;
   if ((sim.step_count() - start_step_) % spec_.refresh_steps == 0) refresh(sim);
 }
 
@@ -84,6 +123,7 @@ std::string PlaneStrainTest::curve_row(const Simulation& sim) const {
   const Eigen::Vector3d lo = cuboid_lo(sim), hi = cuboid_hi(sim);
   const double depth = hi.y() - lo.y(), h = hi.z() - lo.z();
   const double width = m.mean_width_m;
+  const double vol = m.volume_m3 + 2 * clamp_ * b0_ * depth;
   auto stress = [&](std::size_t f, double area) {
     return wall_stress(sim, f, cuboid_inward(f), area);
   };
@@ -122,9 +162,9 @@ std::string PlaneStrainTest::curve_row(const Simulation& sim) const {
                 "%lld,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.6g,%.6g,"
                 "%.6g,%zu",
                 static_cast<long long>(sim.step_count()), sim.time(), axial_strain(sim),
-                (m.volume_m3 - v0_) / v0_, s1, s2, s3, p, q, (s1 - s3) / (s1 + s3), phi,
-                m.volume_m3 / solid_volume(sim) - 1, e_core, width, coordination_number(sim),
-                inertial, sim.unbalanced_force(), m.particle.size());
+                (vol - v0_) / v0_, s1, s2, s3, p, q, (s1 - s3) / (s1 + s3), phi,
+                vol / solid_volume(sim) - 1, e_core, width, coordination_number(sim), inertial,
+                sim.unbalanced_force(), m.particle.size());
   return buf;
 }
 
@@ -141,6 +181,8 @@ std::string PlaneStrainTest::save_state() const {
   st.set("v0", v0_);
   st.set("d50", d50_);
   st.set("start_step", start_step_);
+  st.set("clamp", clamp_);
+  st.set("b0", b0_);
   st.set("max_phi", max_phi_deg_);
   st.set("warned", static_cast<std::int64_t>(warned_));
   return st.text();
@@ -152,6 +194,8 @@ void PlaneStrainTest::load_state(const std::string& state) {
   v0_ = st.number("v0");
   d50_ = st.number("d50");
   start_step_ = st.integer("start_step");
+  clamp_ = st.number("clamp");
+  b0_ = st.number("b0");
   max_phi_deg_ = st.number("max_phi");
   warned_ = st.integer("warned") != 0;
 }

@@ -4,6 +4,13 @@
 // fixed: plane strain). Caps and membranes are frictionless in the seed; the walls take the
 // friction the scene gives them. The membrane's rays are refreshed every `refresh_steps` steps,
 // so the loaded boundary follows the specimen as a shear zone forms.
+//
+// The membrane is clamped to the caps, as a rubber membrane is to the platens of the apparatus:
+// over a height `clamp_height_m` next to each cap the lateral boundary is a short rigid,
+// frictionless wall that moves with its cap (walls 6-9: x− and x+ at the bottom, then at the
+// top). Without the clamps nothing holds the ends of the specimen laterally — the caps are
+// frictionless — and a dense specimen sways as a whole into a parallelogram, shedding all its
+// strength (moment equilibrium then forces σ1 → σc), instead of forming a shear zone.
 #pragma once
 
 #include "flexible_membrane.hpp"
@@ -19,10 +26,15 @@ struct PlaneStrainSpec {
   double membrane_bin_m = 0;      // ray spacing (0: d50 / 2)
   double membrane_stencil_m = 0;  // slope stencil half-width (0: d50)
   std::int64_t refresh_steps = 20;
+  double clamp_height_m = 0;  // membrane clamped to the caps over this height (0: d50)
   double inertial_warning = 1e-4;
   double d50_m = 0;         // 0: mean diameter
   double core_inset_m = 0;  // core void ratio: box inset by this from the boundaries
 };
+
+/// The four clamp walls (boxes, switched off until the loading starts), appended after the six
+/// cuboid planes.
+std::vector<WallSpec> membrane_clamps();
 
 class PlaneStrainTest final : public LoadingProgramme {
  public:
@@ -42,11 +54,14 @@ class PlaneStrainTest final : public LoadingProgramme {
   double axial_strain(const Simulation& sim) const;
   /// The membrane loads the current state would get (not applied).
   MembraneLoads membrane(const Simulation& sim) const;
+  /// Specimen volume: between the membranes, plus the clamped ends.
+  double volume(const Simulation& sim) const;
 
  private:
   void refresh(Simulation& sim);
 
   PlaneStrainSpec spec_;
+  double clamp_ = 0, b0_ = 0;  // clamp height and the width between the clamps
   double h0_ = 0, v0_ = 0, d50_ = 0;
   std::int64_t start_step_ = 0;
   mutable double max_phi_deg_ = 0;

@@ -143,6 +143,7 @@ void read_lab_sections(const Reader& r, const toml::table& root, Scene& s) {
     x.membrane_bin_m = r.number(t, "plane_strain", "membrane_bin_m", false, 0);
     x.membrane_stencil_m = r.number(t, "plane_strain", "membrane_stencil_m", false, 0);
     x.refresh_steps = r.integer(t, "plane_strain", "refresh_steps", false, x.refresh_steps, 1);
+    x.clamp_height_m = r.number(t, "plane_strain", "clamp_height_m", false, 0);
     x.inertial_warning =
         r.positive(t, "plane_strain", "inertial_warning", false, x.inertial_warning);
   } else if (s.test == "direct_shear") {

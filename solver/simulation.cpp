@@ -72,6 +72,7 @@ Simulation::Simulation(SimulationConfig config, const std::vector<Particle>& par
     w.normal =
         spec.shape == WallShape::Plane ? Eigen::Vector3d(spec.normal.normalized()) : spec.normal;
     w.vel = spec.velocity;
+    w.active = spec.active;
     walls_.push_back(w);
   }
   nl_.skin = cfg_.skin > 0 ? cfg_.skin : (n > 0 ? 0.5 * rmin : 1e-3);

@@ -121,6 +121,14 @@ TEST(LabScenes, PlaneStrainMembraneCarriesTheConfiningPressure) {
     EXPECT_EQ(f.walls[1].force.norm(), 0.0);
     EXPECT_GT(f.walls[5].force.norm(), 0.0);  // top cap loaded
   }
+  // The membrane is clamped to the caps: the clamp walls (6-9) stay at the x of the specimen's
+  // faces, the top ones follow the top cap down.
+  const auto& w0 = t.frames.front().walls, &w1 = t.frames.back().walls;
+  ASSERT_EQ(w0.size(), 10u);
+  for (std::size_t k = 6; k < 10; ++k) EXPECT_EQ(w1[k].a.x(), w0[k].a.x());
+  EXPECT_EQ(w1[6].a.z(), w0[6].a.z());
+  EXPECT_NEAR(w1[8].a.z() - w0[8].a.z(), w1[5].a.z() - w0[5].a.z(), 1e-15);
+  EXPECT_NEAR(w1[9].a.z() - w0[9].a.z(), w1[5].a.z() - w0[5].a.z(), 1e-15);
   // External work of the membrane appears in the energy ledger.
   const Csv h = read_csv(dir / "history.csv");
   EXPECT_NE(h.at(h.rows.size() - 1, "external_work_J"), 0.0);
