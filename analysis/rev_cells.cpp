@@ -38,6 +38,18 @@ struct CellSums {
   Eigen::Vector3d rotation = Eigen::Vector3d::Zero(), displacement = Eigen::Vector3d::Zero();
   Eigen::Matrix3d stress = Eigen::Matrix3d::Zero();
 
+  CellSums& operator+=(const CellSums& o) {
+    volume += o.volume;
+    fraction += o.fraction;
+    z_weighted += o.z_weighted;
+    centres += o.centres;
+    matched_volume += o.matched_volume;
+    rotation += o.rotation;
+    displacement += o.displacement;
+    stress += o.stress;
+    return *this;
+  }
+
   void add_particle(double v, double v_ball, const Particle& p, double z, bool centre_inside,
                     const ParticleMotion& m, std::size_t i) {
     volume += v;
@@ -97,123 +109,69 @@ void check_motion(const Frame& frame, const ParticleMotion& m) {
   }
 }
 
-// ---- binning ------------------------------------------------------------------------------
+constexpr int kMaxTable = 4096;
 
-// Items (spheres or branch segments) binned on the grid step in local coordinates. An item of
-// half-extent <= reach[d] around its local centre can touch cell i only if its centre lies in
-// (plane_lo(d, i) - reach, plane_hi(d, i) + reach): bins i .. i + span[d] of the bin grid that
-// starts at lo - reach.
-struct Bins {
-  std::array<int, 3> nb{1, 1, 1}, span{0, 0, 0};
-  std::vector<std::int32_t> order;  // item indices sorted by bin (stable)
-  std::vector<std::size_t> start;   // per bin, into order (size bins + 1)
-
-  std::size_t bin(int x, int y, int z) const {
-    return static_cast<std::size_t>(x) +
-           static_cast<std::size_t>(nb[0]) *
-               (static_cast<std::size_t>(y) + static_cast<std::size_t>(nb[1]) * z);
+// The planes of all cells along one axis, sorted and distinct: elementary intervals
+// [p[e], p[e + 1]); cell i covers the intervals first[i] .. last[i] - 1.
+struct AxisPlanes {
+  std::vector<double> p;
+  std::vector<int> first, last;
+  int intervals() const { return static_cast<int>(p.size()) - 1; }
+  /// The interval holding x (p[e] <= x < p[e + 1]), or -1.
+  int containing(double x) const {
+    const auto e = std::upper_bound(p.begin(), p.end(), x) - p.begin() - 1;
+    return e >= 0 && e < intervals() ? static_cast<int>(e) : -1;
   }
 };
 
-Bins make_bins(const RevGrid& g, const std::vector<Eigen::Vector3d>& centre,
-               const Eigen::Vector3d& reach) {
-  Bins b;
-  std::vector<std::array<int, 3>> ib(centre.size());
-  for (int d = 0; d < 3; ++d) {
-    if (g.n[d] <= 1) continue;  // one cell along this axis: one bin
-    b.span[d] = static_cast<int>(std::floor((g.size[d] + 2.0 * reach[d]) / g.step)) + 1;
-    b.nb[d] = g.n[d] + b.span[d];
+AxisPlanes axis_planes(const RevGrid& g, int d) {
+  AxisPlanes a;
+  if (d >= g.dim) {  // 2D frame: one unbounded interval
+    a.p = {-kInf, kInf};
+    a.first = {0};
+    a.last = {1};
+    return a;
   }
-  std::vector<std::size_t> count(static_cast<std::size_t>(b.nb[0]) * b.nb[1] * b.nb[2] + 1, 0);
-  for (std::size_t k = 0; k < centre.size(); ++k) {
-    for (int d = 0; d < 3; ++d) {
-      if (g.n[d] <= 1) {
-        ib[k][d] = 0;
-        continue;
-      }
-      const double t = std::floor((centre[k][d] - (g.lo[d] - reach[d])) / g.step);
-      ib[k][d] = static_cast<int>(std::clamp(t, 0.0, static_cast<double>(b.nb[d] - 1)));
-    }
-    ++count[b.bin(ib[k][0], ib[k][1], ib[k][2]) + 1];
+  for (int i = 0; i < g.n[d]; ++i) {
+    a.p.push_back(g.plane_lo(d, i));
+    a.p.push_back(g.plane_hi(d, i));
   }
-  for (std::size_t i = 1; i < count.size(); ++i) count[i] += count[i - 1];
-  b.start = count;
-  b.order.resize(centre.size());
-  for (std::size_t k = 0; k < centre.size(); ++k)
-    b.order[count[b.bin(ib[k][0], ib[k][1], ib[k][2])]++] = static_cast<std::int32_t>(k);
-  return b;
+  std::sort(a.p.begin(), a.p.end());
+  a.p.erase(std::unique(a.p.begin(), a.p.end()), a.p.end());
+  for (int i = 0; i < g.n[d]; ++i) {
+    a.first.push_back(
+        static_cast<int>(std::lower_bound(a.p.begin(), a.p.end(), g.plane_lo(d, i)) - a.p.begin()));
+    a.last.push_back(
+        static_cast<int>(std::lower_bound(a.p.begin(), a.p.end(), g.plane_hi(d, i)) - a.p.begin()));
+  }
+  return a;
 }
 
-// Calls fn(item) for every item binned where it may touch cell (i, j, k), in a fixed order.
-template <class Fn>
-void for_candidates(const Bins& b, const std::array<int, 3>& ijk, Fn&& fn) {
-  std::array<int, 3> b0{}, b1{};
-  for (int d = 0; d < 3; ++d) {
-    b0[d] = b.nb[d] > 1 ? ijk[d] : 0;
-    b1[d] = b.nb[d] > 1 ? std::min(b.nb[d] - 1, ijk[d] + b.span[d]) : 0;
-  }
-  for (int z = b0[2]; z <= b1[2]; ++z)
-    for (int y = b0[1]; y <= b1[1]; ++y) {
-      const std::size_t e = b.start[b.bin(b1[0], y, z) + 1];
-      for (std::size_t s = b.start[b.bin(b0[0], y, z)]; s < e; ++s) fn(b.order[s]);
+// Sums along axis d of an array of shape dims (x fastest) over each cell's intervals; the result
+// has g.n[d] entries along that axis (dims is updated).
+std::vector<CellSums> window_sums(const std::vector<CellSums>& in, std::array<int, 3>& dims, int d,
+                                  const AxisPlanes& a) {
+  std::array<int, 3> od = dims;
+  od[d] = static_cast<int>(a.first.size());
+  std::vector<CellSums> out(static_cast<std::size_t>(od[0]) * od[1] * od[2]);
+  const std::array<int, 3> stride_in{1, dims[0], dims[0] * dims[1]};
+  const std::array<int, 3> stride_out{1, od[0], od[0] * od[1]};
+  const int o1 = (d + 1) % 3, o2 = (d + 2) % 3;
+  const auto rows = static_cast<std::ptrdiff_t>(od[o1]) * od[o2];
+#pragma omp parallel for schedule(static)
+  for (std::ptrdiff_t rr = 0; rr < rows; ++rr) {
+    const int u = static_cast<int>(rr % od[o1]), v = static_cast<int>(rr / od[o1]);
+    const std::size_t bin = static_cast<std::size_t>(u * stride_in[o1] + v * stride_in[o2]);
+    const std::size_t bout = static_cast<std::size_t>(u * stride_out[o1] + v * stride_out[o2]);
+    for (int i = 0; i < od[d]; ++i) {
+      CellSums& s = out[bout + static_cast<std::size_t>(i * stride_out[d])];
+      for (int e = a.first[static_cast<std::size_t>(i)]; e < a.last[static_cast<std::size_t>(i)];
+           ++e)
+        s += in[bin + static_cast<std::size_t>(e * stride_in[d])];
     }
-}
-
-// ---- per-sphere octant tables ---------------------------------------------------------------
-
-// Planes of the grid that cut a sphere, per axis: the lower planes of cells ilo0 .. ilo0+nlo-1
-// and the upper planes of cells ihi0 .. ihi0+nhi-1 lie strictly inside (-r, r) of the centre.
-// Slot 0 of an axis is the offset 0; slots 1.. the |offsets| of those planes. `table` holds the
-// octant value for every slot triple (x fastest).
-struct SphereTable {
-  std::array<int, 3> ilo0{}, nlo{}, ihi0{}, nhi{}, m{1, 1, 1};
-  std::size_t offset = 0;
-  bool direct = false;  // too many planes: volume per cell from sphere_box_volume
-};
-
-constexpr int kMaxTable = 343;
-
-SphereTable sphere_planes(const RevGrid& g, const Eigen::Vector3d& c, double r) {
-  SphereTable t;
-  for (int d = 0; d < g.dim; ++d) {
-    t.ilo0[d] = t.ihi0[d] = 0;
-    const int i_min =
-        std::max(0, static_cast<int>(std::floor((c[d] - r - g.size[d] - g.lo[d]) / g.step)) - 1);
-    const int i_max =
-        std::min(g.n[d] - 1, static_cast<int>(std::ceil((c[d] + r - g.lo[d]) / g.step)) + 1);
-    for (int i = i_min; i <= i_max; ++i) {
-      const double lo = g.plane_lo(d, i) - c[d], hi = g.plane_hi(d, i) - c[d];
-      if (lo > -r && lo < r) {
-        if (t.nlo[d] == 0) t.ilo0[d] = i;
-        ++t.nlo[d];
-      }
-      if (hi > -r && hi < r) {
-        if (t.nhi[d] == 0) t.ihi0[d] = i;
-        ++t.nhi[d];
-      }
-    }
-    t.m[d] = 1 + t.nlo[d] + t.nhi[d];
   }
-  t.direct = t.m[0] * t.m[1] * t.m[2] > kMaxTable;
-  return t;
-}
-
-void fill_table(const RevGrid& g, const Eigen::Vector3d& c, double r, const SphereTable& t,
-                double* table) {
-  std::array<std::array<double, kMaxTable>, 3> alpha{};
-  for (int d = 0; d < g.dim; ++d) {
-    alpha[d][0] = 0.0;
-    for (int k = 0; k < t.nlo[d]; ++k)
-      alpha[d][1 + k] = std::abs(g.plane_lo(d, t.ilo0[d] + k) - c[d]);
-    for (int k = 0; k < t.nhi[d]; ++k)
-      alpha[d][1 + t.nlo[d] + k] = std::abs(g.plane_hi(d, t.ihi0[d] + k) - c[d]);
-  }
-  std::size_t q = 0;
-  for (int k = 0; k < t.m[2]; ++k)
-    for (int j = 0; j < t.m[1]; ++j)
-      for (int i = 0; i < t.m[0]; ++i)
-        table[q++] = g.dim == 2 ? disc_quadrant_area(r, alpha[0][i], alpha[1][j])
-                                : sphere_octant_volume(r, alpha[0][i], alpha[1][j], alpha[2][k]);
+  dims = od;
+  return out;
 }
 
 struct SlotTerm {
@@ -306,15 +264,18 @@ RevGrid make_rev_grid(const Frame& frame, const RevGridSpec& spec) {
     if (!(elo.x() < ehi.x())) throw std::invalid_argument("no particle cuts the slab");
     g.lo.z() = -half;
     g.size.z() = spec.slab->thickness;
-  } else if (spec.region) {
-    elo = spec.region->first;
-    ehi = spec.region->second;
-    if (!elo.allFinite() || !ehi.allFinite() || !(elo.array() < ehi.array()).all())
-      throw std::invalid_argument("region must have lo < hi on every axis");
   } else {
     const auto [blo, bhi] = particle_bounds(frame);
     elo = blo;
     ehi = bhi;
+  }
+  if (spec.region) {  // slab: in-plane (local x, y) bounds; 2D frame: x, y; 3D: the box
+    for (int d = 0; d < axes_used; ++d) {
+      elo[d] = spec.region->first[d];
+      ehi[d] = spec.region->second[d];
+      if (!std::isfinite(elo[d]) || !std::isfinite(ehi[d]) || !(elo[d] < ehi[d]))
+        throw std::invalid_argument("region must have lo < hi on every axis");
+    }
   }
   for (int d = 0; d < axes_used; ++d) {
     const double ext = ehi[d] - elo[d];
@@ -329,6 +290,9 @@ RevGrid make_rev_grid(const Frame& frame, const RevGridSpec& spec) {
     const double used = spec.cell + (g.n[d] - 1) * spec.step;
     g.lo[d] = elo[d] + 0.5 * (ext - used);
     g.size[d] = spec.cell;
+    const double m = std::round(spec.cell / spec.step);
+    if (m >= 1.0 && std::abs(spec.cell - m * spec.step) <= 1e-12 * spec.cell)
+      g.cell_steps[d] = static_cast<int>(m);
   }
   if (static_cast<double>(g.n[0]) * g.n[1] * g.n[2] > 5e8)
     throw std::invalid_argument("too many REV cells; increase the step");
@@ -341,127 +305,199 @@ RevFields rev_average(const Frame& frame, const ContactBranches& branches, const
                       const ParticleMotion& motion) {
   check_motion(frame, motion);
   const bool with_motion = !motion.matched.empty();
-  const std::size_t ncell = g.count();
-  RevFields f = empty_fields(ncell, with_motion);
   const std::vector<double> z = contact_counts(frame, branches);
+  const std::array<AxisPlanes, 3> ax{axis_planes(g, 0), axis_planes(g, 1), axis_planes(g, 2)};
+  const std::array<int, 3> ne{ax[0].intervals(), ax[1].intervals(), ax[2].intervals()};
+  const auto box = [&](int i, int j, int k) {
+    return static_cast<std::uint32_t>(i + ne[0] * (j + ne[1] * k));
+  };
+  std::vector<CellSums> elem(static_cast<std::size_t>(ne[0]) * ne[1] * ne[2]);
 
-  // Spheres that can touch a cell, in local coordinates.
-  Eigen::Vector3d glo, ghi;
-  for (int d = 0; d < 3; ++d) {
-    glo[d] = g.plane_lo(d, 0);
-    ghi[d] = g.plane_hi(d, g.n[d] - 1);
-  }
-  std::vector<std::int32_t> sphere;
-  std::vector<Eigen::Vector3d> sc;
-  double rmax = 0.0;
-  for (std::size_t i = 0; i < frame.particles.size(); ++i) {
-    const auto& p = frame.particles[i];
-    const Eigen::Vector3d u = g.local(p.position);
-    bool hit = true;
-    for (int d = 0; d < g.dim; ++d)
-      hit = hit && u[d] - p.radius < ghi[d] && u[d] + p.radius > glo[d];
-    if (!hit) continue;
-    sphere.push_back(static_cast<std::int32_t>(i));
-    sc.push_back(u);
-    rmax = std::max(rmax, p.radius);
-  }
-  const Bins sbins = make_bins(g, sc, Eigen::Vector3d::Constant(rmax));
-
-  // Octant tables, one per sphere (pooled).
-  std::vector<SphereTable> tables(sphere.size());
-  const auto ns = static_cast<std::ptrdiff_t>(sphere.size());
+  // Spheres: exact volume in each elementary box they touch.
+  struct Reach {
+    std::array<int, 3> e0{}, e1{}, k0{}, k1{};  // intervals e0..e1; interior planes k0..k1-1
+    std::size_t offset = 0, count = 0;
+  };
+  const std::size_t np = frame.particles.size();
+  std::vector<Reach> reach(np);
+  std::vector<Eigen::Vector3d> local(np);
+  const auto nps = static_cast<std::ptrdiff_t>(np);
 #pragma omp parallel for schedule(static)
-  for (std::ptrdiff_t k = 0; k < ns; ++k) {
-    const auto ks = static_cast<std::size_t>(k);
-    tables[ks] =
-        sphere_planes(g, sc[ks], frame.particles[static_cast<std::size_t>(sphere[ks])].radius);
+  for (std::ptrdiff_t ii = 0; ii < nps; ++ii) {
+    const auto i = static_cast<std::size_t>(ii);
+    const double r = frame.particles[i].radius;
+    local[i] = g.local(frame.particles[i].position);
+    Reach& q = reach[i];
+    q.count = 1;
+    for (int d = 0; d < 3; ++d) {
+      const auto& p = ax[static_cast<std::size_t>(d)].p;
+      if (d >= g.dim) {  // 2D frame: no third axis
+        q.e0[d] = q.e1[d] = q.k0[d] = q.k1[d] = 0;
+        continue;
+      }
+      const double c = local[i][d];
+      q.k0[d] = static_cast<int>(std::upper_bound(p.begin(), p.end(), c - r) - p.begin());
+      q.k1[d] = static_cast<int>(std::lower_bound(p.begin(), p.end(), c + r) - p.begin());
+      q.e0[d] = std::max(q.k0[d] - 1, 0);
+      q.e1[d] = std::min(q.k1[d] - 1, ne[d] - 1);
+      if (q.e1[d] < q.e0[d]) q.count = 0;
+      if (q.count) q.count *= static_cast<std::size_t>(q.e1[d] - q.e0[d] + 1);
+    }
   }
-  std::size_t pool_size = 0;
-  for (auto& t : tables) {
-    t.offset = pool_size;
-    if (!t.direct) pool_size += static_cast<std::size_t>(t.m[0] * t.m[1] * t.m[2]);
+  std::size_t total = 0;
+  for (auto& q : reach) {
+    q.offset = total;
+    total += q.count;
   }
-  std::vector<double> pool(pool_size);
-#pragma omp parallel for schedule(static)
-  for (std::ptrdiff_t k = 0; k < ns; ++k) {
-    const auto ks = static_cast<std::size_t>(k);
-    if (!tables[ks].direct)
-      fill_table(g, sc[ks], frame.particles[static_cast<std::size_t>(sphere[ks])].radius,
-                 tables[ks], pool.data() + tables[ks].offset);
-  }
-
-  // Branch segments in local coordinates, binned by their mid-points.
-  const auto& br = branches.branches;
-  std::vector<Eigen::Vector3d> bstart(br.size()), bvec(br.size()), bmid(br.size());
-  std::vector<Eigen::Matrix3d> lf(br.size());
-  Eigen::Vector3d half = Eigen::Vector3d::Zero();
-  for (std::size_t k = 0; k < br.size(); ++k) {
-    bstart[k] = g.local(br[k].start);
-    bvec[k] = g.axes * br[k].branch;
-    bmid[k] = bstart[k] + 0.5 * bvec[k];
-    half = half.cwiseMax(0.5 * bvec[k].cwiseAbs());
-    lf[k] = br[k].branch * br[k].force.transpose();
-  }
-  const Bins bbins = make_bins(g, bmid, half);
-
-  const double cell_measure = g.measure();
-  const auto nc = static_cast<std::ptrdiff_t>(ncell);
-#pragma omp parallel for schedule(dynamic, 32)
-  for (std::ptrdiff_t ci = 0; ci < nc; ++ci) {
-    const auto c = static_cast<std::size_t>(ci);
-    const auto ijk = g.ijk(c);
-    Eigen::Vector3d blo, bhi;
-    g.box(c, blo, bhi);
-    CellSums s;
-    for_candidates(sbins, ijk, [&](std::int32_t k) {
-      const auto ks = static_cast<std::size_t>(k);
-      const auto pi = static_cast<std::size_t>(sphere[ks]);
-      const Particle& p = frame.particles[pi];
-      const double r = p.radius;
-      const Eigen::Vector3d& u = sc[ks];
-      const SphereTable& t = tables[ks];
-      SlotTerm terms[3][3];
-      int nt[3] = {1, 1, 1};
-      terms[2][0] = {0, 1.0};  // 2D: no third axis
-      bool full = true, inside = true;
+  std::vector<std::pair<std::uint32_t, double>> deposit(total);
+#pragma omp parallel
+  {
+    std::vector<double> table, alpha[3];
+#pragma omp for schedule(dynamic, 256)
+    for (std::ptrdiff_t ii = 0; ii < nps; ++ii) {
+      const auto i = static_cast<std::size_t>(ii);
+      const Reach& q = reach[i];
+      if (q.count == 0) continue;
+      const double r = frame.particles[i].radius;
+      const Eigen::Vector3d& c = local[i];
+      std::array<int, 3> m{1, 1, 1};
       for (int d = 0; d < g.dim; ++d) {
-        const int i = ijk[d];
-        const double lo = g.plane_lo(d, i) - u[d], hi = g.plane_hi(d, i) - u[d];
-        if (!(lo < r && hi > -r)) return;
-        inside = inside && lo <= 0.0 && hi > 0.0;
-        bool fd = false;
-        nt[d] = cell_terms(lo, hi, r, 1 + (i - t.ilo0[d]), 1 + t.nlo[d] + (i - t.ihi0[d]), terms[d],
-                           fd);
-        full = full && fd;
+        alpha[d].assign(1, 0.0);  // slot 0: the offset 0; slot 1 + t: interior plane k0 + t
+        for (int k = q.k0[d]; k < q.k1[d]; ++k)
+          alpha[d].push_back(
+              std::abs(ax[static_cast<std::size_t>(d)].p[static_cast<std::size_t>(k)] - c[d]));
+        m[d] = static_cast<int>(alpha[d].size());
       }
-      double v = 0.0;
-      const double vb = ball_measure(g.dim, r);
-      if (full) {
-        v = vb;
-      } else if (t.direct) {
-        v = measure_in_box(g.dim, u, r, blo, bhi);
-      } else {
-        const double* tab = pool.data() + t.offset;
-        const auto mx = static_cast<std::size_t>(t.m[0]), my = static_cast<std::size_t>(t.m[1]);
-        for (int a = 0; a < nt[2]; ++a)
-          for (int b = 0; b < nt[1]; ++b) {
-            const double cab = terms[2][a].coef * terms[1][b].coef;
-            const std::size_t row = mx * (static_cast<std::size_t>(terms[1][b].slot) +
-                                          my * static_cast<std::size_t>(terms[2][a].slot));
-            for (int e = 0; e < nt[0]; ++e)
-              v += cab * terms[0][e].coef * tab[row + static_cast<std::size_t>(terms[0][e].slot)];
+      const bool direct = m[0] * m[1] * m[2] > kMaxTable;
+      if (!direct) {
+        table.resize(static_cast<std::size_t>(m[0] * m[1] * m[2]));
+        std::size_t t = 0;
+        for (int k = 0; k < m[2]; ++k)
+          for (int j = 0; j < m[1]; ++j)
+            for (int a = 0; a < m[0]; ++a)
+              table[t++] = g.dim == 2
+                               ? disc_quadrant_area(r, alpha[0][static_cast<std::size_t>(a)],
+                                                    alpha[1][static_cast<std::size_t>(j)])
+                               : sphere_octant_volume(r, alpha[0][static_cast<std::size_t>(a)],
+                                                      alpha[1][static_cast<std::size_t>(j)],
+                                                      alpha[2][static_cast<std::size_t>(k)]);
+      }
+      std::size_t out = q.offset;
+      for (int ek = q.e0[2]; ek <= q.e1[2]; ++ek)
+        for (int ej = q.e0[1]; ej <= q.e1[1]; ++ej)
+          for (int ei = q.e0[0]; ei <= q.e1[0]; ++ei) {
+            const std::array<int, 3> e{ei, ej, ek};
+            SlotTerm terms[3][3];
+            int nt[3] = {1, 1, 1};
+            terms[2][0] = {0, 1.0};
+            bool full = true;
+            Eigen::Vector3d blo, bhi;
+            for (int d = 0; d < g.dim; ++d) {
+              const auto& p = ax[static_cast<std::size_t>(d)].p;
+              blo[d] = p[static_cast<std::size_t>(e[d])];
+              bhi[d] = p[static_cast<std::size_t>(e[d] + 1)];
+              bool fd = false;
+              nt[d] = cell_terms(blo[d] - c[d], bhi[d] - c[d], r, 1 + e[d] - q.k0[d],
+                                 2 + e[d] - q.k0[d], terms[d], fd);
+              full = full && fd;
+            }
+            double v = 0.0;
+            if (full) {
+              v = ball_measure(g.dim, r);
+            } else if (direct) {
+              if (g.dim == 2) blo.z() = -kInf, bhi.z() = kInf;
+              v = measure_in_box(g.dim, c, r, blo, bhi);
+            } else {
+              const auto mx = static_cast<std::size_t>(m[0]), my = static_cast<std::size_t>(m[1]);
+              for (int a = 0; a < nt[2]; ++a)
+                for (int b = 0; b < nt[1]; ++b) {
+                  const double cab = terms[2][a].coef * terms[1][b].coef;
+                  const std::size_t row = mx * (static_cast<std::size_t>(terms[1][b].slot) +
+                                                my * static_cast<std::size_t>(terms[2][a].slot));
+                  for (int t = 0; t < nt[0]; ++t)
+                    v += cab * terms[0][t].coef *
+                         table[row + static_cast<std::size_t>(terms[0][t].slot)];
+                }
+            }
+            deposit[out++] = {box(ei, ej, ek), v};
           }
-      }
-      if (v <= 0.0) return;
-      s.add_particle(v, vb, p, z[pi], inside, motion, pi);
-    });
-    for_candidates(bbins, ijk, [&](std::int32_t k) {
-      const auto kb = static_cast<std::size_t>(k);
-      const double w = segment_box_fraction(bstart[kb], bvec[kb], blo, bhi);
-      if (w > 0.0) s.stress.noalias() += w * lf[kb];
-    });
-    finish(s, c, cell_measure, with_motion, f);
+    }
   }
+  for (std::size_t i = 0; i < np; ++i) {  // fixed order: deterministic sums
+    const Particle& p = frame.particles[i];
+    const double vb = ball_measure(g.dim, p.radius);
+    const Reach& q = reach[i];
+    for (std::size_t k = q.offset; k < q.offset + q.count; ++k)
+      if (deposit[k].second > 0.0)
+        elem[deposit[k].first].add_particle(deposit[k].second, vb, p, z[i], false, motion, i);
+    std::array<int, 3> e{0, 0, 0};
+    bool in = true;
+    for (int d = 0; d < g.dim; ++d) {
+      e[d] = ax[static_cast<std::size_t>(d)].containing(local[i][d]);
+      in = in && e[d] >= 0;
+    }
+    if (in) elem[box(e[0], e[1], e[2])].centres += 1.0;
+  }
+
+  // Branches: pieces between the planes, each in one elementary box.
+  const auto& br = branches.branches;
+  const auto nb = static_cast<std::ptrdiff_t>(br.size());
+  std::vector<std::size_t> boffset(br.size() + 1, 0);
+  for (std::size_t k = 0; k < br.size(); ++k) {
+    const Eigen::Vector3d a = g.local(br[k].start), l = g.axes * br[k].branch;
+    std::size_t cuts = 0;
+    for (int d = 0; d < g.dim; ++d) {
+      const auto& p = ax[static_cast<std::size_t>(d)].p;
+      const double lo = std::min(a[d], a[d] + l[d]), hi = std::max(a[d], a[d] + l[d]);
+      cuts += static_cast<std::size_t>(std::lower_bound(p.begin(), p.end(), hi) -
+                                       std::upper_bound(p.begin(), p.end(), lo));
+    }
+    boffset[k + 1] = boffset[k] + cuts + 1;
+  }
+  std::vector<std::pair<std::uint32_t, double>> piece(boffset.back(), {0u, 0.0});
+#pragma omp parallel
+  {
+    std::vector<double> ts;
+#pragma omp for schedule(dynamic, 1024)
+    for (std::ptrdiff_t kk = 0; kk < nb; ++kk) {
+      const auto k = static_cast<std::size_t>(kk);
+      const Eigen::Vector3d a = g.local(br[k].start), l = g.axes * br[k].branch;
+      ts.assign({0.0, 1.0});
+      for (int d = 0; d < g.dim; ++d) {
+        if (l[d] == 0.0) continue;
+        const auto& p = ax[static_cast<std::size_t>(d)].p;
+        const double lo = std::min(a[d], a[d] + l[d]), hi = std::max(a[d], a[d] + l[d]);
+        for (auto it = std::upper_bound(p.begin(), p.end(), lo); it != p.end() && *it < hi; ++it)
+          ts.push_back((*it - a[d]) / l[d]);
+      }
+      std::sort(ts.begin(), ts.end());
+      std::size_t out = boffset[k];
+      for (std::size_t t = 0; t + 1 < ts.size(); ++t) {
+        const double w = ts[t + 1] - ts[t];
+        if (!(w > 0.0)) continue;
+        const Eigen::Vector3d mid = a + 0.5 * (ts[t] + ts[t + 1]) * l;
+        std::array<int, 3> e{0, 0, 0};
+        bool in = true;
+        for (int d = 0; d < g.dim; ++d) {
+          e[d] = ax[static_cast<std::size_t>(d)].containing(l[d] == 0.0 ? a[d] : mid[d]);
+          in = in && e[d] >= 0;
+        }
+        if (in) piece[out++] = {box(e[0], e[1], e[2]), w};
+      }
+    }
+  }
+  for (std::size_t k = 0; k < br.size(); ++k) {
+    const Eigen::Matrix3d lf = br[k].branch * br[k].force.transpose();
+    for (std::size_t t = boffset[k]; t < boffset[k + 1]; ++t)
+      if (piece[t].second > 0.0) elem[piece[t].first].stress.noalias() += piece[t].second * lf;
+  }
+
+  // Cells: sums of their elementary boxes, axis by axis.
+  std::array<int, 3> dims = ne;
+  for (int d = 0; d < 3; ++d) elem = window_sums(elem, dims, d, ax[static_cast<std::size_t>(d)]);
+  RevFields f = empty_fields(g.count(), with_motion);
+  const double cell_measure = g.measure();
+  for (std::size_t c = 0; c < g.count(); ++c) finish(elem[c], c, cell_measure, with_motion, f);
   return f;
 }
 

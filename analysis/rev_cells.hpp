@@ -13,11 +13,12 @@
 //                 by the fraction of its branch inside the cell.
 // Overlapping spheres are counted twice in their overlap (as every DEM post-processor does).
 //
-// Speed: particles and contact branches are binned on the grid step; every cell visits only the
-// items that can reach it; per sphere the octant values of the few planes that cut it are
-// computed once (the box volume is a signed sum of them). Cells are processed in parallel
-// (OpenMP), each summing its items in a fixed order, so results do not depend on the number of
-// threads.
+// Speed: the planes of all cells partition space into elementary boxes. Each sphere deposits
+// its exact volume in the few elementary boxes it touches (the octant values of the planes that
+// cut it are computed once per sphere; a box volume is a signed sum of them), each branch its
+// pieces between planes; a cell is then the sum of its elementary boxes, done axis by axis.
+// Per-item work runs in parallel (OpenMP); the deposits and sums are done in a fixed order, so
+// results do not depend on the number of threads.
 #pragma once
 
 #include <Eigen/Core>
@@ -36,7 +37,8 @@ struct RevGridSpec {
   double cell = 0.0;         // L, m (> 0); 0 makes a grid of points (kernel coarse-graining)
   double step = 0.0;         // s, m (> 0)
   std::optional<Slab> slab;  // 2D grid in the slab (3D frames only)
-  /// 3D grid: global box the cells must fit in (default: bounding box of the spheres).
+  /// Box the cells must fit in (default: the extent of the spheres): 3D grid: global box; slab:
+  /// in-plane local (x, y) bounds (x along axis1); 2D frame: x, y bounds.
   std::optional<std::pair<Eigen::Vector3d, Eigen::Vector3d>> region;
 };
 
@@ -49,6 +51,9 @@ struct RevGrid {
   Eigen::Vector3d size = Eigen::Vector3d::Zero();      // local cell extents (L, L, L or thickness)
   double step = 0.0;
   std::array<int, 3> n{1, 1, 1};  // cells per local axis (x fastest in the arrays)
+  /// Per axis m > 0 when L is a whole number m of steps: the upper plane of cell i is then the
+  /// lower plane of cell i + m, exactly (cells share their planes).
+  std::array<int, 3> cell_steps{0, 0, 0};
 
   std::size_t count() const {
     return static_cast<std::size_t>(n[0]) * static_cast<std::size_t>(n[1]) *
@@ -61,7 +66,9 @@ struct RevGrid {
   }
   /// Local lower corner of a cell per axis: lo + i s (a plane shared with the brute force).
   double plane_lo(int d, int i) const { return lo[d] + i * step; }
-  double plane_hi(int d, int i) const { return lo[d] + i * step + size[d]; }
+  double plane_hi(int d, int i) const {
+    return cell_steps[d] > 0 ? plane_lo(d, i + cell_steps[d]) : lo[d] + i * step + size[d];
+  }
   /// Local box of cell c (2D frames: z unbounded).
   void box(std::size_t c, Eigen::Vector3d& blo, Eigen::Vector3d& bhi) const;
   Eigen::Vector3d local(const Eigen::Vector3d& x) const { return axes * (x - origin); }
