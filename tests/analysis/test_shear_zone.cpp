@@ -1,0 +1,151 @@
+// Shear zone from a REV rotation map of a lattice whose particle rotations form a Gaussian band
+// (standard deviation sigma) inclined at 60 deg (plane-strain compression, seed 000 §3) or
+// horizontal (direct shear, seed 004 §4.2). The inclination must come back within 0.5 deg. The
+// thickness is that of the band as the map sees it: the Gaussian smoothed by the REV cell (its
+// projection on the band normal: a trapezoid), by the particle volume, by the bilinear sampling
+// of the profile and by the second difference (a triangle of one step); the expected inflection
+// points are computed here by numerical convolution, and the measured thickness must agree
+// within 0.2 d50 (linear interpolation of the second difference between profile samples).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "packing_util.hpp"
+#include "rev_cells.hpp"
+#include "shear_zone.hpp"
+
+namespace ga = gs::analysis;
+
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+
+// Kernel as samples on a grid of spacing h (centred), convolved with boxes / parabola.
+std::vector<double> convolve(const std::vector<double>& a, const std::vector<double>& b) {
+  std::vector<double> c(a.size() + b.size() - 1, 0.0);
+  for (std::size_t i = 0; i < a.size(); ++i)
+    for (std::size_t j = 0; j < b.size(); ++j) c[i + j] += a[i] * b[j];
+  return c;
+}
+std::vector<double> box(double width, double h) {
+  const int n = std::max(1, static_cast<int>(std::lround(width / h)));
+  return std::vector<double>(static_cast<std::size_t>(n), 1.0 / n);
+}
+std::vector<double> parabola(double r, double h) {  // projected sphere volume
+  std::vector<double> k;
+  double s = 0.0;
+  for (double y = -r + 0.5 * h; y < r; y += h) {
+    k.push_back(1.0 - y * y / (r * r));
+    s += k.back();
+  }
+  for (auto& v : k) v /= s;
+  return k;
+}
+
+/// Half-distance between the inflection points of G_sigma convolved with the kernel.
+double expected_half_width(double sigma, const std::vector<double>& kernel, double h) {
+  const double mid = 0.5 * (static_cast<double>(kernel.size()) - 1.0);
+  auto second = [&](double d) {
+    double s = 0.0;
+    for (std::size_t k = 0; k < kernel.size(); ++k) {
+      const double x = d - (k - mid) * h;
+      s += kernel[k] * std::exp(-x * x / (2 * sigma * sigma)) * (x * x - sigma * sigma);
+    }
+    return s;
+  };
+  double lo = 0.0, hi = 10 * sigma;
+  for (int it = 0; it < 200; ++it) {  // second < 0 at the peak, > 0 far out
+    const double m = 0.5 * (lo + hi);
+    (second(m) < 0 ? lo : hi) = m;
+  }
+  return 0.5 * (lo + hi);
+}
+
+struct BandCase {
+  double angle_deg;  // band direction to the horizontal (x) in the x-z plane
+};
+
+void run_band(double angle_deg) {
+  const double r = 0.5e-3, d50 = 2 * r, sigma = 2.5 * d50, L = 5 * d50, s = d50;
+  // Lattice 60 x 6 x 80 (x, y, z); rotation about y in a Gaussian band through the centre.
+  gs::Frame f;
+  const Eigen::Vector3d centre(29.5e-3, 2.5e-3, 39.5e-3);
+  const double a = angle_deg * kPi / 180;
+  const Eigen::Vector3d dir(std::cos(a), 0, std::sin(a)), nrm(-std::sin(a), 0, std::cos(a));
+  for (int k = 0; k < 80; ++k)
+    for (int j = 0; j < 6; ++j)
+      for (int i = 0; i < 60; ++i) {
+        gs::Particle p;
+        p.id = static_cast<std::int64_t>(f.particles.size());
+        p.radius = r;
+        p.position = d50 * Eigen::Vector3d(i, j, k);
+        const double dist = (p.position - centre).dot(nrm);
+        p.rotation = Eigen::Vector3d(0, 0.8 * std::exp(-dist * dist / (2 * sigma * sigma)), 0);
+        f.particles.push_back(p);
+      }
+  ga::RevGridSpec spec;  // front view: e1 = x, e2 = z (normal -y), slab 5 d50 thick
+  spec.cell = L;
+  spec.step = s;
+  spec.slab = ga::Slab{centre, -Eigen::Vector3d::UnitY(), Eigen::Vector3d::UnitX(), 5 * d50};
+  const auto g = ga::make_rev_grid(f, spec);
+  const auto rf = ga::rev_average(f, ga::contact_branches(f), g);
+  ga::ScalarMap m;
+  m.nu = g.n[0];
+  m.nv = g.n[1];
+  m.step = s;
+  m.u0 = g.plane_lo(0, 0) + 0.5 * L;
+  m.v0 = g.plane_lo(1, 0) + 0.5 * L;
+  const Eigen::Vector3d normal = g.axes.row(2);
+  for (std::size_t c = 0; c < g.count(); ++c)
+    m.value.push_back(std::abs(rf.rotation[c].dot(normal)));
+  const auto z = ga::shear_zone(m);
+  EXPECT_NEAR(z.inclination_deg, std::min(angle_deg, 180 - angle_deg), 0.5) << angle_deg;
+  EXPECT_EQ(z.by_rows, angle_deg > 45);
+  // The band passes through the centre: its line does too (within 0.2 d50).
+  const Eigen::Vector2d c2(g.local(centre).x(), g.local(centre).y());
+  const Eigen::Vector2d n2(-z.direction.y(), z.direction.x());
+  EXPECT_NEAR((c2 - z.point).dot(n2), 0.0, 0.2 * d50);
+  // Expected thickness: the Gaussian through the REV cell (trapezoid of widths L |n_x|, L |n_z|),
+  // the bilinear sampling of the map along the band (tents of width s |n_x|, s |n_z| on average),
+  // the second difference (a triangle: two boxes of width s) and the particle volume.
+  const double h = 0.01 * d50;
+  std::vector<double> k = {1.0};
+  for (double w : {L * std::abs(nrm.x()), L * std::abs(nrm.z()), s * std::abs(nrm.x()),
+                   s * std::abs(nrm.x()), s * std::abs(nrm.z()), s * std::abs(nrm.z()), s, s})
+    if (w > h) k = convolve(k, box(w, h));
+  k = convolve(k, parabola(r, h));
+  const double expect = 2 * expected_half_width(sigma, k, h);
+  EXPECT_NEAR(z.thickness, expect, 0.2 * d50) << angle_deg;
+  EXPECT_NEAR(z.upper_d + z.lower_d, 0.0, 0.2 * d50);  // symmetric about the line
+  std::printf(
+      "band %.0f deg: inclination %.3f deg, thickness %.3f d50 (expected %.3f d50, "
+      "band 2 sigma = %.1f d50)\n",
+      angle_deg, z.inclination_deg, z.thickness / d50, expect / d50, 2 * sigma / d50);
+}
+
+TEST(ShearZone, InclinedBandOfPlaneStrainCompression) {
+  run_band(60.0);
+}
+
+TEST(ShearZone, SteepBandTheOtherWay) {
+  run_band(118.0);
+}
+
+TEST(ShearZone, HorizontalBandOfDirectShear) {
+  run_band(0.0);
+}
+
+TEST(ShearZone, RejectsDegenerateMaps) {
+  ga::ScalarMap m;
+  m.nu = 2;
+  m.nv = 5;
+  m.step = 1;
+  m.value.assign(10, 1.0);
+  EXPECT_THROW(ga::shear_zone(m), std::invalid_argument);
+  m.nu = 5;
+  m.value.assign(25, std::nan(""));
+  EXPECT_THROW(ga::shear_zone(m), std::invalid_argument);
+}
+
+}  // namespace
