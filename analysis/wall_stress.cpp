@@ -25,11 +25,50 @@ WallLoads wall_loads(const Frame& frame, const ContactBranches& branches, const 
     throw std::invalid_argument("walls: up vector is zero");
   const Eigen::Vector3d up = opt.up.normalized();
   WallLoads out;
+  // Walls of the snapshot, and bodies in wall contacts that it does not describe (e.g. YADE
+  // facets or boxes in a VTKExporter file): a plane through their mean contact point with the
+  // mean direction from the contact points to the particle centres as its normal.
+  std::vector<Wall> walls = frame.walls;
+  std::vector<std::uint8_t> inferred(walls.size(), 0);
+  {
+    std::unordered_map<std::int64_t, std::size_t> known;
+    for (std::size_t k = 0; k < walls.size(); ++k) known.emplace(walls[k].id, k);
+    std::unordered_map<std::int64_t, std::size_t> extra;
+    std::vector<std::pair<Eigen::Vector3d, double>> sums;
+    for (const auto& b : branches.branches) {
+      if (b.p2 >= 0) continue;
+      const Contact& c = frame.contacts[static_cast<std::size_t>(b.contact)];
+      const std::int64_t pid = frame.particles[static_cast<std::size_t>(b.p1)].id;
+      const std::int64_t wid = c.id1 == pid ? c.id2 : c.id1;
+      if (known.count(wid)) continue;
+      auto [it, added] = extra.emplace(wid, walls.size());
+      if (added) {
+        Wall w;
+        w.id = wid;
+        w.a = Eigen::Vector3d::Zero();
+        w.b = Eigen::Vector3d::Zero();
+        walls.push_back(w);
+        inferred.push_back(1);
+      }
+      Wall& w = walls[it->second];
+      w.a += c.point;
+      w.b -= b.branch.normalized();
+      w.force[0] += 1.0;  // count, replaced below
+    }
+    for (std::size_t k = 0; k < walls.size(); ++k) {
+      if (!inferred[k]) continue;
+      walls[k].a /= walls[k].force[0];
+      walls[k].force.setZero();
+      if (!(walls[k].b.norm() > 0.0)) walls[k].kind = WallKind::Box;
+    }
+  }
   std::unordered_map<std::int64_t, std::size_t> index;
-  for (const auto& w : frame.walls) {
+  for (std::size_t k = 0; k < walls.size(); ++k) {
+    const Wall& w = walls[k];
     WallLoad l;
     l.id = w.id;
     l.recorded = w.force;
+    l.inferred = inferred[k] != 0;
     if (w.kind == WallKind::Plane) {
       l.normal = w.b.normalized();
       const double c = l.normal.dot(up);
@@ -74,10 +113,6 @@ WallLoads wall_loads(const Frame& frame, const ContactBranches& branches, const 
     const std::int64_t pid = frame.particles[static_cast<std::size_t>(b.p1)].id;
     const std::int64_t wid = c.id1 == pid ? c.id2 : c.id1;
     const auto it = index.find(wid);
-    if (it == index.end()) {
-      ++out.unmatched;
-      continue;
-    }
     WallLoad& l = out.walls[it->second];
     l.force += b.force;
     ++l.contacts;
@@ -93,9 +128,10 @@ WallLoads wall_loads(const Frame& frame, const ContactBranches& branches, const 
       continue;
     }
     l.N = -l.force.dot(l.normal);
-    l.T = -l.force.dot(up);
+    // Side walls: the vertical (friction) force; other walls: the tangential force magnitude.
+    l.T = l.role == "side" ? -l.force.dot(up) : (l.force + l.N * l.normal).norm();
     l.phi_deg = l.N != 0.0 ? std::atan(l.T / l.N) * kDeg : kNaN;
-    if (l.role == "bottom") out.P += l.T;
+    if (l.role == "bottom") out.P += -l.force.dot(up);
     if (l.role == "side") {
       out.T += l.T;
       out.N += l.N;

@@ -7,12 +7,16 @@
 //   G   the weight of the material, with G = sum_side T + P in equilibrium.
 // "Vertical" is the `up` direction (default +z). A plane wall (normal b pointing into the
 // material) is a bottom wall when b . up > 0.9, a top wall when b . up < -0.9, a side wall when
-// |b . up| < 0.1. Signs: N_w = -F . b (compression positive), T_w = -F . up (downward drag on the
-// wall positive), P = -F_bottom . up.
+// |b . up| < 0.1. Signs: N_w = -F . b (compression positive), T_w = -F . up on side walls
+// (downward drag on the wall positive; on other walls T_w is the magnitude of the tangential
+// force), phi_w = atan(T_w / N_w), P = -F_bottom . up.
 // Distribution: contacts binned along an axis in the wall plane (side walls: up; others: the
 // lab axis closest to the wall plane's first direction), sigma_n = sum(-F . b) / (bin x width),
 // tau = sum(-F . axis) / (bin x width), width the extent of the material across the axis in the
-// wall plane (or given). Box walls get totals only.
+// wall plane (or given). Box walls get totals only. A body in wall contacts that the snapshot does
+// not list among its walls (YADE facets or boxes exported without walls) is taken as a plane
+// through its mean contact point, its normal the mean direction from the contact points to the
+// particle centres (`inferred`).
 #pragma once
 
 #include <Eigen/Core>
@@ -39,6 +43,7 @@ struct WallLoad {
   Eigen::Vector3d normal = Eigen::Vector3d::Zero();    // plane walls: b
   Eigen::Vector3d force = Eigen::Vector3d::Zero();     // sum over its contacts, by the material, N
   Eigen::Vector3d recorded = Eigen::Vector3d::Zero();  // Wall::force of the snapshot
+  bool inferred = false;  // body not among the snapshot's walls: plane fitted to its contacts
   std::size_t contacts = 0;
   double N = 0.0, T = 0.0, phi_deg = 0.0;          // see header (NaN for box walls)
   Eigen::Vector3d axis = Eigen::Vector3d::Zero();  // binning axis
@@ -49,7 +54,6 @@ struct WallLoad {
 struct WallLoads {
   std::vector<WallLoad> walls;
   double G = 0.0, P = 0.0, T = 0.0, N = 0.0, phi_deg = 0.0;  // T, N: sums over side walls
-  std::size_t unmatched = 0;  // wall contacts whose body is not in frame.walls
 };
 
 /// Throws std::invalid_argument for a bad bin, width, up vector or no wall contact.

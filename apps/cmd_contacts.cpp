@@ -309,7 +309,6 @@ void run_walls(const WallArgs& a) {
            {"P_over_G", w.P / w.G}, {"T_over_G", w.T / w.G}, {"N_over_G", w.N / w.G},
            {"balance", (w.T + w.P) / w.G}})
     h.attr(n, v);
-  h.attr("unmatched", static_cast<long long>(w.unmatched));
   h.write("/up", flat(o.up.normalized()));
   std::vector<double> cid, cpos, csn, ctau, ccount;
   h.group("/walls");
@@ -320,6 +319,7 @@ void run_walls(const WallArgs& a) {
     h.group(g);
     h.attr("id", static_cast<long long>(l.id), g);
     h.attr("role", l.role, g);
+    h.attr("inferred", static_cast<long long>(l.inferred ? 1 : 0), g);
     h.attr("contacts", static_cast<long long>(l.contacts), g);
     h.attr("N", l.N, g);
     h.attr("T", l.T, g);
@@ -340,7 +340,7 @@ void run_walls(const WallArgs& a) {
       ctau.push_back(l.tau[b]);
       ccount.push_back(l.count[b]);
     }
-    std::cout << "wall " << l.id << " (" << l.role << "): " << l.contacts << " contacts, force "
+    std::cout << "wall " << l.id << " (" << l.role << (l.inferred ? ", inferred" : "") << "): " << l.contacts << " contacts, force "
               << l.force.transpose() << " N, N " << l.N << " N, T " << l.T << " N, phi_w "
               << l.phi_deg << " deg\n";
   }
