@@ -26,7 +26,7 @@ long FrameArgs::frame_index() const {
 }
 
 Frame FrameArgs::load() const {
-  if (d50 != 0.0) require_positive(input, "--d50", d50);
+  if (d50) require_positive(input, "--d50", *d50);
   return read_frame(input, frame_index());
 }
 
@@ -38,7 +38,7 @@ std::optional<Frame> FrameArgs::load_to() const {
 }
 
 double FrameArgs::d50_of(const Frame& f) const {
-  if (d50 > 0.0) return d50;
+  if (d50) return *d50;
   if (f.particles.empty()) throw InputError(input, "the frame has no particles");
   return analysis::d50(f);
 }
@@ -48,15 +48,15 @@ void require_positive(const std::string& file, const char* name, double v) {
     throw InputError(file, std::string(name) + " must be a finite number > 0", value_str(v));
 }
 
-double length_option(const std::string& file, const char* name, double m, double k,
-                     double fallback_d50, double d50) {
-  if (m != 0.0) {
-    require_positive(file, name, m);
-    return m;
+double length_option(const std::string& file, const char* name, const std::optional<double>& m,
+                     const std::optional<double>& k, double fallback_d50, double d50) {
+  if (m) {
+    require_positive(file, name, *m);
+    return *m;
   }
-  if (k != 0.0) {
-    require_positive(file, (std::string(name) + "-d50").c_str(), k);
-    return k * d50;
+  if (k) {
+    require_positive(file, (std::string(name) + "-d50").c_str(), *k);
+    return *k * d50;
   }
   return fallback_d50 * d50;
 }
@@ -71,13 +71,12 @@ void SelectionArgs::add_to(CLI::App& cmd, bool with_region) {
       ->expected(3);
   cmd.add_option("--slab-thickness", slab_thickness, "slab thickness in m");
   cmd.add_option("--slab-d50", slab_d50, "slab thickness in d50 (default 5)");
-  if (with_region)
-    cmd.add_option("--region", region, "box x0 y0 z0 x1 y1 z1 (m)")->expected(6);
+  if (with_region) cmd.add_option("--region", region, "box x0 y0 z0 x1 y1 z1 (m)")->expected(6);
 }
 
 bool SelectionArgs::slab_requested() const {
   return slab || !slab_origin.empty() || !slab_normal.empty() || !slab_axis.empty() ||
-         slab_thickness != 0.0 || slab_d50 != 0.0;
+         slab_thickness || slab_d50;
 }
 
 namespace {
@@ -97,8 +96,8 @@ std::optional<analysis::Slab> SelectionArgs::make_slab(const std::string& file, 
   analysis::Slab s;
   const auto [lo, hi] = particle_bounds(f);
   s.origin = slab_origin.size() == 3 ? vec(file, "--slab-origin", slab_origin) : 0.5 * (lo + hi);
-  s.normal = slab_normal.size() == 3 ? vec(file, "--slab-normal", slab_normal)
-                                     : Eigen::Vector3d(0, -1, 0);
+  s.normal =
+      slab_normal.size() == 3 ? vec(file, "--slab-normal", slab_normal) : Eigen::Vector3d(0, -1, 0);
   s.axis1 = slab_axis.size() == 3 ? vec(file, "--slab-axis", slab_axis) : Eigen::Vector3d::UnitX();
   s.thickness = length_option(file, "--slab-thickness", slab_thickness, slab_d50, 5.0, d50);
   try {

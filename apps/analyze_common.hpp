@@ -18,7 +18,7 @@ struct FrameArgs {
   std::string input;
   long frame = -1;  // negative: from the end
   std::optional<long> to;
-  double d50 = 0.0;  // m; 0: from the frame
+  std::optional<double> d50;  // m; default: from the frame
 
   /// Adds INPUT (positional), --frame, --d50 and, with `with_to`, --to.
   void add_to(CLI::App& cmd, bool with_to, bool input_required = true);
@@ -31,10 +31,10 @@ struct FrameArgs {
   double d50_of(const Frame& f) const;
 };
 
-/// A length given in m (`m`) or in multiples of d50 (`k`); `m` wins when > 0, else k d50, else
-/// fallback_d50 d50. Throws InputError for a value <= 0 or not finite.
-double length_option(const std::string& file, const char* name, double m, double k,
-                     double fallback_d50, double d50);
+/// A length given in m (`m`) or in multiples of d50 (`k`): m if given, else k d50, else
+/// fallback_d50 d50. Throws InputError for a given value <= 0 or not finite.
+double length_option(const std::string& file, const char* name, const std::optional<double>& m,
+                     const std::optional<double>& k, double fallback_d50, double d50);
 
 /// Rejects a non-finite or non-positive value with one line naming the option.
 void require_positive(const std::string& file, const char* name, double v);
@@ -42,7 +42,7 @@ void require_positive(const std::string& file, const char* name, double v);
 struct SelectionArgs {
   bool slab = false;  // --slab: the default front slab
   std::vector<double> slab_origin, slab_normal, slab_axis;
-  double slab_thickness = 0.0, slab_d50 = 0.0;
+  std::optional<double> slab_thickness, slab_d50;
   std::vector<double> region;  // x0 y0 z0 x1 y1 z1
 
   void add_to(CLI::App& cmd, bool with_region = true);

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <iomanip>
 #include <iostream>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -107,9 +108,9 @@ void run_fabric(const FabricArgs& a) {
                             {"orientation_bodies", 1, {static_cast<double>(o.bodies)}},
                             {"orientation_D_norm", 1, {o.D_norm}}});
   }
-  std::cout << std::setprecision(4) << "fabric: " << fab.particles << " particles, "
-            << fab.contacts << " contacts, coordination omega = " << fab.omega
-            << ", |D| = " << fab.D_norm << ", D principal " << fab.D_principal.transpose();
+  std::cout << std::setprecision(4) << "fabric: " << fab.particles << " particles, " << fab.contacts
+            << " contacts, coordination omega = " << fab.omega << ", |D| = " << fab.D_norm
+            << ", D principal " << fab.D_principal.transpose();
   if (o.bodies > 0) std::cout << "; " << o.bodies << " clumps, orientation |D| = " << o.D_norm;
   std::cout << "\n";
 }
@@ -144,8 +145,8 @@ void run_rose(const RoseArgs& a) {
     p.thickness = 1.0;
     p.normal = a.plane_normal.empty() ? Eigen::Vector3d(axes.row(2))
                                       : Eigen::Vector3d(a.plane_normal.data());
-    p.axis1 = a.plane_axis.empty() ? Eigen::Vector3d(axes.row(0))
-                                   : Eigen::Vector3d(a.plane_axis.data());
+    p.axis1 =
+        a.plane_axis.empty() ? Eigen::Vector3d(axes.row(0)) : Eigen::Vector3d(a.plane_axis.data());
     try {
       axes = ga::slab_axes(p);
     } catch (const std::invalid_argument& e) {
@@ -251,8 +252,8 @@ void run_chains(const ChainArgs& a) {
     std::vector<double> fn, fs, width, chain;
     for (std::size_t s = 0; s < fc.fn.size(); ++s) {
       if (!fc.strong[s]) continue;
-      lines.push_back({static_cast<std::int64_t>(pts.size()),
-                       static_cast<std::int64_t>(pts.size() + 1)});
+      lines.push_back(
+          {static_cast<std::int64_t>(pts.size()), static_cast<std::int64_t>(pts.size() + 1)});
       pts.push_back(fc.a[s]);
       pts.push_back(fc.b[s]);
       fn.push_back(fc.fn[s]);
@@ -278,7 +279,8 @@ struct WallArgs {
   FrameArgs in;
   std::string output, csv;
   std::vector<double> up{0.0, 0.0, 1.0};
-  double bin = 0.0, bin_d50 = 0.0, width = 0.0, gravity = 9.81, particle_density = 2650.0;
+  std::optional<double> bin, bin_d50, width;
+  double gravity = 9.81, particle_density = 2650.0;
 };
 
 void run_walls(const WallArgs& a) {
@@ -287,8 +289,8 @@ void run_walls(const WallArgs& a) {
   ga::WallOptions o;
   o.up = Eigen::Vector3d(a.up[0], a.up[1], a.up[2]);
   o.bin = length_option(a.in.input, "--bin", a.bin, a.bin_d50, 5.0, d50);
-  if (a.width != 0.0) require_positive(a.in.input, "--width", a.width);
-  o.width = a.width;
+  if (a.width) require_positive(a.in.input, "--width", *a.width);
+  o.width = a.width.value_or(0.0);
   require_positive(a.in.input, "--gravity", a.gravity);
   require_positive(a.in.input, "--particle-density", a.particle_density);
   o.gravity = a.gravity;
@@ -304,10 +306,16 @@ void run_walls(const WallArgs& a) {
   h.attr("frame", static_cast<long long>(a.in.frame_index()));
   h.attr("d50", d50);
   h.attr("bin", o.bin);
-  for (const auto& [n, v] : std::vector<std::pair<const char*, double>>{
-           {"P", w.P}, {"T", w.T}, {"N", w.N}, {"G", w.G}, {"phi_w_deg", w.phi_deg},
-           {"P_over_G", w.P / w.G}, {"T_over_G", w.T / w.G}, {"N_over_G", w.N / w.G},
-           {"balance", (w.T + w.P) / w.G}})
+  for (const auto& [n, v] :
+       std::vector<std::pair<const char*, double>>{{"P", w.P},
+                                                   {"T", w.T},
+                                                   {"N", w.N},
+                                                   {"G", w.G},
+                                                   {"phi_w_deg", w.phi_deg},
+                                                   {"P_over_G", w.P / w.G},
+                                                   {"T_over_G", w.T / w.G},
+                                                   {"N_over_G", w.N / w.G},
+                                                   {"balance", (w.T + w.P) / w.G}})
     h.attr(n, v);
   h.write("/up", flat(o.up.normalized()));
   std::vector<double> cid, cpos, csn, ctau, ccount;
@@ -340,9 +348,9 @@ void run_walls(const WallArgs& a) {
       ctau.push_back(l.tau[b]);
       ccount.push_back(l.count[b]);
     }
-    std::cout << "wall " << l.id << " (" << l.role << (l.inferred ? ", inferred" : "") << "): " << l.contacts << " contacts, force "
-              << l.force.transpose() << " N, N " << l.N << " N, T " << l.T << " N, phi_w "
-              << l.phi_deg << " deg\n";
+    std::cout << "wall " << l.id << " (" << l.role << (l.inferred ? ", inferred" : "")
+              << "): " << l.contacts << " contacts, force " << l.force.transpose() << " N, N "
+              << l.N << " N, T " << l.T << " N, phi_w " << l.phi_deg << " deg\n";
   }
   h.commit();
   if (!a.csv.empty()) {
@@ -352,9 +360,9 @@ void run_walls(const WallArgs& a) {
                             {"tau", 1, ctau},
                             {"contacts", 1, ccount}});
   }
-  std::cout << "walls: G " << w.G << " N, P/G " << w.P / w.G << ", T/G " << w.T / w.G
-            << ", N/G " << w.N / w.G << ", phi_w " << w.phi_deg << " deg, (T + P)/G "
-            << (w.T + w.P) / w.G << "\n";
+  std::cout << "walls: G " << w.G << " N, P/G " << w.P / w.G << ", T/G " << w.T / w.G << ", N/G "
+            << w.N / w.G << ", phi_w " << w.phi_deg << " deg, (T + P)/G " << (w.T + w.P) / w.G
+            << "\n";
 }
 
 }  // namespace
@@ -386,8 +394,7 @@ void register_analyze_contacts(CLI::App& app) {
     s->add_option("--plane-normal", a->plane_normal,
                   "plane of the 2D rose: normal x y z (default: the front view x-z, or the slab)")
         ->expected(3);
-    s->add_option("--plane-axis", a->plane_axis, "direction of angle 0 in the plane")
-        ->expected(3);
+    s->add_option("--plane-axis", a->plane_axis, "direction of angle 0 in the plane")->expected(3);
     s->add_flag("--3d", a->three_d, "also the 3D histogram on equal-area bins");
     s->add_option("--bins3d", a->bins3d, "3D bins: bands in cos(theta) and longitudes (18 36)")
         ->expected(2);

@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
+#include <optional>
 #include <string>
 #include <unordered_map>
 #include <vector>
@@ -74,7 +75,7 @@ struct RevArgs {
   FrameArgs in;
   SelectionArgs sel;
   std::string output, vti, csv, method = "box";
-  double cell = 0, cell_d50 = 0, step = 0, step_d50 = 0, width = 0, width_d50 = 0;
+  std::optional<double> cell, cell_d50, step, step_d50, width, width_d50;
   double particle_density = 2650.0;
   std::vector<double> profile;
   int profile_points = 0;
@@ -222,10 +223,13 @@ void run_rev(const RevArgs& a) {
     g = ga::make_rev_grid(f, spec);
     if (!gauss) {
       const auto r = ga::rev_average(f, branches, g, motion);
-      out.scalar = {{"void_ratio", r.void_ratio},         {"solid_fraction", r.solid_fraction},
-                    {"solid_volume", r.solid_volume},     {"particles", r.particles},
+      out.scalar = {{"void_ratio", r.void_ratio},
+                    {"solid_fraction", r.solid_fraction},
+                    {"solid_volume", r.solid_volume},
+                    {"particles", r.particles},
                     {"coordination", r.coordination}};
-      if (g.slab || g.dim == 2) out.scalar.emplace_back("rotation_normal", rotation_normal(g, r.rotation));
+      if (g.slab || g.dim == 2)
+        out.scalar.emplace_back("rotation_normal", rotation_normal(g, r.rotation));
       out.vector.emplace_back("rotation", r.rotation);
       if (!r.displacement.empty()) out.vector.emplace_back("displacement", r.displacement);
       out.tensor.emplace_back("stress", r.stress);
@@ -237,7 +241,8 @@ void run_rev(const RevArgs& a) {
       std::vector<Eigen::Matrix3d> total;
       for (std::size_t k = 0; k < c.contact_stress.size(); ++k)
         total.push_back(c.contact_stress[k] + c.kinetic_stress[k]);
-      out.scalar = {{"density", c.density}, {"solid_fraction", c.solid_fraction}, {"void_ratio", e}};
+      out.scalar = {
+          {"density", c.density}, {"solid_fraction", c.solid_fraction}, {"void_ratio", e}};
       out.vector.emplace_back("velocity", c.velocity);
       out.tensor = {{"stress", total},
                     {"stress_contact", c.contact_stress},
@@ -272,7 +277,10 @@ void run_rev(const RevArgs& a) {
                     Eigen::Vector3d::Constant(g.step), g.n, out.arrays());
   }
   if (!a.csv.empty()) write_rev_csv(a, g, out);
-  std::cout << "rev (" << a.method << ", " << (g.dim == 2 ? "2D" : g.slab ? "slab" : "3D")
+  std::cout << "rev (" << a.method << ", "
+            << (g.dim == 2 ? "2D"
+                : g.slab   ? "slab"
+                           : "3D")
             << "): " << g.n[0] << " x " << g.n[1] << " x " << g.n[2] << " cells, "
             << f.particles.size() << " particles, " << branches.particle_contacts << " + "
             << branches.wall_contacts << " wall contacts, " << seconds << " s\n";
@@ -284,7 +292,7 @@ struct ShearArgs {
   FrameArgs in;
   SelectionArgs sel;
   std::string output, csv, field = "rotation";
-  double cell = 0, cell_d50 = 0, step = 0, step_d50 = 0;
+  std::optional<double> cell, cell_d50, step, step_d50;
 };
 
 /// In-plane equivalent shear strain sqrt(((exx - eyy)/2)^2 + exy^2) from the REV displacement
@@ -381,10 +389,10 @@ void run_shearzone(const ShearArgs& a) {
   h.commit();
   if (!a.csv.empty())
     write_csv_table(a.csv, {{"distance", 1, z.profile_d}, {a.field, 1, z.profile_value}});
-  std::cout << std::fixed << std::setprecision(2) << "shearzone (" << a.field
-            << "): inclination " << z.inclination_deg << " deg to the horizontal (direction "
-            << z.angle_deg << " deg), thickness " << 1e3 * z.thickness << " mm = "
-            << z.thickness / d50 << " d50; map " << m.nu << " x " << m.nv << " cells, ridge from "
+  std::cout << std::fixed << std::setprecision(2) << "shearzone (" << a.field << "): inclination "
+            << z.inclination_deg << " deg to the horizontal (direction " << z.angle_deg
+            << " deg), thickness " << 1e3 * z.thickness << " mm = " << z.thickness / d50
+            << " d50; map " << m.nu << " x " << m.nv << " cells, ridge from "
             << (z.by_rows ? "rows" : "columns") << "\n";
 }
 
@@ -468,12 +476,20 @@ void run_invariants(const InvArgs& a) {
     const auto s = ga::stress_invariants(sigma, dim);
     h.group("/stress");
     h.write("/stress/tensor", flat(sigma), {3, 3});
-    h.write("/stress/principal", std::vector<double>{s.principal.x(), s.principal.y(), s.principal.z()});
+    h.write("/stress/principal",
+            std::vector<double>{s.principal.x(), s.principal.y(), s.principal.z()});
     h.write("/stress/directions", flat(s.directions), {3, 3});
-    for (const auto& [n, v] : std::vector<std::pair<const char*, double>>{
-             {"p", s.p}, {"q", s.q}, {"eta", s.eta}, {"b", s.b}, {"lode_deg", s.lode_deg},
-             {"phi_mob_deg", s.phi_mob_deg}, {"j2d", s.j2d}, {"j3d", s.j3d},
-             {"asymmetry", s.asymmetry}, {"volume", volume}}) {
+    for (const auto& [n, v] :
+         std::vector<std::pair<const char*, double>>{{"p", s.p},
+                                                     {"q", s.q},
+                                                     {"eta", s.eta},
+                                                     {"b", s.b},
+                                                     {"lode_deg", s.lode_deg},
+                                                     {"phi_mob_deg", s.phi_mob_deg},
+                                                     {"j2d", s.j2d},
+                                                     {"j3d", s.j3d},
+                                                     {"asymmetry", s.asymmetry},
+                                                     {"volume", volume}}) {
       h.attr(n, v, "/stress");
       row.push_back({n, 1, {v}});
     }
@@ -482,8 +498,8 @@ void run_invariants(const InvArgs& a) {
       h.write("/stress/boundary_eq14", flat(boundary), {3, 3});
       row.push_back({"stress_boundary_eq14", 9, flat(boundary)});
     }
-    std::cout << std::setprecision(6) << "stress (compression positive): p " << s.p << ", q "
-              << s.q << ", eta " << s.eta << ", b " << s.b << ", Lode " << s.lode_deg
+    std::cout << std::setprecision(6) << "stress (compression positive): p " << s.p << ", q " << s.q
+              << ", eta " << s.eta << ", b " << s.b << ", Lode " << s.lode_deg
               << " deg, mobilised friction " << s.phi_mob_deg << " deg\n";
   }
   if (has_F) {
@@ -494,14 +510,24 @@ void run_invariants(const InvArgs& a) {
       throw InputError(src, x.what());
     }
     h.group("/strain");
-    for (const auto& [n, m] : std::vector<std::pair<const char*, Eigen::Matrix3d>>{
-             {"F", F}, {"U", e.U}, {"R", e.R}, {"biot", e.biot}, {"Fv", e.Fv}, {"Fd", e.Fd},
-             {"directions", e.directions}})
+    for (const auto& [n, m] :
+         std::vector<std::pair<const char*, Eigen::Matrix3d>>{{"F", F},
+                                                              {"U", e.U},
+                                                              {"R", e.R},
+                                                              {"biot", e.biot},
+                                                              {"Fv", e.Fv},
+                                                              {"Fd", e.Fd},
+                                                              {"directions", e.directions}})
       h.write(std::string("/strain/") + n, flat(m), {3, 3});
-    h.write("/strain/principal", std::vector<double>{e.principal.x(), e.principal.y(), e.principal.z()});
-    for (const auto& [n, v] : std::vector<std::pair<const char*, double>>{
-             {"J", e.J}, {"eps_v", e.eps_v}, {"eps_q", e.eps_q}, {"b_eps", e.b_eps},
-             {"b_stretch", e.b_stretch}, {"lode_deg", e.lode_deg}}) {
+    h.write("/strain/principal",
+            std::vector<double>{e.principal.x(), e.principal.y(), e.principal.z()});
+    for (const auto& [n, v] :
+         std::vector<std::pair<const char*, double>>{{"J", e.J},
+                                                     {"eps_v", e.eps_v},
+                                                     {"eps_q", e.eps_q},
+                                                     {"b_eps", e.b_eps},
+                                                     {"b_stretch", e.b_stretch},
+                                                     {"lode_deg", e.lode_deg}}) {
       h.attr(n, v, "/strain");
       row.push_back({std::string("strain_") + n, 1, {v}});
     }
@@ -538,8 +564,7 @@ void register_analyze_rev(CLI::App& app) {
                   "kg/m^3 for particles of unknown mass (default 2650)");
     s->add_option("--vti", a->vti, "also write a VTK image (slab: in its plane coordinates)");
     s->add_option("--csv", a->csv, "also write a CSV: all cells, or the --profile");
-    s->add_option("--profile", a->profile, "line x0 y0 z0 x1 y1 z1 for a CSV profile")
-        ->expected(6);
+    s->add_option("--profile", a->profile, "line x0 y0 z0 x1 y1 z1 for a CSV profile")->expected(6);
     s->add_option("--profile-points", a->profile_points, "points on the profile (default s/2)");
     s->callback([a] { run_rev(*a); });
   }
@@ -576,8 +601,7 @@ void register_analyze_rev(CLI::App& app) {
         ->required();
     s->add_option("--stress", a->stress, "evaluate this stress s11 s12 ... s33 instead")
         ->expected(9);
-    s->add_option("--gradient", a->gradient, "evaluate this F11 F12 ... F33 instead")
-        ->expected(9);
+    s->add_option("--gradient", a->gradient, "evaluate this F11 F12 ... F33 instead")->expected(9);
     s->add_option("--csv", a->csv, "also write one CSV row of all values");
     s->callback([a] { run_invariants(*a); });
   }

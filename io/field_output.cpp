@@ -343,8 +343,8 @@ void write_csv_table(const std::filesystem::path& path, const std::vector<VtkArr
       first = true;
       for (const auto& c : columns)
         for (int j = 0; j < c.components; ++j) {
-          const double v = c.values[r * static_cast<std::size_t>(c.components) +
-                                    static_cast<std::size_t>(j)];
+          const double v =
+              c.values[r * static_cast<std::size_t>(c.components) + static_cast<std::size_t>(j)];
           os << (first ? "" : ",");
           first = false;
           if (std::isfinite(v)) {

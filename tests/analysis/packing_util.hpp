@@ -161,4 +161,26 @@ inline Frame random_packing(int n, double spacing, unsigned seed) {
   return f;
 }
 
+/// Simple-cubic lattice nx x ny x nz (spacing d) whose particles rotate about y in a Gaussian
+/// band (standard deviation sigma, peak 0.8 rad) through `centre`, inclined at angle_deg to x in
+/// the x-z plane: the rotation field of a shear band.
+inline Frame band_lattice(int nx, int ny, int nz, double d, double angle_deg, double sigma,
+                          const Eigen::Vector3d& centre) {
+  Frame f;
+  const double a = angle_deg * 3.141592653589793 / 180.0;
+  const Eigen::Vector3d nrm(-std::sin(a), 0, std::cos(a));
+  for (int k = 0; k < nz; ++k)
+    for (int j = 0; j < ny; ++j)
+      for (int i = 0; i < nx; ++i) {
+        Particle p;
+        p.id = static_cast<std::int64_t>(f.particles.size());
+        p.radius = 0.5 * d;
+        p.position = d * Eigen::Vector3d(i, j, k);
+        const double dist = (p.position - centre).dot(nrm);
+        p.rotation = Eigen::Vector3d(0, 0.8 * std::exp(-dist * dist / (2 * sigma * sigma)), 0);
+        f.particles.push_back(p);
+      }
+  return f;
+}
+
 }  // namespace gs::test

@@ -69,21 +69,10 @@ struct BandCase {
 void run_band(double angle_deg) {
   const double r = 0.5e-3, d50 = 2 * r, sigma = 2.5 * d50, L = 5 * d50, s = d50;
   // Lattice 60 x 6 x 80 (x, y, z); rotation about y in a Gaussian band through the centre.
-  gs::Frame f;
   const Eigen::Vector3d centre(29.5e-3, 2.5e-3, 39.5e-3);
   const double a = angle_deg * kPi / 180;
-  const Eigen::Vector3d dir(std::cos(a), 0, std::sin(a)), nrm(-std::sin(a), 0, std::cos(a));
-  for (int k = 0; k < 80; ++k)
-    for (int j = 0; j < 6; ++j)
-      for (int i = 0; i < 60; ++i) {
-        gs::Particle p;
-        p.id = static_cast<std::int64_t>(f.particles.size());
-        p.radius = r;
-        p.position = d50 * Eigen::Vector3d(i, j, k);
-        const double dist = (p.position - centre).dot(nrm);
-        p.rotation = Eigen::Vector3d(0, 0.8 * std::exp(-dist * dist / (2 * sigma * sigma)), 0);
-        f.particles.push_back(p);
-      }
+  const Eigen::Vector3d nrm(-std::sin(a), 0, std::cos(a));
+  const gs::Frame f = gs::test::band_lattice(60, 6, 80, d50, angle_deg, sigma, centre);
   ga::RevGridSpec spec;  // front view: e1 = x, e2 = z (normal -y), slab 5 d50 thick
   spec.cell = L;
   spec.step = s;
