@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <numbers>
@@ -34,6 +35,16 @@ std::size_t lines(const fs::path& p) {
   std::size_t n = 0;
   for (std::string l; std::getline(in, l);) ++n;
   return n;
+}
+
+/// With GS_KEEP_TEST_OUTPUT=DIR the HDF5 outputs are copied there (e.g. to try the figures).
+void keep_outputs(const fs::path& dir) {
+  const char* keep = std::getenv("GS_KEEP_TEST_OUTPUT");
+  if (!keep) return;
+  for (const auto& e : fs::directory_iterator(dir))
+    if (e.path().extension() == ".h5")
+      fs::copy_file(e.path(), fs::path(keep) / ("rev_cli_" + e.path().filename().string()),
+                    fs::copy_options::overwrite_existing);
 }
 
 /// `granoscope figures FILE` writes these PNGs, and they are not blank.
@@ -114,6 +125,7 @@ TEST(CmdRev, LatticeVoidRatioStressDisplacementAndFigures) {
   const auto b14 = read_doubles(dir / "i.h5", "/stress/boundary_eq14");
   EXPECT_NEAR(b14[0], 3e6, 1e-6);
   expect_figures(dir, dir / "i.h5", {"invariants.png"});
+  keep_outputs(dir);
   fs::remove_all(dir);
 }
 
@@ -142,6 +154,7 @@ TEST(CmdRev, ShearZoneOfAPlaneStrainBand) {
   std::getline(log, line);
   EXPECT_NE(line.find("inclination 60."), std::string::npos) << line;
   expect_figures(dir, dir / "sz.h5", {"shearzone.png"});
+  keep_outputs(dir);
   fs::remove_all(dir);
 }
 
@@ -192,6 +205,7 @@ TEST(CmdRev, ContactAnalysesAndFigures) {
   expect_figures(dir, dir / "r.h5", {"rose.png", "rose_3d.png"});
   expect_figures(dir, dir / "c.h5", {"chains.png"});
   expect_figures(dir, dir / "w.h5", {"walls.png"});
+  keep_outputs(dir);
   fs::remove_all(dir);
 }
 
