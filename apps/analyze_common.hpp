@@ -39,6 +39,14 @@ double length_option(const std::string& file, const char* name, const std::optio
 /// Rejects a non-finite or non-positive value with one line naming the option.
 void require_positive(const std::string& file, const char* name, double v);
 
+/// REV grid: cell size L and step s, in m or d50 (defaults 5 d50 and 1 d50).
+struct GridArgs {
+  std::optional<double> cell, cell_d50, step, step_d50;
+  void add_to(CLI::App& cmd);
+  double cell_size(const std::string& file, double d50) const;
+  double step_size(const std::string& file, double d50) const;
+};
+
 struct SelectionArgs {
   bool slab = false;  // --slab: the default front slab
   std::vector<double> slab_origin, slab_normal, slab_axis;

@@ -75,7 +75,8 @@ struct RevArgs {
   FrameArgs in;
   SelectionArgs sel;
   std::string output, vti, csv, method = "box";
-  std::optional<double> cell, cell_d50, step, step_d50, width, width_d50;
+  GridArgs grid;
+  std::optional<double> width, width_d50;
   double particle_density = 2650.0;
   std::vector<double> profile;
   int profile_points = 0;
@@ -204,8 +205,8 @@ void run_rev(const RevArgs& a) {
   const double d50 = a.in.d50_of(f);
   const bool gauss = a.method == "gaussian";
   ga::RevGridSpec spec;
-  spec.cell = gauss ? 0.0 : length_option(a.in.input, "--cell", a.cell, a.cell_d50, 5.0, d50);
-  spec.step = length_option(a.in.input, "--step", a.step, a.step_d50, 1.0, d50);
+  spec.cell = gauss ? 0.0 : a.grid.cell_size(a.in.input, d50);
+  spec.step = a.grid.step_size(a.in.input, d50);
   spec.slab = a.sel.make_slab(a.in.input, f, d50);
   spec.region = a.sel.make_region(a.in.input);
   if (spec.region && spec.slab)
@@ -292,7 +293,7 @@ struct ShearArgs {
   FrameArgs in;
   SelectionArgs sel;
   std::string output, csv, field = "rotation";
-  std::optional<double> cell, cell_d50, step, step_d50;
+  GridArgs grid;
 };
 
 /// In-plane equivalent shear strain sqrt(((exx - eyy)/2)^2 + exy^2) from the REV displacement
@@ -323,8 +324,8 @@ void run_shearzone(const ShearArgs& a) {
   const Frame f = a.in.load();
   const double d50 = a.in.d50_of(f);
   ga::RevGridSpec spec;
-  spec.cell = length_option(a.in.input, "--cell", a.cell, a.cell_d50, 5.0, d50);
-  spec.step = length_option(a.in.input, "--step", a.step, a.step_d50, 1.0, d50);
+  spec.cell = a.grid.cell_size(a.in.input, d50);
+  spec.step = a.grid.step_size(a.in.input, d50);
   if (!f.two_d) {
     SelectionArgs sel = a.sel;
     sel.slab = true;  // always a slab map: default the front view
@@ -554,10 +555,7 @@ void register_analyze_rev(CLI::App& app) {
     a->sel.add_to(*s);
     s->add_option("-o,--output", a->output, "output HDF5 (format granoscope-rev)")->required();
     s->add_option("--method", a->method, "box (REV cells, default) or gaussian (coarse-graining)");
-    s->add_option("--cell", a->cell, "REV cell size L in m");
-    s->add_option("--cell-d50", a->cell_d50, "REV cell size in d50 (default 5)");
-    s->add_option("--step", a->step, "grid step s in m");
-    s->add_option("--step-d50", a->step_d50, "grid step in d50 (default 1)");
+    a->grid.add_to(*s);
     s->add_option("--width", a->width, "gaussian: kernel width (standard deviation) in m");
     s->add_option("--width-d50", a->width_d50, "gaussian: kernel width in d50 (default 1)");
     s->add_option("--particle-density", a->particle_density,
@@ -580,10 +578,7 @@ void register_analyze_rev(CLI::App& app) {
         ->required();
     s->add_option("--field", a->field,
                   "rotation (about the slab normal, default) or shear (needs --to)");
-    s->add_option("--cell", a->cell, "REV cell size L in m");
-    s->add_option("--cell-d50", a->cell_d50, "REV cell size in d50 (default 5)");
-    s->add_option("--step", a->step, "grid step s in m");
-    s->add_option("--step-d50", a->step_d50, "grid step in d50 (default 1)");
+    a->grid.add_to(*s);
     s->add_option("--csv", a->csv, "also write the profile across the band as CSV");
     s->callback([a] { run_shearzone(*a); });
   }

@@ -18,14 +18,9 @@ from figutil import plt
 AXES = "xyz"
 
 
-def _attr(f, name, default=None):
-    v = f.attrs.get(name, default)
-    return v.decode() if isinstance(v, bytes) else v
-
-
 def make(input_path, out_dir, args):
     with h5py.File(input_path, "r") as f:
-        if _attr(f, "format", "") == "granoscope-shearzone":
+        if figutil.attr(f, "format", "") == "granoscope-shearzone":
             return _shearzone(f, out_dir)
         return _rev(f, out_dir, getattr(args, "field", None))
 
@@ -55,7 +50,7 @@ def _section(f, values):
     nx, ny, nz = (int(d) for d in dims)
     local = f["cells/local"][()]
     v = values.reshape(nz, ny, nx)
-    mode = _attr(f, "mode", "3d")
+    mode = figutil.attr(f, "mode", "3d")
     if mode in ("slab", "2d"):
         img = v[0]
         u, w = local[:, 0].reshape(nz, ny, nx)[0], local[:, 1].reshape(nz, ny, nx)[0]
@@ -72,7 +67,7 @@ def _section(f, values):
 
 def _rev(f, out_dir, field):
     cells = f["cells"]
-    method = _attr(f, "method", "box")
+    method = figutil.attr(f, "method", "box")
     if field:
         names = [field]
     elif method == "gaussian":
@@ -136,7 +131,7 @@ def _shearzone(f, out_dir):
     ax.set_ylim(extent[2], extent[3])
     ax.set_xlabel("map x (m)")
     ax.set_ylabel("map y (m)")
-    ax.set_title("%s map; inclination %.1f deg" % (_attr(f, "field", ""),
+    ax.set_title("%s map; inclination %.1f deg" % (figutil.attr(f, "field", ""),
                                                   float(f.attrs["inclination_deg"])))
     ax.legend(loc="lower right", fontsize=7)
     fig.colorbar(im, ax=ax, shrink=0.7)
@@ -149,7 +144,7 @@ def _shearzone(f, out_dir):
         if np.isfinite(off):
             ax.axvline(off / d50, color="r", ls="--")
     ax.set_xlabel("distance across the band (d50)")
-    ax.set_ylabel("mean %s along the band" % _attr(f, "field", ""))
+    ax.set_ylabel("mean %s along the band" % figutil.attr(f, "field", ""))
     ax.set_title("thickness %.2f mm = %.2f d50 (inflection points)"
                  % (float(f.attrs["thickness_mm"]), float(f.attrs["thickness_d50"])))
     return [figutil.save(fig, out_dir, "shearzone.png")]

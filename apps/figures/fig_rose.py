@@ -14,14 +14,9 @@ import figutil
 from figutil import plt
 
 
-def _attr(f, name, default=None):
-    v = f.attrs.get(name, default)
-    return v.decode() if isinstance(v, bytes) else v
-
-
 def make(input_path, out_dir, args):
     with h5py.File(input_path, "r") as f:
-        if _attr(f, "format", "") == "granoscope-fabric":
+        if figutil.attr(f, "format", "") == "granoscope-fabric":
             return _fabric(f, out_dir)
         return _rose(f, out_dir)
 

@@ -9,11 +9,6 @@ import figutil
 from figutil import plt
 
 
-def _attr(g, name, default=None):
-    v = g.attrs.get(name, default)
-    return v.decode() if isinstance(v, bytes) else v
-
-
 def make(input_path, out_dir, args):
     with h5py.File(input_path, "r") as f:
         walls = []
@@ -21,7 +16,7 @@ def make(input_path, out_dir, args):
             g = f["walls"][key]
             if g["position"].size == 0:
                 continue
-            walls.append((int(_attr(g, "id")), _attr(g, "role"), g["position"][()],
+            walls.append((int(figutil.attr(g, "id")), figutil.attr(g, "role"), g["position"][()],
                           g["sigma_n"][()], g["tau"][()]))
         text = "P/G %.3f, T/G %.3f, N/G %.3f, phi_w %.1f deg, (T + P)/G %.3f" % tuple(
             float(f.attrs[k]) for k in ("P_over_G", "T_over_G", "N_over_G", "phi_w_deg",
