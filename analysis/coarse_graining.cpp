@@ -48,13 +48,11 @@ struct Axis {
   int n = 1;
   int first(double c) const { return static_cast<int>(std::ceil((c - reach - lo) / s)); }
   int last(double c) const { return static_cast<int>(std::floor((c + reach - lo) / s)); }
-  /// Weight (1/m) of point k: the Gaussian's integral over [x_k - s/2, x_k + s/2] cut to
-  /// [c - 4w, c + 4w], over s, normalised so that the weights of all points sum to 1/s.
-  double weight(int k, double c) const {
-    const double x = lo + k * s;
-    const double a = std::max(x - 0.5 * s, c - kCut * w), b = std::min(x + 0.5 * s, c + kCut * w);
-    if (!(b > a)) return 0.0;
-    return (normal_cdf((b - c) / w) - normal_cdf((a - c) / w)) / (s * norm);
+  /// The Gaussian's cumulative distribution at y, cut to [c - 4w, c + 4w]: the weight (1/m) of
+  /// point k is (edge(x_k + s/2) - edge(x_k - s/2)) / (s norm), so that the weights of all
+  /// points sum to 1/s; neighbouring points share an edge.
+  double edge(double y, double c) const {
+    return normal_cdf((std::clamp(y, c - kCut * w, c + kCut * w) - c) / w);
   }
 };
 
@@ -66,7 +64,13 @@ struct Stencil {
 void fill(const Axis& ax, double c, int clip0, int clip1, Stencil& st) {
   st.k0 = std::max(ax.first(c), clip0);
   st.k1 = std::min(ax.last(c), clip1);
-  for (int k = st.k0; k <= st.k1; ++k) st.g[k - st.k0] = ax.weight(k, c);
+  const double scale = 1.0 / (ax.s * ax.norm);
+  double lower = ax.edge(ax.lo + (st.k0 - 0.5) * ax.s, c);
+  for (int k = st.k0; k <= st.k1; ++k) {
+    const double upper = ax.edge(ax.lo + (k + 0.5) * ax.s, c);
+    st.g[k - st.k0] = (upper - lower) * scale;
+    lower = upper;
+  }
 }
 
 }  // namespace
