@@ -18,6 +18,7 @@ def make(input_path, out_dir, args):
         fig, axes = plt.subplots(1, 2 if has_e and has_s else 1, figsize=(11 if has_e and has_s
                                                                            else 6, 5))
         axes = np.atleast_1d(axes)
+        fig.subplots_adjust(wspace=0.4)
         k = 0
         if has_s:
             g = f["stress"]
@@ -30,12 +31,16 @@ def make(input_path, out_dir, args):
                     (s[0], s[1]),):
                 c, r = 0.5 * (a + b), 0.5 * (a - b)
                 ax.plot(c + r * np.cos(th), r * np.sin(th), "k")
+            rmax = 0.5 * (s.max() - s.min()) or abs(s.max()) or 1.0
+            lo, hi = s.min() - 0.6 * rmax, s.max() + 0.6 * rmax
             phi = float(g.attrs["phi_mob_deg"])
             if np.isfinite(phi):
-                x = np.linspace(0, s.max() * 1.05, 2)
+                x = np.linspace(max(lo, 0.0), hi, 2)
                 ax.plot(x, x * np.tan(np.radians(phi)), "r--", label="phi_mob = %.1f deg" % phi)
                 ax.legend()
-            ax.set_aspect("equal")
+            ax.set_xlim(lo, hi)
+            ax.set_ylim(0.0, 1.5 * rmax)
+            ax.set_aspect("equal", adjustable="datalim")
             ax.set_xlabel("normal stress (Pa, compression positive)")
             ax.set_ylabel("shear stress (Pa)")
             ax.set_title("p %.4g, q %.4g, eta %.3f, b %.3f, Lode %.1f deg" % tuple(
