@@ -217,18 +217,23 @@ ShearZone shear_zone(const ScalarMap& m) {
     z.profile_d.push_back(static_cast<double>(k) * m.step);
     z.profile_value.push_back(v);
   }
+  // The profile smoothed by the binomial [1 2 1] / 4 (particle-scale noise would otherwise make
+  // the second difference change sign early; it widens the band by a variance of s^2 / 2).
+  const std::size_t np = z.profile_value.size();
+  std::vector<double> sm = z.profile_value;
+  for (std::size_t k = 1; k + 1 < np; ++k)
+    sm[k] = 0.25 * (z.profile_value[k - 1] + 2.0 * z.profile_value[k] + z.profile_value[k + 1]);
   // Peak: the largest value within 3 steps of the line.
   int kp = -1;
-  for (std::size_t k = 0; k < z.profile_d.size(); ++k) {
+  for (std::size_t k = 0; k < np; ++k) {
     if (std::abs(z.profile_d[k]) > 3.0 * m.step + 1e-12 * m.step) continue;
-    if (kp < 0 || z.profile_value[k] > z.profile_value[static_cast<std::size_t>(kp)])
-      kp = static_cast<int>(k);
+    if (kp < 0 || sm[k] > sm[static_cast<std::size_t>(kp)]) kp = static_cast<int>(k);
   }
   if (kp < 0) throw std::invalid_argument("shear zone: no profile across the band");
   z.peak_d = z.profile_d[static_cast<std::size_t>(kp)];
   z.peak_value = z.profile_value[static_cast<std::size_t>(kp)];
-  z.lower_d = inflection(z.profile_d, z.profile_value, kp, -1);
-  z.upper_d = inflection(z.profile_d, z.profile_value, kp, 1);
+  z.lower_d = inflection(z.profile_d, sm, kp, -1);
+  z.upper_d = inflection(z.profile_d, sm, kp, 1);
   z.thickness = z.upper_d - z.lower_d;
   return z;
 }

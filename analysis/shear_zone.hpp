@@ -12,9 +12,10 @@
 //
 // Thickness (seed 004 §4.2.3: "an inflection point in the distribution of sphere rotation around
 // the maximum defined the lower and the upper boundary of the shear zone"): the profile across the
-// band is the mean of the map (bilinear) along lines parallel to the fitted one, one step apart;
-// from its maximum near the line, the first sign change of the second difference on each side,
-// found by linear interpolation, gives the two boundaries; the thickness is their distance. The
+// band is the mean of the map (bilinear) along lines parallel to the fitted one, one step apart,
+// smoothed by the binomial [1 2 1] / 4 against particle-scale noise; from its maximum near the
+// line, the first sign change of the second difference on each side, found by linear
+// interpolation, gives the two boundaries; the thickness is their distance. The
 // profile is that of the map: the band widened by the REV cell (for a Gaussian band of standard
 // deviation s0, about sqrt(s0^2 + L^2/12) per side, L the cell size).
 #pragma once

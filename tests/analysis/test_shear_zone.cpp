@@ -10,6 +10,7 @@
 
 #include <cmath>
 #include <numbers>
+#include <random>
 
 #include "packing_util.hpp"
 #include "rev_cells.hpp"
@@ -66,13 +67,18 @@ struct BandCase {
   double angle_deg;  // band direction to the horizontal (x) in the x-z plane
 };
 
-void run_band(double angle_deg, int nx = 60, int nz = 80, double sigma_d50 = 2.5) {
+void run_band(double angle_deg, int nx = 60, int nz = 80, double sigma_d50 = 2.5,
+              double noise = 0.0, double tol_angle = 0.5, double tol_d50 = 0.2) {
   const double r = 0.5e-3, d50 = 2 * r, sigma = sigma_d50 * d50, L = 5 * d50, s = d50;
   // Lattice nx x 6 x nz (x, y, z); rotation about y in a Gaussian band through the centre.
   const Eigen::Vector3d centre(0.5 * (nx - 1) * d50, 2.5e-3, 0.5 * (nz - 1) * d50);
   const double a = angle_deg * kPi / 180;
   const Eigen::Vector3d nrm(-std::sin(a), 0, std::cos(a));
-  const gs::Frame f = gs::test::band_lattice(nx, 6, nz, d50, angle_deg, sigma, centre);
+  gs::Frame f = gs::test::band_lattice(nx, 6, nz, d50, angle_deg, sigma, centre);
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> scatter(0.0, noise > 0 ? noise : 1.0);
+  if (noise > 0)
+    for (auto& p : f.particles) p.rotation.y() += scatter(rng);  // particle-scale scatter
   ga::RevGridSpec spec;  // front view: e1 = x, e2 = z (normal -y), slab 5 d50 thick
   spec.cell = L;
   spec.step = s;
@@ -89,7 +95,7 @@ void run_band(double angle_deg, int nx = 60, int nz = 80, double sigma_d50 = 2.5
   for (std::size_t c = 0; c < g.count(); ++c)
     m.value.push_back(std::abs(rf.rotation[c].dot(normal)));
   const auto z = ga::shear_zone(m);
-  EXPECT_NEAR(z.inclination_deg, std::min(angle_deg, 180 - angle_deg), 0.5) << angle_deg;
+  EXPECT_NEAR(z.inclination_deg, std::min(angle_deg, 180 - angle_deg), tol_angle) << angle_deg;
   // The band passes through the centre: its line does too (within 0.2 d50).
   const Eigen::Vector2d c2(g.local(centre).x(), g.local(centre).y());
   const Eigen::Vector2d n2(-z.direction.y(), z.direction.x());
@@ -103,9 +109,13 @@ void run_band(double angle_deg, int nx = 60, int nz = 80, double sigma_d50 = 2.5
                    s * std::abs(nrm.x()), s * std::abs(nrm.z()), s * std::abs(nrm.z()), s, s})
     if (w > h) k = convolve(k, box(w, h));
   k = convolve(k, parabola(r, h));
+  std::vector<double> binomial(static_cast<std::size_t>(std::lround(2 * s / h)) + 1, 0.0);
+  binomial.front() = binomial.back() = 0.25;  // the [1 2 1] / 4 smoothing of the profile
+  binomial[binomial.size() / 2] = 0.5;
+  k = convolve(k, binomial);
   const double expect = 2 * expected_half_width(sigma, k, h);
-  EXPECT_NEAR(z.thickness, expect, 0.2 * d50) << angle_deg;
-  EXPECT_NEAR(z.upper_d + z.lower_d, 0.0, 0.2 * d50);  // symmetric about the line
+  EXPECT_NEAR(z.thickness, expect, tol_d50 * d50) << angle_deg;
+  EXPECT_NEAR(z.upper_d + z.lower_d, 0.0, tol_d50 * d50);  // symmetric about the line
   std::printf(
       "band %.0f deg: inclination %.3f deg, thickness %.3f d50 (expected %.3f d50, "
       "band 2 sigma = %.1f d50)\n",
@@ -124,6 +134,14 @@ TEST(ShearZone, WideBandInANarrowPlaneStrainSection) {
   // Seed 000 §3 proportions: a 4 x 14 cm section with d50 = 2.5 mm is 16 x 56 d50, and the band
   // is about 10 d50 thick (sigma 4 d50 here), inclined at 62 deg.
   run_band(62.0, 16, 56, 4.0);
+}
+
+TEST(ShearZone, NoisyRotations) {
+  // The same with a particle-scale scatter of 0.1 rad (1/8 of the band's peak) on every
+  // rotation. Over seeds 5-8 the inclination came within 0.44 deg and the thickness within
+  // -0.29..+0.12 d50 of the noise-free expectation (0.2 rad: 0.94 deg, -0.58..+0.26 d50): the
+  // noise moves the sign change of the second difference. Allowed: 1 deg and 1 d50 (~4 sigma).
+  run_band(62.0, 16, 56, 4.0, 0.1, 1.0, 1.0);
 }
 
 TEST(ShearZone, HorizontalBandOfDirectShear) {
