@@ -23,6 +23,11 @@ struct SlabProjection {
   Eigen::Vector3d e1 = Eigen::Vector3d::UnitX(), e2 = Eigen::Vector3d::UnitY();
 };
 
+/// Orthonormal axes of the slab as the rows of a matrix: e1 (axis1 made orthogonal to the
+/// normal), e2 = n x e1, n; local coordinates are axes * (x - origin). Throws std::invalid_argument
+/// for a thickness <= 0, a zero normal, or axis1 parallel to the normal.
+Eigen::Matrix3d slab_axes(const Slab& slab);
+
 /// Selects |(x - origin) . n| <= thickness / 2 and projects positions and `vectors` (same size
 /// as `positions`, may be empty) onto the plane. Throws std::invalid_argument for a thickness
 /// <= 0, a zero normal, or axis1 parallel to the normal.

@@ -21,6 +21,8 @@ void register_figures(CLI::App& app) {
   cmd->add_option("--type", *type, "one figure type (e.g. positions); default: all for the input");
   cmd->add_option("--frame", *frame, "frame of a trajectory (negative counts from the end)")
       ->capture_default_str();
+  auto field = std::make_shared<std::string>();
+  cmd->add_option("--field", *field, "field of a map figure (rev), e.g. void_ratio, stress_zz");
   cmd->callback([=] {
     std::error_code ec;
     if (!std::filesystem::exists(*in, ec)) throw InputError(*in, "no such file");
@@ -35,6 +37,10 @@ void register_figures(CLI::App& app) {
     if (!type->empty()) {
       argv.push_back("--type");
       argv.push_back(*type);
+    }
+    if (!field->empty()) {
+      argv.push_back("--field");
+      argv.push_back(*field);
     }
     const int rc = run_process(argv);
     if (rc != 0) throw ExitStatus{rc == 2 ? 2 : (rc == 0 ? 0 : 2)};

@@ -24,5 +24,9 @@ void register_dic(CLI::App& app);  // dic (apps/cmd_dic.cpp)
 CLI::App& analyze_command(CLI::App& app);
 /// `granoscope analyze strain` and `granoscope analyze voidcells` (apps/cmd_strain.cpp).
 void register_analyze_strain(CLI::App& app);
+/// `granoscope analyze rev | shearzone | invariants` (apps/cmd_rev.cpp).
+void register_analyze_rev(CLI::App& app);
+/// `granoscope analyze fabric | rose | chains | walls` (apps/cmd_contacts.cpp).
+void register_analyze_contacts(CLI::App& app);
 
 }  // namespace gs::cli

@@ -29,6 +29,8 @@ int main(int argc, char** argv) {
   gs::cli::register_simulate(app);
   gs::cli::register_dic(app);
   gs::cli::register_analyze_strain(app);
+  gs::cli::register_analyze_rev(app);
+  gs::cli::register_analyze_contacts(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -15,6 +15,8 @@
 #include <vtkXMLUnstructuredGridWriter.h>
 
 #include <algorithm>
+#include <cmath>
+#include <fstream>
 #include <numeric>
 
 #include "atomic_file.hpp"
@@ -309,6 +311,54 @@ void write_vti_image(const std::filesystem::path& path, const Eigen::Vector3d& o
                  static_cast<std::size_t>(dims[2]);
   for (const auto& a : point_data) img->GetPointData()->AddArray(to_vtk(a, n, path.string()));
   write_vtk<vtkXMLImageDataWriter>(path, img);
+}
+
+void write_csv_table(const std::filesystem::path& path, const std::vector<VtkArray>& columns) {
+  std::size_t rows = 0;
+  for (std::size_t k = 0; k < columns.size(); ++k) {
+    const auto& c = columns[k];
+    if (c.components < 1 || c.values.size() % static_cast<std::size_t>(c.components) != 0)
+      throw InputError(path.string(), "CSV column has a bad size", c.name);
+    const std::size_t n = c.values.size() / static_cast<std::size_t>(c.components);
+    if (k > 0 && n != rows) throw InputError(path.string(), "CSV columns differ in length", c.name);
+    rows = n;
+  }
+  AtomicOutput out(path);
+  {
+    std::ofstream os(out.temp_path());
+    if (!os) throw InputError(path.string(), "cannot write CSV");
+    static const char* xyz[3] = {"x", "y", "z"};
+    bool first = true;
+    for (const auto& c : columns)
+      for (int j = 0; j < c.components; ++j) {
+        os << (first ? "" : ",") << c.name;
+        first = false;
+        if (c.components == 3) os << '_' << xyz[j];
+        if (c.components == 9) os << '_' << xyz[j / 3] << xyz[j % 3];
+        if (c.components != 1 && c.components != 3 && c.components != 9) os << '_' << j;
+      }
+    os << '\n';
+    os.precision(12);
+    for (std::size_t r = 0; r < rows; ++r) {
+      first = true;
+      for (const auto& c : columns)
+        for (int j = 0; j < c.components; ++j) {
+          const double v =
+              c.values[r * static_cast<std::size_t>(c.components) + static_cast<std::size_t>(j)];
+          os << (first ? "" : ",");
+          first = false;
+          if (std::isfinite(v)) {
+            os << v;
+          } else {
+            os << "nan";
+          }
+        }
+      os << '\n';
+    }
+    os.flush();
+    if (!os) throw InputError(path.string(), "cannot write CSV");
+  }
+  out.commit();
 }
 
 }  // namespace gs

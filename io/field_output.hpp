@@ -86,4 +86,9 @@ void write_vti_image(const std::filesystem::path& path, const Eigen::Vector3d& o
                      const Eigen::Vector3d& spacing, const std::array<int, 3>& dims,
                      const std::vector<VtkArray>& point_data);
 
+/// CSV table of named columns of equal length (`values.size()` = rows x components); a column of
+/// 3 components is written as name_x, name_y, name_z, of 9 as name_xx .. name_zz (row-major),
+/// others as name_0, name_1, ... Non-finite values are written as nan.
+void write_csv_table(const std::filesystem::path& path, const std::vector<VtkArray>& columns);
+
 }  // namespace gs

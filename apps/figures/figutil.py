@@ -15,3 +15,9 @@ def save(fig, out_dir, name, dpi=150):
     plt.close(fig)
     os.replace(tmp, path)
     return path
+
+
+def attr(obj, name, default=None):
+    """An HDF5 attribute, bytes decoded to str."""
+    v = obj.attrs.get(name, default)
+    return v.decode() if isinstance(v, bytes) else v

@@ -16,6 +16,13 @@ FIGURES = {
     "granoscope-dic": ["fig_dic"],
     "granoscope-strain": ["fig_strain"],
     "granoscope-voidcells": ["fig_strain"],
+    "granoscope-rev": ["fig_rev"],
+    "granoscope-shearzone": ["fig_rev"],
+    "granoscope-invariants": ["fig_invariants"],
+    "granoscope-fabric": ["fig_rose"],
+    "granoscope-rose": ["fig_rose"],
+    "granoscope-chains": ["fig_chains"],
+    "granoscope-walls": ["fig_walls"],
 }
 
 
@@ -25,6 +32,7 @@ def main(argv):
     ap.add_argument("-o", "--out", required=True)
     ap.add_argument("--type", default=None, help="figure module name, e.g. positions")
     ap.add_argument("--frame", type=int, default=-1, help="frame index (trajectory figures)")
+    ap.add_argument("--field", default=None, help="field of a map figure (rev), e.g. void_ratio")
     args = ap.parse_args(argv)
     sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
     import h5py  # noqa: E402

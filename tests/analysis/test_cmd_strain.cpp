@@ -1,17 +1,14 @@
 // End-to-end tests of `granoscope analyze strain` / `analyze voidcells` on synthetic RUN.h5
 // files: exact affine answers come back through the HDF5 outputs; bad input exits 2.
 #include <gtest/gtest.h>
-#include <hdf5.h>
 
-#include <unistd.h>
-
-#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <random>
 #include <set>
 #include <string>
 
+#include "cli_util.hpp"
 #include "hdf5_trajectory.hpp"
 #include "tet_strain.hpp"
 
@@ -19,45 +16,12 @@ namespace fs = std::filesystem;
 
 namespace {
 
+using gs::test::read_doubles;
+using gs::test::read_format;
+using gs::test::run;
+
 fs::path temp_dir() {
-  const auto d =
-      fs::temp_directory_path() / ("gs_strain_cli_" + std::to_string(::getpid()) + "_" +
-                                   ::testing::UnitTest::GetInstance()->current_test_info()->name());
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
-
-int run(const std::string& args, const fs::path& log) {
-  const std::string cmd =
-      std::string(GS_BINARY_DIR) + "/bin/granoscope " + args + " > " + log.string() + " 2>&1";
-  const int rc = std::system(cmd.c_str());
-  return WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
-}
-
-std::vector<double> read_doubles(const fs::path& file, const char* name) {
-  const hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
-  EXPECT_GE(f, 0);
-  const hid_t d = H5Dopen2(f, name, H5P_DEFAULT);
-  const hid_t s = H5Dget_space(d);
-  std::vector<double> v(static_cast<std::size_t>(H5Sget_simple_extent_npoints(s)));
-  H5Dread(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data());
-  H5Sclose(s);
-  H5Dclose(d);
-  H5Fclose(f);
-  return v;
-}
-
-std::string read_format(const fs::path& file) {
-  const hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
-  const hid_t a = H5Aopen(f, "format", H5P_DEFAULT);
-  const hid_t t = H5Aget_type(a);
-  std::string s(H5Tget_size(t), '\0');
-  H5Aread(a, t, s.data());
-  H5Tclose(t);
-  H5Aclose(a);
-  H5Fclose(f);
-  return s.c_str();
+  return gs::test::temp_dir("gs_strain_cli");
 }
 
 TEST(CmdStrain, ThreeDAffineBetweenFramesMatchedById) {

@@ -1,5 +1,5 @@
 // Exact sphere–box volume and disc–rectangle area: analytic special cases, partitions of space
-// (volumes of all boxes of a grid sum to the ball), and Monte Carlo on random cuts by 0–3 planes.
+// (volumes of all boxes of a grid sum to the ball), and Monte Carlo on random boxes.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -98,9 +98,9 @@ TEST(SphereBoxVolume, GridPartitionSumsToTheBall) {
 }
 
 TEST(SphereBoxVolume, MonteCarloOnRandomCuts) {
-  // Random boxes cutting the unit ball by 0..3 planes per axis pair, including boxes smaller than
-  // the ball. Reference: 2e6 uniform samples in the box ∩ [-1, 1]^3; tolerance 5 standard
-  // deviations of the estimate (about 1e-3 of the ball volume).
+  // Random boxes whose faces cut the unit ball by 0 to 6 planes (some axes left uncut on one
+  // side), including boxes smaller than the ball. Reference: 2e6 uniform samples in the
+  // box ∩ [-1, 1]^3; tolerance 5 standard deviations of the estimate (~1e-3 of the ball volume).
   std::mt19937_64 rng(7);
   std::uniform_real_distribution<double> u(-1.2, 1.2), s(-1.0, 1.0);
   const int samples = 2000000;

@@ -1,0 +1,73 @@
+// Helpers of the CLI tests of the analyses: a scratch directory per test, running the
+// `granoscope` executable, and reading datasets and attributes of its HDF5 outputs.
+#pragma once
+
+#include <gtest/gtest.h>
+#include <hdf5.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace gs::test {
+
+/// A fresh directory named after the running test (removed by the caller).
+inline std::filesystem::path temp_dir(const std::string& prefix) {
+  const auto d = std::filesystem::temp_directory_path() /
+                 (prefix + "_" + std::to_string(::getpid()) + "_" +
+                  ::testing::UnitTest::GetInstance()->current_test_info()->name());
+  std::filesystem::remove_all(d);
+  std::filesystem::create_directories(d);
+  return d;
+}
+
+/// Runs `granoscope ARGS`, stdout and stderr into `log`; returns the exit code.
+inline int run(const std::string& args, const std::filesystem::path& log) {
+  const std::string cmd =
+      std::string(GS_BINARY_DIR) + "/bin/granoscope " + args + " > " + log.string() + " 2>&1";
+  const int rc = std::system(cmd.c_str());
+  return WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
+}
+
+inline std::vector<double> read_doubles(const std::filesystem::path& file, const char* name) {
+  const hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  EXPECT_GE(f, 0);
+  const hid_t d = H5Dopen2(f, name, H5P_DEFAULT);
+  const hid_t s = H5Dget_space(d);
+  std::vector<double> v(static_cast<std::size_t>(H5Sget_simple_extent_npoints(s)));
+  H5Dread(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data());
+  H5Sclose(s);
+  H5Dclose(d);
+  H5Fclose(f);
+  return v;
+}
+
+/// A numeric attribute of an object ("/" for the root).
+inline double read_attr(const std::filesystem::path& file, const char* object, const char* name) {
+  const hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  EXPECT_GE(f, 0);
+  const hid_t a = H5Aopen_by_name(f, object, name, H5P_DEFAULT, H5P_DEFAULT);
+  EXPECT_GE(a, 0) << name;
+  double v = 0.0;
+  H5Aread(a, H5T_NATIVE_DOUBLE, &v);
+  H5Aclose(a);
+  H5Fclose(f);
+  return v;
+}
+
+inline std::string read_format(const std::filesystem::path& file) {
+  const hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  const hid_t a = H5Aopen(f, "format", H5P_DEFAULT);
+  const hid_t t = H5Aget_type(a);
+  std::string s(H5Tget_size(t), '\0');
+  H5Aread(a, t, s.data());
+  H5Tclose(t);
+  H5Aclose(a);
+  H5Fclose(f);
+  return s.c_str();
+}
+
+}  // namespace gs::test
