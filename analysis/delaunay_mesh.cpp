@@ -173,17 +173,33 @@ std::vector<std::array<std::int32_t, 4>> regular_tetrahedra(
   return tets;
 }
 
-VertexRings vertex_rings(const DelaunayMesh& mesh, std::size_t n_points) {
-  const int nv = mesh.dim + 1;
+double tetrahedron_quality(const std::array<Eigen::Vector3d, 4>& x, double volume) {
+  double l2 = 0.0;
+  for (std::size_t a = 0; a < 4; ++a)
+    for (std::size_t b = a + 1; b < 4; ++b) l2 += (x[b] - x[a]).squaredNorm();
+  const double lrms = std::sqrt(l2 / 6.0);
+  return lrms > 0.0 ? 6.0 * std::sqrt(2.0) * volume / (lrms * lrms * lrms) : 0.0;
+}
+
+double triangle_quality(const std::array<Eigen::Vector2d, 3>& x, double area) {
+  double l2 = 0.0;
+  for (std::size_t a = 0; a < 3; ++a) l2 += (x[(a + 1) % 3] - x[a]).squaredNorm();
+  const double lrms2 = l2 / 3.0;
+  return lrms2 > 0.0 ? 4.0 * std::sqrt(3.0) * area / (3.0 * lrms2) : 0.0;
+}
+
+VertexRings vertex_rings(int dim, const std::vector<std::array<std::int32_t, 4>>& simplices,
+                         std::size_t n_points) {
+  const int nv = dim + 1;
   // Each simplex lists its nv (nv - 1) directed edges; sort and make unique per vertex.
   std::vector<std::int64_t> count(n_points + 1, 0);
-  for (const auto& s : mesh.simplices)
+  for (const auto& s : simplices)
     for (int a = 0; a < nv; ++a)
       count[static_cast<std::size_t>(s[static_cast<std::size_t>(a)]) + 1] += nv - 1;
   for (std::size_t i = 0; i < n_points; ++i) count[i + 1] += count[i];
   std::vector<std::int32_t> all(static_cast<std::size_t>(count[n_points]));
   std::vector<std::int64_t> fill(count.begin(), count.end() - 1);
-  for (const auto& s : mesh.simplices)
+  for (const auto& s : simplices)
     for (int a = 0; a < nv; ++a)
       for (int b = 0; b < nv; ++b) {
         if (a == b) continue;

@@ -43,8 +43,15 @@ std::vector<std::array<std::int32_t, 4>> regular_tetrahedra(
 std::vector<std::array<std::int32_t, 3>> delaunay_triangles(
     const std::vector<Eigen::Vector2d>& points);
 
-/// Vertex 1-rings of a mesh (the Delaunay edges) in compressed rows: the neighbours of vertex i
-/// are index[offset[i] .. offset[i+1]), sorted ascending. `n_points` >= every vertex index + 1.
+/// Shape quality q = 6 sqrt(2) V / l_rms^3 of a tetrahedron of volume V, l_rms the root-mean-square
+/// edge length: 1 for the regular tetrahedron, -> 0 for slivers.
+double tetrahedron_quality(const std::array<Eigen::Vector3d, 4>& x, double volume);
+/// q = 4 sqrt(3) A / (3 l_rms^2) of a triangle of area A: 1 equilateral, -> 0 flat.
+double triangle_quality(const std::array<Eigen::Vector2d, 3>& x, double area);
+
+/// Vertex 1-rings of a mesh of `dim`-simplices (the Delaunay edges) in compressed rows: the
+/// neighbours of vertex i are index[offset[i] .. offset[i+1]), sorted ascending. `n_points` >=
+/// every vertex index + 1.
 struct VertexRings {
   std::vector<std::int64_t> offset;
   std::vector<std::int32_t> index;
@@ -52,6 +59,7 @@ struct VertexRings {
     return static_cast<std::size_t>(offset[i + 1] - offset[i]);
   }
 };
-VertexRings vertex_rings(const DelaunayMesh& mesh, std::size_t n_points);
+VertexRings vertex_rings(int dim, const std::vector<std::array<std::int32_t, 4>>& simplices,
+                         std::size_t n_points);
 
 }  // namespace gs::analysis

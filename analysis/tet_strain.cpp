@@ -24,14 +24,6 @@ void check_finite(const std::vector<Vec>& v, const char* what) {
   }
 }
 
-double tet_quality(const std::array<Eigen::Vector3d, 4>& x, double volume) {
-  double l2 = 0.0;
-  for (int a = 0; a < 4; ++a)
-    for (int b = a + 1; b < 4; ++b) l2 += (x[b] - x[a]).squaredNorm();
-  const double lrms = std::sqrt(l2 / 6.0);
-  return lrms > 0.0 ? 6.0 * std::sqrt(2.0) * volume / (lrms * lrms * lrms) : 0.0;
-}
-
 // Per-particle and assembly averages over the good simplices; serial accumulation in simplex
 // order, so the result does not depend on the thread count.
 void average(SimplexStrain& r, std::size_t n_points, int nv) {
@@ -116,7 +108,7 @@ SimplexStrain tet_strain(const std::vector<Eigen::Vector3d>& reference,
     const double vol = dx.determinant() / 6.0;  // > 0: CGAL cells are positively oriented
     const auto ts = static_cast<std::size_t>(t);
     r.measure[ts] = std::abs(vol);
-    r.quality[ts] = tet_quality(x, std::abs(vol));
+    r.quality[ts] = tetrahedron_quality(x, std::abs(vol));
     // A cell flat in floating point (quality ~ 0) keeps a zero gradient and is a sliver.
     if (r.quality[ts] > 1e-12) {
       r.gradient[ts] = dx.transpose().partialPivLu().solve(du.transpose()).transpose();
@@ -164,11 +156,8 @@ SimplexStrain triangle_strain(const std::vector<Eigen::Vector2d>& reference,
     }
     const Eigen::Vector2d e1 = x[1] - x[0], e2 = x[2] - x[0];
     const double area = 0.5 * (e1.x() * e2.y() - e1.y() * e2.x());  // > 0: CGAL faces are CCW
-    double l2 = 0.0;
-    for (int a = 0; a < 3; ++a) l2 += (x[(a + 1) % 3] - x[a]).squaredNorm();
-    const double lrms2 = l2 / 3.0;
     r.measure[ts] = std::abs(area);
-    r.quality[ts] = lrms2 > 0.0 ? 4.0 * std::sqrt(3.0) * std::abs(area) / (3.0 * lrms2) : 0.0;
+    r.quality[ts] = triangle_quality(x, std::abs(area));
     if (r.quality[ts] > 1e-12) {
       // Seed 002 eq 4: L_pq = 1/(6A) sum_{j1<j2} (v^{j1} - v^{j2})_p (b^{j1} - b^{j2})_q with
       // b^j the outward normal of the edge opposite vertex j, scaled by its length.
