@@ -208,7 +208,9 @@ void check_rates(int dim, const std::vector<int>& ns, HhdSolver solver, bool v_d
     EXPECT_LT(r, 1.2);
   }
   EXPECT_GT(ru, 1.7);
-  if (v_determined) EXPECT_GT(rv, 1.7);
+  if (v_determined) {
+    EXPECT_GT(rv, 1.7);
+  }
 }
 
 TEST(Hhd, AnalyticFieldConvergesAtFirstOrder2D) {
