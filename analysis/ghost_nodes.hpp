@@ -3,6 +3,9 @@
 // in 3D) outside the box of the particle centres up to a distance D, each ghost at least d_min
 // from every centre, its vector the Gaussian average (radius R) of the true nodes.
 //
+// Lattice nodes are shifted by a fixed pseudo-random amount of at most 1e-3 h_g per coordinate
+// (breaks the Delaunay degeneracy of a regular lattice).
+//
 // Paper (d50 = 2.5 mm, specimen width b = 40 mm): h_g = 4.5 mm, d_min = 4 mm, D = 50 mm,
 // R = 80 mm = 2 b. The defaults scale these: h_g = 1.8 d50, d_min = 1.6 d50, D = 1.25 b, R = 2 b.
 //

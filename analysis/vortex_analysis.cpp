@@ -31,7 +31,8 @@ VortexAnalysis analyze_vortices(const std::vector<Eigen::Vector3d>& points,
   a.true_nodes = points.size();
   a.mesh.dim = dim;
   a.mesh.points = points;
-  std::vector<Eigen::Vector3d> nodal = vectors;
+  std::vector<Eigen::Vector3d>& nodal = a.vectors;
+  nodal = vectors;
   for (auto& p : a.mesh.points)
     if (dim == 2) p.z() = 0.0;
   for (auto& v : nodal)

@@ -28,7 +28,8 @@ struct VortexAnalysisOptions {
 struct VortexAnalysis {
   HhdMesh mesh;  // the true nodes first (input order), then the ghosts
   std::size_t true_nodes = 0;
-  std::vector<std::uint8_t> excluded;  // ghosts and Dirichlet nodes
+  std::vector<Eigen::Vector3d> vectors;  // nodal vectors (true, then ghost averages; 2D z = 0)
+  std::vector<std::uint8_t> excluded;    // ghosts and Dirichlet nodes
   VertexRings rings;
   HhdResult hhd;
   std::vector<Extremum> extrema;

@@ -25,4 +25,7 @@ CLI::App& analyze_command(CLI::App& app);
 /// `granoscope analyze strain` and `granoscope analyze voidcells` (apps/cmd_strain.cpp).
 void register_analyze_strain(CLI::App& app);
 
+/// `granoscope analyze hhd` and `granoscope analyze vortices` (apps/cmd_hhd.cpp).
+void register_analyze_hhd(CLI::App& app);
+
 }  // namespace gs::cli

@@ -29,6 +29,7 @@ int main(int argc, char** argv) {
   gs::cli::register_simulate(app);
   gs::cli::register_dic(app);
   gs::cli::register_analyze_strain(app);
+  gs::cli::register_analyze_hhd(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -16,6 +16,8 @@ FIGURES = {
     "granoscope-dic": ["fig_dic"],
     "granoscope-strain": ["fig_strain"],
     "granoscope-voidcells": ["fig_strain"],
+    "granoscope-hhd": ["fig_hhd"],
+    "granoscope-vortices": ["fig_vortices"],
 }
 
 
