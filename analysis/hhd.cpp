@@ -191,6 +191,8 @@ double dot(const std::vector<double>& w, const std::vector<Eigen::Vector3d>& a,
 
 const char* hhd_solver_name(HhdSolver s) {
   switch (s) {
+    case HhdSolver::Auto:
+      return "auto";
     case HhdSolver::Cholmod:
       return "cholmod";
     case HhdSolver::Ldlt:
@@ -204,9 +206,10 @@ const char* hhd_solver_name(HhdSolver s) {
 }
 
 HhdSolver hhd_solver_from_name(const std::string& name) {
-  for (auto s : {HhdSolver::Cholmod, HhdSolver::Ldlt, HhdSolver::Cg, HhdSolver::BiCgStab})
+  for (auto s :
+       {HhdSolver::Auto, HhdSolver::Cholmod, HhdSolver::Ldlt, HhdSolver::Cg, HhdSolver::BiCgStab})
     if (name == hhd_solver_name(s)) return s;
-  throw std::invalid_argument("unknown HHD solver, expected cholmod, ldlt, cg or bicgstab (" +
+  throw std::invalid_argument("unknown HHD solver, expected auto, cholmod, ldlt, cg or bicgstab (" +
                               name + ")");
 }
 
@@ -331,7 +334,6 @@ HhdResult helmholtz_hodge(const HhdMesh& m, const std::vector<Eigen::Vector3d>& 
   }
   HhdResult r;
   r.dim = m.dim;
-  r.report.solver = hhd_solver_name(o.solver);
   const int nv = m.dim == 3 ? 3 : 1;
   auto t0 = Clock::now();
   const P1Geometry g = p1_geometry(m);
@@ -339,6 +341,12 @@ HhdResult helmholtz_hodge(const HhdMesh& m, const std::vector<Eigen::Vector3d>& 
   const std::vector<int> idx = unknown_index(m, g, n);
   if (n == 0) throw std::invalid_argument("HHD mesh has no interior node to solve for");
   r.report.unknowns = static_cast<std::size_t>(n);
+  HhdSolver solver = o.solver;
+  if (solver == HhdSolver::Auto) {
+    solver =
+        m.dim == 3 && r.report.unknowns > kHhdAutoDirectMax ? HhdSolver::Cg : HhdSolver::Cholmod;
+  }
+  r.report.solver = hhd_solver_name(solver);
   r.xi = xi;
   if (m.dim == 2)
     for (auto& x : r.xi) x.z() = 0.0;
@@ -366,7 +374,8 @@ HhdResult helmholtz_hodge(const HhdMesh& m, const std::vector<Eigen::Vector3d>& 
     x = solver.solve(rhs);
     r.report.seconds_solve = seconds_since(t0);
   };
-  switch (o.solver) {
+  switch (solver) {
+    case HhdSolver::Auto:  // resolved above
     case HhdSolver::Cholmod: {
       Eigen::CholmodDecomposition<SpMat, Eigen::Lower> s;
       direct(s);
@@ -378,16 +387,29 @@ HhdResult helmholtz_hodge(const HhdMesh& m, const std::vector<Eigen::Vector3d>& 
       break;
     }
     case HhdSolver::Cg: {
+      // One CG per right-hand side, the right-hand sides spread over the threads: no barrier
+      // inside the iterations (a parallel SpMV stalls badly on a loaded 2-core machine), and
+      // each column is computed the same way whatever the thread count.
       t0 = Clock::now();
-      Eigen::ConjugateGradient<SpMat, Eigen::Lower | Eigen::Upper> s;
-      s.setTolerance(o.tolerance);
-      s.setMaxIterations(o.max_iterations);
-      s.compute(k);
-      r.report.seconds_factor = seconds_since(t0);
-      t0 = Clock::now();
-      x.col(0) = iterate(s, rhs.col(0), r.report.iterations_u, r.report.converged);
-      for (int c = 1; c <= nv; ++c)
-        x.col(c) = iterate(s, rhs.col(c), r.report.iterations_v, r.report.converged);
+      r.report.seconds_factor = 0.0;
+      const int cols = 1 + nv;
+      std::vector<int> its(static_cast<std::size_t>(cols), 0);
+      std::vector<char> ok(static_cast<std::size_t>(cols), 1);
+#pragma omp parallel for schedule(dynamic, 1)
+      for (int c = 0; c < cols; ++c) {
+        Eigen::ConjugateGradient<SpMat, Eigen::Lower> s;
+        s.setTolerance(o.tolerance);
+        s.setMaxIterations(o.max_iterations);
+        s.compute(k);
+        bool conv = true;
+        x.col(c) = iterate(s, rhs.col(c), its[static_cast<std::size_t>(c)], conv);
+        ok[static_cast<std::size_t>(c)] = conv ? 1 : 0;
+      }
+      r.report.iterations_u = its[0];
+      for (int c = 1; c < cols; ++c) {
+        r.report.iterations_v = std::max(r.report.iterations_v, its[static_cast<std::size_t>(c)]);
+      }
+      r.report.converged = std::all_of(ok.begin(), ok.end(), [](char b) { return b != 0; });
       r.report.seconds_solve = seconds_since(t0);
       break;
     }

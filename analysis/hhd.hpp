@@ -15,7 +15,8 @@
 //  * v, path (a) `bicgstab` (the paper's): eq 18 exactly as written, BiCGSTAB (Eigen, diagonal
 //    preconditioner). In 3D its matrix is −CᵀMC (C the P1 curl, M = diag|T_k|): the normal
 //    equations of eq 11; negative definite on generic meshes but conditioned like h^-4.
-//  * v, path (b) `cholmod` (default) and its variants `ldlt` (path c: Eigen SimplicialLDLT) and
+//  * v, path (b) `cholmod` (`auto`, the default, picks it or `cg`) and its variants `ldlt` (path c:
+//  Eigen SimplicialLDLT) and
 //    `cg` (Jacobi-preconditioned CG): the component-wise Laplacian K v_a = (Σ_k |T_k| ξ_k ×
 //    (∇φ_i)_k)_a with the same K as for u, factored once for all 1 + (1 or 3) right-hand sides.
 //    Since K⊗I = CᵀMC + DᵀMD exactly for P1 fields vanishing on the hull (D the P1 divergence),
@@ -32,17 +33,22 @@
 namespace gs::analysis {
 
 enum class HhdSolver {
+  Auto,      // path (b): Cholmod in 2D and up to kHhdAutoDirectMax unknowns in 3D, Cg above
   Cholmod,   // path (b): Laplacian, CHOLMOD Cholesky (supernodal/simplicial as CHOLMOD picks)
   Ldlt,      // path (c): Laplacian, Eigen SimplicialLDLT (AMD ordering)
   Cg,        // path (b) iterative: Laplacian, Jacobi-preconditioned conjugate gradients
   BiCgStab,  // path (a): eq 17 and eq 18 as written, BiCGSTAB (the paper's)
 };
 const char* hhd_solver_name(HhdSolver s);
-/// "cholmod", "ldlt", "cg", "bicgstab"; throws std::invalid_argument listing them.
+/// 3D meshes with more unknowns use CG under HhdSolver::Auto: with Debian's reference BLAS the
+/// supernodal factorization of a 3D Laplacian (O(N^2) flops) is slower than Jacobi-CG beyond
+/// ~2e4 nodes (bench/bench_hhd.cpp).
+inline constexpr std::size_t kHhdAutoDirectMax = 20000;
+/// "auto", "cholmod", "ldlt", "cg", "bicgstab"; throws std::invalid_argument listing them.
 HhdSolver hhd_solver_from_name(const std::string& name);
 
 struct HhdOptions {
-  HhdSolver solver = HhdSolver::Cholmod;
+  HhdSolver solver = HhdSolver::Auto;
   double tolerance = 1e-10;    // iterative solvers: relative residual ‖r‖/‖b‖ per system
   int max_iterations = 10000;  // iterative solvers, per system
 };
@@ -81,7 +87,7 @@ std::vector<double> p1_divergence(const HhdMesh& mesh, const P1Geometry& g,
                                   const Eigen::MatrixXd& v);
 
 struct HhdReport {
-  std::string solver;
+  std::string solver;        // the one used (auto resolved)
   std::size_t unknowns = 0;  // nodes solved for (not Dirichlet, in a simplex of positive measure)
   int iterations_u = 0, iterations_v = 0;  // iterative solvers (v: the most over components)
   bool converged = true;                   // iterative solvers reached `tolerance`

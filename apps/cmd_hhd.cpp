@@ -44,7 +44,7 @@ struct FieldArgs {
   bool ghosts = false;
   double ghost_spacing = 0.0, ghost_min_distance = -1.0, ghost_extent = 0.0, ghost_radius = 0.0;
   double d50 = 0.0;
-  std::string solver = "cholmod";
+  std::string solver = "auto";
   double tolerance = 1e-10;
   int max_iterations = 10000;
   std::vector<double> axis;
@@ -65,9 +65,11 @@ void add_field_options(CLI::App* s, FieldArgs& a) {
   s->add_option("--ghost-extent", a.ghost_extent, "ghosts up to this distance in m (1.25 width)");
   s->add_option("--ghost-radius", a.ghost_radius, "Gaussian averaging radius R in m (2 width)");
   s->add_option("--d50", a.d50, "d50 in m for the ghost defaults (default: from the frame)");
-  s->add_option("--solver", a.solver,
-                "cholmod (path b, default) | ldlt (path c) | cg (path b, iterative) | bicgstab "
-                "(path a: eq 17-18 as written, the paper's)");
+  s->add_option(
+      "--solver", a.solver,
+      "auto (default: cholmod, or cg for 3D meshes over 20000 nodes) | cholmod (path b) | "
+      "ldlt (path c) | cg (path b, iterative) | bicgstab (path a: eq 17-18 as written, "
+      "the paper's)");
   s->add_option("--tolerance", a.tolerance, "iterative solvers: relative residual (1e-10)");
   s->add_option("--max-iterations", a.max_iterations, "iterative solvers (10000)");
   s->add_option("--axis", a.axis,

@@ -238,6 +238,8 @@ TEST(Hhd, BadInputThrows) {
   EXPECT_THROW(helmholtz_hodge(m, xi, o), std::invalid_argument);
   EXPECT_THROW(hhd_solver_from_name("gmres"), std::invalid_argument);
   EXPECT_EQ(hhd_solver_from_name("bicgstab"), HhdSolver::BiCgStab);
+  EXPECT_EQ(HhdOptions{}.solver, HhdSolver::Auto);
+  EXPECT_EQ(helmholtz_hodge(m, xi).report.solver, "cholmod");  // 2D: always the direct path
   m.dirichlet.assign(m.points.size(), 1);
   EXPECT_THROW(helmholtz_hodge(m, xi), std::invalid_argument);
   // A uniform field: no potential at all, h = ξ exactly.
