@@ -17,19 +17,14 @@ from figutil import plt
 RIGHT, LEFT, SOURCE, SINK = 0, 1, 2, 3
 
 
-def _attr(f, name, default=None):
-    v = f.attrs.get(name, default)
-    return v.decode() if isinstance(v, bytes) else v
-
-
 def make(input_path, out_dir, args):
     with h5py.File(input_path, "r") as f:
-        if _attr(f, "format", "") != "granoscope-hhd":
-            raise ValueError("not an HHD file (format %s)" % _attr(f, "format", ""))
+        if figutil.attr(f, "format", "") != "granoscope-hhd":
+            raise ValueError("not an HHD file (format %s)" % figutil.attr(f, "format", ""))
         for name in ("nodes/position", "simplices/vertices", "simplices/xi", "extrema/kind"):
             if name not in f:
                 raise KeyError("%s missing" % name)
-        dim = int(_attr(f, "dim", 3))
+        dim = int(figutil.attr(f, "dim", 3))
         data = {k: f[k][()] for k in ("nodes/position", "nodes/ghost", "nodes/v",
                                       "simplices/vertices", "simplices/xi", "simplices/grad_u",
                                       "simplices/curl_v", "simplices/harmonic", "extrema/node",

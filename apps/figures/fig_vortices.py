@@ -9,15 +9,10 @@ import figutil
 from figutil import plt
 
 
-def _attr(f, name, default=None):
-    v = f.attrs.get(name, default)
-    return v.decode() if isinstance(v, bytes) else v
-
-
 def make(input_path, out_dir, args):
     with h5py.File(input_path, "r") as f:
-        if _attr(f, "format", "") != "granoscope-vortices":
-            raise ValueError("not a vortex series (format %s)" % _attr(f, "format", ""))
+        if figutil.attr(f, "format", "") != "granoscope-vortices":
+            raise ValueError("not a vortex series (format %s)" % figutil.attr(f, "format", ""))
         if "series/strain" not in f:
             raise KeyError("series/strain missing")
         s = {k: f["series/" + k][()] for k in ("strain", "right", "left", "sources", "sinks")}
@@ -27,7 +22,7 @@ def make(input_path, out_dir, args):
             if g in f:
                 spectra[hand] = (f[g + "/period"][()], f[g + "/amplitude"][()],
                                  float(f[g].attrs.get("dominant_period", 0.0)))
-        axis = _attr(f, "strain_axis", "z")
+        axis = figutil.attr(f, "strain_axis", "z")
     written = []
     fig, axes = plt.subplots(1, 2, figsize=(11, 4))
     eps = 100.0 * s["strain"]

@@ -1,4 +1,4 @@
-"""Shared helpers for figure modules: headless matplotlib and atomic PNG writing."""
+"""Shared helpers for figure modules: headless matplotlib, HDF5 attributes, atomic PNG writing."""
 import os
 
 import matplotlib
@@ -15,3 +15,9 @@ def save(fig, out_dir, name, dpi=150):
     plt.close(fig)
     os.replace(tmp, path)
     return path
+
+
+def attr(obj, name, default=None):
+    """An HDF5 attribute of a file, group or dataset, bytes decoded to str."""
+    v = obj.attrs.get(name, default)
+    return v.decode() if isinstance(v, bytes) else v

@@ -16,6 +16,7 @@
 #include <sstream>
 #include <string>
 
+#include "cli_test_util.hpp"
 #include "hdf5_trajectory.hpp"
 
 namespace fs = std::filesystem;
@@ -23,52 +24,18 @@ namespace fs = std::filesystem;
 namespace {
 
 fs::path temp_dir() {
-  const auto d =
-      fs::temp_directory_path() / ("gs_hhd_cli_" + std::to_string(::getpid()) + "_" +
-                                   ::testing::UnitTest::GetInstance()->current_test_info()->name());
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
+  return gs::test::cli_temp_dir("gs_hhd_cli");
 }
 
 int run(const std::string& args, const fs::path& log) {
-  const std::string cmd =
-      std::string(GS_BINARY_DIR) + "/bin/granoscope " + args + " > " + log.string() + " 2>&1";
-  const int rc = std::system(cmd.c_str());
-  return WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
+  return gs::test::run_granoscope(args, log);
 }
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using gs::test::slurp;
 
 template <class T>
 std::vector<T> read_array(const fs::path& file, const char* name, hid_t type) {
-  const hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
-  EXPECT_GE(f, 0);
-  const hid_t d = H5Dopen2(f, name, H5P_DEFAULT);
-  const hid_t s = H5Dget_space(d);
-  std::vector<T> v(static_cast<std::size_t>(H5Sget_simple_extent_npoints(s)));
-  H5Dread(d, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data());
-  H5Sclose(s);
-  H5Dclose(d);
-  H5Fclose(f);
-  return v;
-}
-
-std::string read_format(const fs::path& file) {
-  const hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
-  const hid_t a = H5Aopen(f, "format", H5P_DEFAULT);
-  const hid_t t = H5Aget_type(a);
-  std::string s(H5Tget_size(t), '\0');
-  H5Aread(a, t, s.data());
-  H5Tclose(t);
-  H5Aclose(a);
-  H5Fclose(f);
-  return s.c_str();
+  return gs::test::read_h5_array<T>(file, name, type);
 }
 
 // A PNG that exists and is not one flat colour: some byte variety in its image data.
@@ -133,7 +100,7 @@ TEST(CmdHhd, Csv2DVortexPairFiguresAndOutputs) {
                 dir / "log"),
             0)
       << slurp(dir / "log");
-  EXPECT_EQ(read_format(dir / "h.h5"), "granoscope-hhd");
+  EXPECT_EQ(gs::test::read_h5_format(dir / "h.h5"), "granoscope-hhd");
   EXPECT_TRUE(fs::exists(dir / "h.vtu"));
   const double spacing = 0.05 / std::sqrt(2500.0);
   const auto left = strongest(extrema_rows(dir / "e.csv", "left_vortex"));
@@ -230,7 +197,7 @@ TEST(CmdHhd, Trajectory3DTubesSliceAndSeries) {
       run("analyze vortices " + run_h5 + " --every 1 -o " + (dir / "v.h5").string(), dir / "log"),
       0)
       << slurp(dir / "log");
-  EXPECT_EQ(read_format(dir / "v.h5"), "granoscope-vortices");
+  EXPECT_EQ(gs::test::read_h5_format(dir / "v.h5"), "granoscope-vortices");
   const auto strain = read_array<double>(dir / "v.h5", "/series/strain", H5T_NATIVE_DOUBLE);
   const auto lefts = read_array<std::int32_t>(dir / "v.h5", "/series/left", H5T_NATIVE_INT32);
   ASSERT_EQ(strain.size(), 9u);

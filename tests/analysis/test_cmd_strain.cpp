@@ -12,6 +12,7 @@
 #include <set>
 #include <string>
 
+#include "cli_test_util.hpp"
 #include "hdf5_trajectory.hpp"
 #include "tet_strain.hpp"
 
@@ -20,45 +21,15 @@ namespace fs = std::filesystem;
 namespace {
 
 fs::path temp_dir() {
-  const auto d =
-      fs::temp_directory_path() / ("gs_strain_cli_" + std::to_string(::getpid()) + "_" +
-                                   ::testing::UnitTest::GetInstance()->current_test_info()->name());
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
+  return gs::test::cli_temp_dir("gs_strain_cli");
 }
 
 int run(const std::string& args, const fs::path& log) {
-  const std::string cmd =
-      std::string(GS_BINARY_DIR) + "/bin/granoscope " + args + " > " + log.string() + " 2>&1";
-  const int rc = std::system(cmd.c_str());
-  return WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
+  return gs::test::run_granoscope(args, log);
 }
 
-std::vector<double> read_doubles(const fs::path& file, const char* name) {
-  const hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
-  EXPECT_GE(f, 0);
-  const hid_t d = H5Dopen2(f, name, H5P_DEFAULT);
-  const hid_t s = H5Dget_space(d);
-  std::vector<double> v(static_cast<std::size_t>(H5Sget_simple_extent_npoints(s)));
-  H5Dread(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data());
-  H5Sclose(s);
-  H5Dclose(d);
-  H5Fclose(f);
-  return v;
-}
-
-std::string read_format(const fs::path& file) {
-  const hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
-  const hid_t a = H5Aopen(f, "format", H5P_DEFAULT);
-  const hid_t t = H5Aget_type(a);
-  std::string s(H5Tget_size(t), '\0');
-  H5Aread(a, t, s.data());
-  H5Tclose(t);
-  H5Aclose(a);
-  H5Fclose(f);
-  return s.c_str();
-}
+using gs::test::read_h5_doubles;
+using gs::test::read_h5_format;
 
 TEST(CmdStrain, ThreeDAffineBetweenFramesMatchedById) {
   const auto dir = temp_dir();
@@ -86,12 +57,12 @@ TEST(CmdStrain, ThreeDAffineBetweenFramesMatchedById) {
                     (dir / "s.h5").string() + " --vtu " + (dir / "s.vtu").string(),
                 dir / "log"),
             0);
-  EXPECT_EQ(read_format(dir / "s.h5"), "granoscope-strain");
-  const auto mean = read_doubles(dir / "s.h5", "/mean_gradient");
+  EXPECT_EQ(read_h5_format(dir / "s.h5"), "granoscope-strain");
+  const auto mean = read_h5_doubles(dir / "s.h5", "/mean_gradient");
   ASSERT_EQ(mean.size(), 9u);
   for (int i = 0; i < 9; ++i)
     EXPECT_NEAR(mean[static_cast<std::size_t>(i)], h(i / 3, i % 3), 1e-14);
-  EXPECT_EQ(read_doubles(dir / "s.h5", "/particles/volumetric_strain").size(), 299u);
+  EXPECT_EQ(read_h5_doubles(dir / "s.h5", "/particles/volumetric_strain").size(), 299u);
   EXPECT_TRUE(fs::exists(dir / "s.vtu"));
   // Slab |z - 5 mm| <= 2 mm projected onto x-y: triangles, in-plane block of h (seed 000 §5).
   ASSERT_EQ(run("analyze strain " + (dir / "run.h5").string() +
@@ -100,12 +71,12 @@ TEST(CmdStrain, ThreeDAffineBetweenFramesMatchedById) {
                     (dir / "p.h5").string(),
                 dir / "log"),
             0);
-  const auto m2 = read_doubles(dir / "p.h5", "/mean_gradient");
+  const auto m2 = read_h5_doubles(dir / "p.h5", "/mean_gradient");
   for (int i = 0; i < 9; ++i) {
     const double expect = (i / 3 < 2 && i % 3 < 2) ? h(i / 3, i % 3) : 0.0;
     EXPECT_NEAR(m2[static_cast<std::size_t>(i)], expect, 1e-14) << i;
   }
-  const auto n2 = read_doubles(dir / "p.h5", "/particles/volumetric_strain").size();
+  const auto n2 = read_h5_doubles(dir / "p.h5", "/particles/volumetric_strain").size();
   EXPECT_GT(n2, 60u);
   EXPECT_LT(n2, 180u);
   if (const char* keep = std::getenv("GS_KEEP_TEST_OUTPUT")) {  // e.g. to try the figures
@@ -169,13 +140,13 @@ TEST(CmdStrain, VoidCellsPeriodic2DFromVelocities) {
   ASSERT_EQ(run("analyze voidcells " + (dir / "run.h5").string() + " -o " + (dir / "v.h5").string(),
                 dir / "log"),
             0);
-  EXPECT_EQ(read_format(dir / "v.h5"), "granoscope-voidcells");
+  EXPECT_EQ(read_h5_format(dir / "v.h5"), "granoscope-voidcells");
   // With the cell velocity gradient l the image velocities are consistent: exact l per cell.
   ASSERT_EQ(run("analyze voidcells " + (dir / "run.h5").string() +
                     " --cell-velocity-gradient 0 0.02 -0.01 0.005 -o " + (dir / "vl.h5").string(),
                 dir / "log"),
             0);
-  const auto gl = read_doubles(dir / "vl.h5", "/cells/gradient");
+  const auto gl = read_h5_doubles(dir / "vl.h5", "/cells/gradient");
   ASSERT_GT(gl.size(), 40u);
   for (std::size_t i = 0; i < gl.size(); ++i) {
     EXPECT_NEAR(gl[i], l((i % 4) / 2, i % 2), 1e-12 * l.norm()) << i;
@@ -190,7 +161,7 @@ TEST(CmdStrain, VoidCellsPeriodic2DFromVelocities) {
                     (dir / "v2.h5").string(),
                 dir / "log"),
             0);
-  const auto grad = read_doubles(dir / "v2.h5", "/cells/gradient");
+  const auto grad = read_h5_doubles(dir / "v2.h5", "/cells/gradient");
   ASSERT_GT(grad.size(), 40u);
   // The displacement is rebuilt from stored positions (x_B - x_A): its rounding, eps |x|, is
   // ~1e-13 of a cell's relative displacement |l| h, amplified in thin cells. The method itself is
@@ -198,7 +169,7 @@ TEST(CmdStrain, VoidCellsPeriodic2DFromVelocities) {
   for (std::size_t i = 0; i < grad.size(); ++i) {
     EXPECT_NEAR(grad[i], l((i % 4) / 2, i % 2), 1e-10 * l.norm()) << i;
   }
-  const auto alpha = read_doubles(dir / "v2.h5", "/cells/alpha");
+  const auto alpha = read_h5_doubles(dir / "v2.h5", "/cells/alpha");
   for (double a : alpha) EXPECT_NEAR(a, 1.0, 1e-10);
   // Non-affine motion for the figures: random particle jitter on top of l.
   std::normal_distribution<double> jitter(0.0, 2e-6);
@@ -210,15 +181,15 @@ TEST(CmdStrain, VoidCellsPeriodic2DFromVelocities) {
                 dir / "log"),
             0);
   EXPECT_TRUE(fs::exists(dir / "v3.vtu"));
-  const auto w = read_doubles(dir / "v3.h5", "/cells/w");
+  const auto w = read_h5_doubles(dir / "v3.h5", "/cells/w");
   for (double x : w) EXPECT_TRUE(std::isfinite(x));
   // The triangle (Bagi eq 4) variant of the same motion: 2D strain with alpha and w.
   ASSERT_EQ(
       run("analyze strain " + (dir / "run3.h5").string() + " --to 1 -o " + (dir / "t3.h5").string(),
           dir / "log"),
       0);
-  EXPECT_EQ(read_doubles(dir / "t3.h5", "/simplices/alpha").size(),
-            read_doubles(dir / "t3.h5", "/simplices/measure").size());
+  EXPECT_EQ(read_h5_doubles(dir / "t3.h5", "/simplices/alpha").size(),
+            read_h5_doubles(dir / "t3.h5", "/simplices/measure").size());
   if (const char* keep = std::getenv("GS_KEEP_TEST_OUTPUT")) {  // e.g. to try the figures
     fs::copy_file(dir / "v3.h5", fs::path(keep) / "voidcells_demo.h5",
                   fs::copy_options::overwrite_existing);
