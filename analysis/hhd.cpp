@@ -29,7 +29,7 @@ int vertices_of(const HhdMesh& m) {
   return m.dim + 1;
 }
 
-// 2D cross product (z component) of in-plane vectors, and the 3D one.
+// z component of the cross product of two in-plane vectors (2D).
 double cross_z(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
   return a.x() * b.y() - a.y() * b.x();
 }
@@ -361,17 +361,17 @@ HhdResult helmholtz_hodge(const HhdMesh& m, const std::vector<Eigen::Vector3d>& 
   Eigen::MatrixXd rhs(n, 1 + nv);
   rhs.col(0) = bu;
   rhs.rightCols(nv) = -b18;  // path (b): K v = Σ |T| ξ × ∇φ_i (docs/hhd.md)
-  auto direct = [&](auto& solver) {
+  auto direct = [&](auto& factor) {
     t0 = Clock::now();
-    solver.compute(k);
+    factor.compute(k);
     r.report.seconds_factor = seconds_since(t0);
-    if (solver.info() != Eigen::Success) {
+    if (factor.info() != Eigen::Success) {
       throw std::invalid_argument(
           "HHD stiffness matrix factorization failed (not positive "
           "definite: degenerate mesh?)");
     }
     t0 = Clock::now();
-    x = solver.solve(rhs);
+    x = factor.solve(rhs);
     r.report.seconds_solve = seconds_since(t0);
   };
   switch (solver) {
