@@ -237,6 +237,7 @@ void write_tubes_vtp(const fs::path& path, const VortexAnalysis& a) {
   std::vector<std::vector<std::int64_t>> lines;
   std::vector<double> vnorm, kind, magnitude;
   for (const auto& t : a.tubes) {
+    if (t.nodes.size() < 2) continue;  // a centre without a tube: in the extrema only
     lines.emplace_back();
     for (const auto i : t.nodes) {
       lines.back().push_back(static_cast<std::int64_t>(pts.size()));
@@ -580,7 +581,8 @@ void register_analyze_hhd(CLI::App& app) {
                   "(seed 000: IT steps apart); without it the velocities of --from");
     s->add_option("--vtu", a->vtu, "also write the mesh: point u, v; cell xi, grad_u, curl_v, h");
     s->add_option("--extrema", a->extrema, "also write the extrema as CSV");
-    s->add_option("--tubes", a->tubes, "also write the vortex tubes as VTP polylines (3D)");
+    s->add_option("--tubes", a->tubes,
+                  "also write the vortex tubes of 2 or more nodes as VTP polylines (3D)");
     add_field_options(s, a->field);
     s->callback([a] { run_hhd(*a); });
   }

@@ -164,6 +164,13 @@ TEST(CmdHhd, Trajectory3DTubesSliceAndSeries) {
   const auto left = strongest(extrema_rows(dir / "e.csv", "left_vortex"));
   EXPECT_LE(std::hypot(left[0] - 0.009, left[1] - 0.011), spacing);
   EXPECT_TRUE(fs::exists(dir / "t.vtp"));
+  // δ = 0: every centre is a one-node tube; the VTP then holds no line (and is still written).
+  ASSERT_EQ(run("analyze hhd " + run_h5 + " --from 1 --to 2 -o " + (dir / "h0.h5").string() +
+                    " --tubes " + (dir / "t0.vtp").string() + " --delta 0",
+                dir / "log"),
+            0)
+      << slurp(dir / "log");
+  EXPECT_NE(slurp(dir / "t0.vtp").find("NumberOfLines=\"0\""), std::string::npos);
   EXPECT_GT(read_array<std::int64_t>(dir / "h.h5", "/tubes/offsets", H5T_NATIVE_INT64).size(), 1u);
   ASSERT_EQ(
       run("figures " + (dir / "h.h5").string() + " -o " + (dir / "fig").string(), dir / "log"), 0)
