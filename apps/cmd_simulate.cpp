@@ -1,11 +1,14 @@
-// `granoscope simulate SCENE.toml`: runs a DEM scene, writing an HDF5 trajectory (frames with
-// contacts and walls), a monitor history (CSV) and checkpoints it can resume from bit-for-bit.
+// `granoscope simulate SCENE.toml`: runs a DEM scene — a plain run of N steps, or a laboratory
+// test (specimen preparation, then triaxial / plane-strain compression or direct shear) —
+// writing an HDF5 trajectory (frames with contacts and walls), a monitor history, the test's
+// macroscopic curve (CSV), the prepared specimen, and checkpoints it resumes from bit-for-bit.
 #include <unistd.h>
 
 #include <chrono>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
+#include <map>
 #include <memory>
 #include <optional>
 #include <sstream>
@@ -32,92 +35,139 @@ struct Args {
   bool quiet = false;
 };
 
-struct CheckpointInfo {
-  std::int64_t step = 0;
-  std::size_t frames = 0, history_rows = 0;
-  std::string state_file;
+/// A CSV written as `<path>.partial` row by row and renamed at the end; on resume it is cut back
+/// to the rows a checkpoint recorded.
+class CsvOutput {
+ public:
+  explicit CsvOutput(fs::path path)
+      : path_(std::move(path)), partial_(path_.string() + ".partial") {}
+  bool open() const { return out_.is_open(); }
+  std::size_t rows() const { return rows_; }
+  void create(const std::string& header) {
+    out_.open(partial_, std::ios::trunc);
+    out_ << header << "\n";
+    rows_ = 0;
+    check();
+  }
+  void resume(std::size_t rows) {
+    if (!fs::exists(partial_)) throw InputError(partial_.string(), "missing output to resume");
+    const std::string old = text::read_text_file(partial_);
+    const auto lines = text::split_lines(old);
+    if (lines.size() < rows + 1)
+      throw InputError(partial_.string(), "output shorter than its checkpoint",
+                       std::to_string(lines.size()));
+    std::string kept;
+    for (std::size_t i = 0; i <= rows; ++i) kept += std::string(lines[i]) + "\n";
+    std::ofstream(partial_, std::ios::trunc) << kept;
+    out_.open(partial_, std::ios::app);
+    rows_ = rows;
+    check();
+  }
+  void append(const std::string& row) {
+    out_ << row << "\n";
+    ++rows_;
+  }
+  void flush() {
+    out_.flush();
+    check();
+  }
+  void finish() {
+    if (!out_.is_open()) return;
+    out_.close();
+    std::error_code ec;
+    fs::rename(partial_, path_, ec);
+    if (ec) throw InputError(path_.string(), "cannot rename output into place", ec.message());
+  }
+  const fs::path& path() const { return path_; }
+
+ private:
+  void check() {
+    if (!out_) throw InputError(partial_.string(), "cannot write output");
+  }
+  fs::path path_, partial_;
+  std::ofstream out_;
+  std::size_t rows_ = 0;
 };
 
-void write_checkpoint_info(const fs::path& path, const CheckpointInfo& c) {
+using Index = std::map<std::string, std::string>;
+
+void write_index(const fs::path& path, const Index& index) {
   AtomicOutput out(path);
   {
     std::ofstream o(out.temp_path());
-    o << "step " << c.step << "\nframes " << c.frames << "\nhistory_rows " << c.history_rows
-      << "\nstate " << c.state_file << "\n";
+    for (const auto& [k, v] : index) o << k << " " << v << "\n";
     if (!o.flush()) throw InputError(path.string(), "cannot write checkpoint index");
   }
   out.commit();
 }
 
-CheckpointInfo read_checkpoint_info(const fs::path& path) {
-  const std::string text = text::read_text_file(path, 1 << 16);
-  CheckpointInfo c;
-  std::istringstream in(text);
-  std::string key;
-  bool got[4] = {};
-  while (in >> key) {
-    if (key == "step")
-      got[0] = static_cast<bool>(in >> c.step);
-    else if (key == "frames")
-      got[1] = static_cast<bool>(in >> c.frames);
-    else if (key == "history_rows")
-      got[2] = static_cast<bool>(in >> c.history_rows);
-    else if (key == "state")
-      got[3] = static_cast<bool>(in >> c.state_file);
-    else
-      throw InputError(path.string(), "unknown key in checkpoint index", key);
+Index read_index(const fs::path& path) {
+  std::istringstream in(text::read_text_file(path, 1 << 16));
+  Index index;
+  std::string k, v;
+  while (in >> k >> v) index[k] = v;
+  for (const char* key : {"step", "programme", "frames", "last_frame", "last_frame_step",
+                          "last_curve_step", "history_rows", "curve_rows", "prep_rows", "state"})
+    if (!index.count(key)) throw InputError(path.string(), "incomplete checkpoint index", key);
+  return index;
+}
+
+std::int64_t as_int(const Index& index, const std::string& key, const fs::path& path) {
+  try {
+    return std::stoll(index.at(key));
+  } catch (const std::exception&) {
+    throw InputError(path.string(), "bad checkpoint index value", key);
   }
-  for (bool g : got)
-    if (!g) throw InputError(path.string(), "incomplete checkpoint index");
-  return c;
 }
 
 std::string history_header(const solver::Simulation& sim) {
   std::string h =
-      "step,time_s,contacts,kinetic_J,unbalanced_force,elastic_J,friction_dissipation_J,"
-      "rolling_dissipation_J,damping_dissipation_J,gravity_work_J,wall_work_J,energy_residual_J";
+      "step,time_s,contacts,kinetic_J,unbalanced_force,inertial_number,elastic_J,"
+      "friction_dissipation_J,rolling_dissipation_J,damping_dissipation_J,gravity_work_J,"
+      "wall_work_J,external_work_J,energy_residual_J";
   for (const auto& w : sim.walls()) {
     const std::string n = w.spec.name.empty() ? "wall" : w.spec.name;
     for (const char* c : {"_fx_N", "_fy_N", "_fz_N", "_x_m", "_y_m", "_z_m"}) h += "," + n + c;
   }
-  return h + "\n";
+  return h;
 }
 
 std::string history_row(solver::Simulation& sim) {
   const auto& e = sim.energy();
-  char buf[512];
-  std::snprintf(
-      buf, sizeof buf, "%lld,%.17g,%zu,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g",
-      static_cast<long long>(sim.step_count()), sim.time(), sim.contact_count(), e.kinetic,
-      sim.unbalanced_force(), sim.inertial_number(),
-      e.elastic_normal + e.elastic_shear + e.elastic_rolling, e.friction_dissipation,
-      e.rolling_dissipation, e.damping_dissipation, e.gravity_work, e.wall_work, e.residual());
+  char buf[640];
+  std::snprintf(buf, sizeof buf,
+                "%lld,%.17g,%zu,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g",
+                static_cast<long long>(sim.step_count()), sim.time(), sim.contact_count(),
+                e.kinetic, sim.unbalanced_force(), sim.inertial_number(),
+                e.elastic_normal + e.elastic_shear + e.elastic_rolling, e.friction_dissipation,
+                e.rolling_dissipation, e.damping_dissipation, e.gravity_work, e.wall_work,
+                e.external_work, e.residual());
   std::string row = buf;
   for (const auto& w : sim.walls()) {
     std::snprintf(buf, sizeof buf, ",%.17g,%.17g,%.17g,%.17g,%.17g,%.17g", w.force.x(), w.force.y(),
                   w.force.z(), w.pos.x(), w.pos.y(), w.pos.z());
     row += buf;
   }
-  return row + "\n";
-}
-
-Frame output_frame(const solver::Simulation& sim, bool contacts) {
-  Frame f = sim.frame();
-  if (!contacts) f.contacts.clear();
-  return f;
+  return row;
 }
 
 void run(const Args& a) {
   solver::Scene scene = solver::load_scene(a.scene);
-  if (a.steps >= 0) scene.steps = a.steps;
+  auto programmes = solver::scene_programmes(scene);
   if (a.threads > 0) scene.config.threads = a.threads;
+  // Where the run stops at the latest: --steps, or a plain scene's own number of steps.
+  std::optional<std::int64_t> stop_at;
+  if (a.steps >= 0) stop_at = a.steps;
+  if (scene.test.empty()) {
+    if (!stop_at) stop_at = scene.steps;
+    programmes.clear();
+    programmes.push_back(std::make_unique<solver::FixedSteps>(*stop_at, scene.output.every));
+  }
   const fs::path out = a.out.empty() ? fs::path("out") / scene.name : fs::path(a.out);
   std::error_code ec;
   fs::create_directories(out, ec);
   if (ec) throw InputError(out.string(), "cannot create output directory", ec.message());
   const fs::path traj = out / scene.output.trajectory;
-  const fs::path history = out / scene.output.history;
-  const fs::path history_partial = fs::path(history.string() + ".partial");
   const fs::path ckpt_index = out / "checkpoint.txt";
   const bool tty = isatty(STDERR_FILENO) && !a.quiet;
 
@@ -132,111 +182,195 @@ void run(const Args& a) {
   meta.parameters = scene.parameters;
   meta.parameters.emplace_back("solver.dt_s", value_str(scene.config.dt));
   meta.parameters.emplace_back("solver.dt_pwave_s", value_str(scene.dt_pwave));
+  if (!scene.test.empty()) meta.parameters.emplace_back("output.curve", scene.output.curve);
 
+  CsvOutput history(out / scene.output.history);
+  CsvOutput curve(out / scene.output.curve);
+  CsvOutput prep_curve(out / scene.output.preparation);
   std::optional<TrajectoryWriter> writer;
-  CheckpointInfo ck;
-  std::size_t history_rows = 0;
-  std::ofstream hist;
+  std::size_t k = 0;             // current programme
+  std::int64_t last_frame = -1;  // frame index of the last frame written
+  std::int64_t last_frame_step = -1;
+  Index ck;
+
+  std::int64_t last_curve_step = -1;
+  auto curve_for = [&](std::size_t i) -> CsvOutput& {
+    return programmes[i]->name() == "preparation" ? prep_curve : curve;
+  };
+  auto open_curve = [&](std::size_t i) {
+    const std::string h = programmes[i]->curve_header();
+    if (!h.empty()) curve_for(i).create(h);
+    last_curve_step = -1;
+  };
+  auto curve_row = [&] {
+    CsvOutput& c = curve_for(k);
+    if (c.open() && last_curve_step != sim.step_count()) {
+      c.append(programmes[k]->curve_row(sim));
+      c.flush();  // a few rows per thousand steps: keep them readable while the run goes on
+      last_curve_step = sim.step_count();
+    }
+  };
+  auto write_frame = [&] {
+    if (!writer) writer.emplace(traj, meta, TrajectoryWriter::Options{.discard_unfinished = false});
+    Frame f = sim.frame();
+    if (!scene.output.contacts) f.contacts.clear();
+    writer->append(f);
+    last_frame_step = sim.step_count();
+  };
+  auto checkpoint = [&](std::int64_t s) {
+    history.flush();
+    if (curve.open()) curve.flush();
+    if (prep_curve.open()) prep_curve.flush();
+    Index next{{"step", std::to_string(s)},
+               {"programme", std::to_string(k)},
+               {"frames", std::to_string(writer ? writer->frames_written() : 0)},
+               {"last_frame", std::to_string(last_frame)},
+               {"last_frame_step", std::to_string(last_frame_step)},
+               {"last_curve_step", std::to_string(last_curve_step)},
+               {"history_rows", std::to_string(history.rows())},
+               {"curve_rows", std::to_string(curve.open() ? curve.rows() : 0)},
+               {"prep_rows", std::to_string(prep_curve.open() ? prep_curve.rows() : 0)},
+               {"state", "checkpoint-" + std::to_string(s) + ".bin"}};
+    sim.save_checkpoint(out / next["state"], programmes[k]->save_state());
+    write_index(ckpt_index, next);
+    if (ck.count("state") && ck["state"] != next["state"]) fs::remove(out / ck["state"], ec);
+    ck = next;
+  };
+
   if (a.resume) {
     if (!fs::exists(ckpt_index))
       throw InputError(ckpt_index.string(), "no checkpoint to resume from");
-    ck = read_checkpoint_info(ckpt_index);
-    sim.load_checkpoint(out / ck.state_file);
-    if (sim.step_count() != ck.step)
-      throw InputError((out / ck.state_file).string(), "checkpoint step differs from its index",
+    ck = read_index(ckpt_index);
+    const fs::path state = out / ck["state"];
+    const std::string extra = sim.load_checkpoint(state);
+    if (sim.step_count() != as_int(ck, "step", ckpt_index))
+      throw InputError(state.string(), "checkpoint step differs from its index",
                        std::to_string(sim.step_count()));
-    writer.emplace(TrajectoryWriter::resume(traj, ck.frames, {.discard_unfinished = false}));
-    // Keep the header and the rows up to the checkpoint.
-    const std::string old = text::read_text_file(history_partial);
-    const auto lines = text::split_lines(old);
-    if (lines.size() < ck.history_rows + 1)
-      throw InputError(history_partial.string(), "history shorter than its checkpoint",
-                       std::to_string(lines.size()));
-    std::string kept;
-    for (std::size_t i = 0; i <= ck.history_rows; ++i) kept += std::string(lines[i]) + "\n";
-    std::ofstream(history_partial, std::ios::trunc) << kept;
-    history_rows = ck.history_rows;
-    hist.open(history_partial, std::ios::app);
-    std::cerr << "resuming " << scene.name << " from step " << ck.step << "\n";
+    k = static_cast<std::size_t>(as_int(ck, "programme", ckpt_index));
+    if (k >= programmes.size())
+      throw InputError(ckpt_index.string(), "checkpoint programme not in the scene",
+                       ck["programme"]);
+    programmes[k]->load_state(extra);
+    last_frame = as_int(ck, "last_frame", ckpt_index);
+    last_frame_step = as_int(ck, "last_frame_step", ckpt_index);
+    last_curve_step = as_int(ck, "last_curve_step", ckpt_index);
+    const auto frames = static_cast<std::size_t>(as_int(ck, "frames", ckpt_index));
+    if (frames > 0)
+      writer.emplace(TrajectoryWriter::resume(traj, frames, {.discard_unfinished = false}));
+    history.resume(static_cast<std::size_t>(as_int(ck, "history_rows", ckpt_index)));
+    // Curves of the phases that have begun.
+    for (std::size_t i = 0; i <= k; ++i) {
+      if (programmes[i]->curve_header().empty()) continue;
+      CsvOutput& c = curve_for(i);
+      if (i < k && &c == &prep_curve) continue;  // finished: already renamed
+      c.resume(static_cast<std::size_t>(
+          as_int(ck, &c == &prep_curve ? "prep_rows" : "curve_rows", ckpt_index)));
+    }
+    std::cerr << "resuming " << scene.name << " from step " << sim.step_count() << " ("
+              << programmes[k]->name() << ")\n";
   } else {
-    writer.emplace(traj, meta, TrajectoryWriter::Options{.discard_unfinished = false});
-    hist.open(history_partial, std::ios::trunc);
-    hist << history_header(sim) << history_row(sim);
-    history_rows = 1;
-    writer->append(output_frame(sim, scene.output.contacts));
-    ck.step = 0;
-    ck.frames = writer->frames_written();
-    ck.history_rows = history_rows;
-    ck.state_file = "checkpoint-0.bin";
-    hist.flush();
-    sim.save_checkpoint(out / ck.state_file);
-    write_checkpoint_info(ckpt_index, ck);
+    history.create(history_header(sim));
+    programmes[0]->start(sim);
+    open_curve(0);
+    history.append(history_row(sim));
+    curve_row();
+    if (programmes[0]->name() != "preparation") {
+      last_frame = programmes[0]->frame_index(sim);
+      write_frame();
+    }
+    checkpoint(sim.step_count());
   }
-  if (!hist) throw InputError(history_partial.string(), "cannot write history");
 
   const auto t0 = std::chrono::steady_clock::now();
   auto last_print = t0;
   const std::int64_t first = sim.step_count();
   try {
-    while (sim.step_count() < scene.steps) {
+    while (true) {
+      if (programmes[k]->finished(sim)) {
+        const std::string sum = programmes[k]->summary(sim);
+        if (!sum.empty()) std::printf("%s\n", sum.c_str());
+        curve_row();  // the state at the programme's end
+        if (k + 1 == programmes.size()) break;
+        if (programmes[k]->name() == "preparation") {
+          prep_curve.finish();
+          Trajectory specimen;
+          specimen.metadata = meta;
+          specimen.metadata.provenance += " (prepared specimen)";
+          specimen.frames.push_back(sim.frame());
+          write_hdf5_trajectory(out / scene.output.specimen, specimen);
+        }
+        ++k;
+        programmes[k]->start(sim);
+        open_curve(k);
+        curve_row();
+        last_frame = programmes[k]->frame_index(sim);
+        write_frame();
+        continue;
+      }
+      if (stop_at && sim.step_count() >= *stop_at) break;
+      programmes[k]->control(sim);
+      if (programmes[k]->finished(sim)) continue;  // ended by its control (a stage check)
       sim.step();
       const std::int64_t s = sim.step_count();
-      const bool last = s == scene.steps;
-      if (s % scene.output.history_every == 0 || last) {
+      if (s % scene.output.history_every == 0) {
         sim.check_energy();
-        hist << history_row(sim);
-        ++history_rows;
+        history.append(history_row(sim));
       }
-      if (s % scene.output.every == 0 || last)
-        writer->append(output_frame(sim, scene.output.contacts));
-      if (s % scene.output.checkpoint_every == 0 && !last) {
-        hist.flush();
-        CheckpointInfo next{s, writer->frames_written(), history_rows,
-                            "checkpoint-" + std::to_string(s) + ".bin"};
-        sim.save_checkpoint(out / next.state_file);
-        write_checkpoint_info(ckpt_index, next);
-        fs::remove(out / ck.state_file, ec);
-        ck = next;
+      if (s % scene.output.curve_every == 0) curve_row();
+      if (programmes[k]->name() != "preparation") {
+        const std::int64_t fi = programmes[k]->frame_index(sim);
+        if (fi > last_frame) {
+          last_frame = fi;
+          write_frame();
+        }
       }
+      if (s % scene.output.checkpoint_every == 0) checkpoint(s);
       if (tty) {
         const auto now = std::chrono::steady_clock::now();
-        if (now - last_print > std::chrono::milliseconds(500) || last) {
+        if (now - last_print > std::chrono::milliseconds(500)) {
           const double el = std::chrono::duration<double>(now - t0).count();
           const double rate = static_cast<double>(s - first) / std::max(el, 1e-9);
-          std::fprintf(stderr, "\rstep %lld/%lld (%.1f%%)  %.3g steps/s  ETA %.0f s   ",
-                       static_cast<long long>(s), static_cast<long long>(scene.steps),
-                       100.0 * static_cast<double>(s) / static_cast<double>(scene.steps), rate,
-                       static_cast<double>(scene.steps - s) / std::max(rate, 1e-9));
+          const double prog = programmes[k]->progress(sim);
+          const double done_frac = (static_cast<double>(k) + prog) / programmes.size();
+          const double eta = done_frac > 0 ? el * (1 - done_frac) / done_frac : 0;
+          std::fprintf(stderr, "\r%s %zu/%zu: step %lld  %.1f%%  %.3g steps/s  ETA %.0f s   ",
+                       programmes[k]->name().c_str(), k + 1, programmes.size(),
+                       static_cast<long long>(s), 100.0 * prog, rate, eta);
           last_print = now;
         }
       }
     }
   } catch (const solver::BlowUp& e) {
-    hist.flush();
+    history.flush();
     throw InputError(a.scene, std::string("blow-up: ") + e.what() +
-                                  "; last good checkpoint at step " + std::to_string(ck.step) +
-                                  " in " + (out / ck.state_file).string());
+                                  "; last good checkpoint at step " + ck["step"] + " in " +
+                                  (out / ck["state"]).string());
   }
   if (tty) std::fprintf(stderr, "\n");
-  hist.close();
-  writer->finish();
-  fs::rename(history_partial, history, ec);
-  if (ec) throw InputError(history.string(), "cannot rename output into place", ec.message());
-  fs::remove(out / ck.state_file, ec);
+  // Final rows and frame, unless the last step already wrote them.
+  const std::int64_t s = sim.step_count();
+  if (s % scene.output.history_every != 0) history.append(history_row(sim));
+  if (programmes[k]->name() != "preparation" && last_frame_step != s) write_frame();
+  history.finish();
+  curve.finish();
+  prep_curve.finish();
+  if (writer) writer->finish();
+  fs::remove(out / ck["state"], ec);
   fs::remove(ckpt_index, ec);
   const double el = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  const double ps =
-      static_cast<double>(sim.step_count() - first) * static_cast<double>(sim.particles().size());
+  const double ps = static_cast<double>(s - first) * static_cast<double>(sim.particles().size());
   const auto& e = sim.energy();
   std::printf("%s: %lld steps of %zu particles in %.2f s (%.3g particle-steps/s, %d thread(s))\n",
-              scene.name.c_str(), static_cast<long long>(sim.step_count() - first),
-              sim.particles().size(), el, ps / std::max(el, 1e-9), scene.config.threads);
+              scene.name.c_str(), static_cast<long long>(s - first), sim.particles().size(), el,
+              ps / std::max(el, 1e-9), scene.config.threads);
   std::printf(
       "final: %zu contacts, unbalanced force %.3g, kinetic energy %.3g J, energy residual %.3g J "
       "(%.2g of the energy turnover)\n",
       sim.contact_count(), sim.unbalanced_force(), e.kinetic, e.residual(),
       std::abs(e.residual()) / std::max(1e-300, e.stored() + e.dissipated()));
-  std::printf("wrote %s, %s\n", traj.string().c_str(), history.string().c_str());
+  std::printf("wrote %s, %s", traj.string().c_str(), history.path().string().c_str());
+  if (!scene.test.empty()) std::printf(", %s", curve.path().string().c_str());
+  std::printf("\n");
 }
 
 }  // namespace
@@ -246,7 +380,9 @@ void register_simulate(CLI::App& app) {
   auto a = std::make_shared<Args>();
   cmd->add_option("SCENE", a->scene, "scene file (.toml)")->required();
   cmd->add_option("-o,--out", a->out, "output directory (default out/<scene name>)");
-  cmd->add_option("--steps", a->steps, "override the number of steps")
+  cmd->add_option("--steps", a->steps,
+                  "stop at this step (a plain scene: its number of steps; a laboratory test "
+                  "ends earlier if its programme ends first)")
       ->check(CLI::NonNegativeNumber);
   cmd->add_option("--threads", a->threads, "override the thread count")->check(CLI::PositiveNumber);
   cmd->add_flag("--resume", a->resume, "continue from the last checkpoint in the output directory");

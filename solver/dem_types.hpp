@@ -42,6 +42,7 @@ struct WallSpec {
   double servo_area_m2 = 0;       // area the force is divided by
   double servo_gain = 0;          // m/s per Pa of stress error
   double servo_max_velocity = 0;  // m/s cap
+  double friction_deg = -1;       // wall–sphere friction angle; negative: the material's
 };
 
 /// Per-particle state, structure of arrays (index = particle index, not id).
@@ -52,6 +53,7 @@ struct ParticleState {
   std::vector<Eigen::Quaterniond> ori;
   std::vector<std::uint8_t> fixed;        // 1: velocities imposed (not integrated from forces)
   std::vector<std::uint8_t> rot_blocked;  // 1: angular velocity imposed, translation free
+  std::vector<Eigen::Vector3d> external_force;  // N, applied loads (e.g. membrane pressure)
 
   std::size_t size() const { return pos.size(); }
 };
@@ -63,6 +65,9 @@ struct WallState {
   Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
   Eigen::Vector3d vel = Eigen::Vector3d::Zero();
   Eigen::Vector3d force = Eigen::Vector3d::Zero(), torque = Eigen::Vector3d::Zero();
+  bool active = true;  // an inactive wall touches nothing (e.g. replaced by a membrane)
+  double contact_stiffness = 0;  // Σ Kn of its contacts in the last step, N/m
+  std::size_t contacts = 0;      // its contacts in the last step
 };
 
 /// History of one contact (YADE's CohFrictPhys + ScGeom state that survives between steps).

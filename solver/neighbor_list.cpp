@@ -88,6 +88,7 @@ void NeighborList::build(const ParticleState& p, const std::vector<WallState>& w
         }
     for (std::size_t w = 0; w < walls.size(); ++w) {
       const auto& wall = walls[w];
+      if (!wall.active) continue;
       const double dist = wall.spec.shape == WallShape::Box
                               ? box_distance(wall.pos, wall.spec.half_extents, p.pos[i])
                               : (p.pos[i] - wall.pos).dot(wall.normal);

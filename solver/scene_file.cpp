@@ -1,7 +1,9 @@
 #include "scene_file.hpp"
 
 #include <toml++/toml.h>
+#include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <sstream>
 
 #include "errors.hpp"
@@ -77,6 +79,18 @@ struct Reader {
     return *s;
   }
 
+  /// Rejects keys a section does not know (a misspelt key or a unit in its name, such as
+  /// `young_MPa`, must not be silently ignored).
+  void only(const toml::table* t, const std::string& sec,
+            std::initializer_list<const char*> keys) const {
+    if (!t) return;
+    for (const auto& [k, v] : *t) {
+      bool known = false;
+      for (const char* allowed : keys) known = known || k.str() == allowed;
+      if (!known) fail(sec + "." + std::string(k.str()), "unknown key");
+    }
+  }
+
   std::int64_t integer(const toml::table* t, const std::string& sec, const std::string& key,
                        bool required, std::int64_t fallback, std::int64_t min) const {
     if (!t || !t->contains(key)) {
@@ -90,6 +104,106 @@ struct Reader {
     return *v;
   }
 };
+
+void read_lab_sections(const Reader& r, const toml::table& root, Scene& s) {
+  for (const char* name : {"triaxial", "plane_strain", "direct_shear"}) {
+    if (root.contains(name) && s.test != name)
+      r.fail(std::string("[") + name + "]", "does not match scene.test", s.test);
+  }
+  if (s.test == "triaxial") {
+    const auto* t = r.table("triaxial", true);
+    r.only(t, "triaxial",
+           {"confining_Pa", "strain_rate_1_s", "max_strain", "frame_every_strain", "servo_gain",
+            "max_wall_speed_m_s", "inertial_warning"});
+    auto& x = s.triaxial;
+    x.confining_Pa = r.positive(t, "triaxial", "confining_Pa", true, 0);
+    x.strain_rate_1_s = r.positive(t, "triaxial", "strain_rate_1_s", true, 0);
+    x.max_strain = r.positive(t, "triaxial", "max_strain", true, 0);
+    if (x.max_strain >= 1)
+      r.fail("triaxial.max_strain", "must be below 1", value_str(x.max_strain));
+    x.frame_every_strain =
+        r.positive(t, "triaxial", "frame_every_strain", false, x.frame_every_strain);
+    x.servo_gain = r.positive(t, "triaxial", "servo_gain", false, x.servo_gain);
+    x.max_wall_speed_m_s =
+        r.positive(t, "triaxial", "max_wall_speed_m_s", false, x.max_wall_speed_m_s);
+    x.inertial_warning = r.positive(t, "triaxial", "inertial_warning", false, x.inertial_warning);
+  } else if (s.test == "plane_strain") {
+    const auto* t = r.table("plane_strain", true);
+    r.only(t, "plane_strain",
+           {"confining_Pa", "strain_rate_1_s", "max_strain", "frame_every_strain", "membrane_bin_m",
+            "membrane_stencil_m", "refresh_steps", "inertial_warning"});
+    auto& x = s.plane_strain;
+    x.confining_Pa = r.positive(t, "plane_strain", "confining_Pa", true, 0);
+    x.strain_rate_1_s = r.positive(t, "plane_strain", "strain_rate_1_s", true, 0);
+    x.max_strain = r.positive(t, "plane_strain", "max_strain", true, 0);
+    if (x.max_strain >= 1)
+      r.fail("plane_strain.max_strain", "must be below 1", value_str(x.max_strain));
+    x.frame_every_strain =
+        r.positive(t, "plane_strain", "frame_every_strain", false, x.frame_every_strain);
+    x.membrane_bin_m = r.number(t, "plane_strain", "membrane_bin_m", false, 0);
+    x.membrane_stencil_m = r.number(t, "plane_strain", "membrane_stencil_m", false, 0);
+    x.refresh_steps = r.integer(t, "plane_strain", "refresh_steps", false, x.refresh_steps, 1);
+    x.inertial_warning =
+        r.positive(t, "plane_strain", "inertial_warning", false, x.inertial_warning);
+  } else if (s.test == "direct_shear") {
+    const auto* t = r.table("direct_shear", true);
+    r.only(
+        t, "direct_shear",
+        {"normal_stress_Pa", "shear_velocity_m_s", "max_displacement_m", "frame_every_m", "gap_m",
+         "side_friction_deg", "platen_friction_deg", "servo_gain", "max_platen_speed_m_s"});
+    auto& x = s.direct_shear;
+    x.normal_stress_Pa = r.positive(t, "direct_shear", "normal_stress_Pa", true, 0);
+    x.shear_velocity_m_s = r.positive(t, "direct_shear", "shear_velocity_m_s", true, 0);
+    x.max_displacement_m = r.positive(t, "direct_shear", "max_displacement_m", true, 0);
+    x.frame_every_m = r.number(t, "direct_shear", "frame_every_m", false, 0);
+    x.servo_gain = r.positive(t, "direct_shear", "servo_gain", false, x.servo_gain);
+    x.max_platen_speed_m_s =
+        r.positive(t, "direct_shear", "max_platen_speed_m_s", false, x.max_platen_speed_m_s);
+    auto& g = s.shear_box;
+    g.gap_m = r.number(t, "direct_shear", "gap_m", false, -1);
+    g.side_friction_deg = r.number(t, "direct_shear", "side_friction_deg", false, 0);
+    g.platen_friction_deg = r.number(t, "direct_shear", "platen_friction_deg", false, -1);
+  }
+  const auto* prep = r.table("preparation", false);
+  if (!s.test.empty() && (prep || s.specimen)) {
+    auto& p = s.preparation.emplace();
+    r.only(prep, "preparation",
+           {"pressure_Pa", "void_ratio", "core_inset_m", "friction_start_deg", "friction_factor",
+            "stage_steps", "check_every", "stress_tolerance", "unbalanced_force", "kinetic_ratio",
+            "servo_gain", "max_wall_speed_m_s", "deposition", "max_steps"});
+    // Default: the stress of the test (σc, or σn of the direct shear).
+    const double test_stress = s.test == "triaxial"       ? s.triaxial.confining_Pa
+                               : s.test == "plane_strain" ? s.plane_strain.confining_Pa
+                                                          : s.direct_shear.normal_stress_Pa;
+    p.pressure_Pa = r.number(prep, "preparation", "pressure_Pa", false, test_stress);
+    if (p.pressure_Pa < 0) r.fail("preparation.pressure_Pa", "negative", value_str(p.pressure_Pa));
+    p.void_ratio_target = r.number(prep, "preparation", "void_ratio", false,
+                                   s.specimen ? s.specimen->void_ratio : -1);
+    p.core_inset_m = r.number(prep, "preparation", "core_inset_m", false, -1);
+    p.friction_start_deg = r.number(prep, "preparation", "friction_start_deg", false, -1);
+    p.friction_factor =
+        r.positive(prep, "preparation", "friction_factor", false, p.friction_factor);
+    if (p.friction_factor >= 1)
+      r.fail("preparation.friction_factor", "must be below 1", value_str(p.friction_factor));
+    p.stage_steps = r.integer(prep, "preparation", "stage_steps", false, p.stage_steps, 1);
+    p.check_every = r.integer(prep, "preparation", "check_every", false, p.check_every, 1);
+    p.stress_tolerance =
+        r.positive(prep, "preparation", "stress_tolerance", false, p.stress_tolerance);
+    p.unbalanced_force =
+        r.positive(prep, "preparation", "unbalanced_force", false, p.unbalanced_force);
+    p.kinetic_ratio = r.positive(prep, "preparation", "kinetic_ratio", false, p.kinetic_ratio);
+    p.servo_gain = r.positive(prep, "preparation", "servo_gain", false, p.servo_gain);
+    p.max_wall_speed_m_s =
+        r.positive(prep, "preparation", "max_wall_speed_m_s", false, p.max_wall_speed_m_s);
+    p.deposition =
+        prep && prep->contains("deposition") ? (*prep)["deposition"].value_or(false) : false;
+    p.max_steps = r.integer(prep, "preparation", "max_steps", false, 0, 0);
+    if (p.pressure_Pa == 0 && !p.deposition)
+      r.fail("preparation.pressure_Pa", "missing (or set deposition = true)");
+  } else if (prep) {
+    r.fail("[preparation]", "needs scene.test");
+  }
+}
 
 }  // namespace
 
@@ -108,20 +222,40 @@ Scene load_scene(const std::filesystem::path& path) {
   const Reader r{file, root};
   Scene s;
   s.file = path;
+  for (const auto& [k, v] : root) {
+    static const char* sections[] = {"scene",        "material",    "solver",      "output",
+                                     "walls",        "specimen",    "preparation", "triaxial",
+                                     "plane_strain", "direct_shear"};
+    if (std::find(std::begin(sections), std::end(sections), k.str()) == std::end(sections))
+      r.fail("[" + std::string(k.str()) + "]", "unknown section");
+  }
   const auto* scene = r.table("scene", true);
+  r.only(scene, "scene", {"name", "packing", "test", "wall_friction_deg"});
   s.name = r.string(scene, "scene", "name", true, "");
-  const std::string packing = r.string(scene, "scene", "packing", true, "");
-  const auto packing_path = path.parent_path() / packing;
-  {
+  s.test = r.string(scene, "scene", "test", false, "");
+  if (!s.test.empty() && s.test != "triaxial" && s.test != "plane_strain" &&
+      s.test != "direct_shear")
+    r.fail("scene.test", "expected \"triaxial\", \"plane_strain\" or \"direct_shear\"", s.test);
+  const auto* specimen = r.table("specimen", false);
+  const bool has_packing = scene->contains("packing");
+  if (s.test.empty() || has_packing || !specimen) {
+    const std::string packing = r.string(scene, "scene", "packing", true, "");
+    const auto packing_path = path.parent_path() / packing;
     const Trajectory t = read_snapshots(packing_path);
     if (t.frames.empty() || t.frames.back().particles.empty())
       throw InputError(packing_path.string(), "packing holds no particles");
     s.particles = t.frames.back().particles;
+    s.parameters.emplace_back("scene.packing", packing);
   }
+  if (specimen && has_packing) r.fail("[specimen]", "give either scene.packing or [specimen]");
+  if (specimen && s.test.empty()) r.fail("[specimen]", "needs scene.test");
   s.parameters.emplace_back("scene.name", s.name);
-  s.parameters.emplace_back("scene.packing", packing);
+  s.wall_friction_deg = r.number(scene, "scene", "wall_friction_deg", false, 0.0);
 
   const auto* mat = r.table("material", true);
+  r.only(mat, "material",
+         {"young_Pa", "stiffness_ratio", "friction_deg", "density_kg_m3", "rolling_stiffness",
+          "rolling_limit", "rolling_limit_radius", "twisting_stiffness", "twisting_limit"});
   auto& m = s.config.material;
   m.young_ec = r.positive(mat, "material", "young_Pa", true, 0);
   m.stiffness_ratio = r.number(mat, "material", "stiffness_ratio", true, 0);
@@ -144,8 +278,38 @@ Scene load_scene(const std::filesystem::path& path) {
   s.config.twist_eta = r.number(mat, "material", "twisting_limit", false, -1);
 
   const auto* sol = r.table("solver", true);
+  r.only(sol, "solver",
+         {"dt_s", "dt_safety", "damping", "gravity_m_s2", "steps", "threads", "skin_m",
+          "max_overlap_ratio", "max_energy_residual"});
+  if (specimen) {
+    auto& sp = s.specimen.emplace();
+    r.only(specimen, "specimen",
+           {"size_m", "dmin_m", "dmax_m", "distribution", "void_ratio", "seed",
+            "cloud_solid_fraction"});
+    sp.size_m = r.vec3(specimen, "specimen", "size_m", true, {});
+    if ((sp.size_m.array() <= 0).any()) r.fail("specimen.size_m", "must be positive");
+    sp.sizes.dmin_m = r.positive(specimen, "specimen", "dmin_m", true, 0);
+    sp.sizes.dmax_m = r.positive(specimen, "specimen", "dmax_m", true, 0);
+    if (sp.sizes.dmax_m < sp.sizes.dmin_m)
+      r.fail("specimen.dmax_m", "smaller than dmin_m", value_str(sp.sizes.dmax_m));
+    const std::string dist = r.string(specimen, "specimen", "distribution", false, "uniform");
+    if (dist == "uniform")
+      sp.sizes.distribution = SizeDistribution::Uniform;
+    else if (dist == "linear")
+      sp.sizes.distribution = SizeDistribution::Linear;
+    else
+      r.fail("specimen.distribution", "expected \"uniform\" or \"linear\"", dist);
+    sp.void_ratio = r.positive(specimen, "specimen", "void_ratio", false, sp.void_ratio);
+    sp.seed = static_cast<std::uint64_t>(r.integer(specimen, "specimen", "seed", false, 1, 0));
+    sp.cloud_solid_fraction =
+        r.positive(specimen, "specimen", "cloud_solid_fraction", false, sp.cloud_solid_fraction);
+    if (sp.cloud_solid_fraction >= 0.45)
+      r.fail("specimen.cloud_solid_fraction", "too dense for random sequential addition (< 0.45)",
+             value_str(sp.cloud_solid_fraction));
+  }
   std::vector<double> radii;
   for (const auto& p : s.particles) radii.push_back(p.radius);
+  if (s.specimen) radii.push_back(0.5 * s.specimen->sizes.dmin_m);
   s.dt_pwave = pwave_timestep(radii, m.density, m.young_ec);
   if (sol->contains("dt_s") && (*sol)["dt_s"].is_string()) {
     if (r.string(sol, "solver", "dt_s", true, "") != "auto")
@@ -158,13 +322,16 @@ Scene load_scene(const std::filesystem::path& path) {
   if (s.config.damping < 0 || s.config.damping >= 1)
     r.fail("solver.damping", "outside [0, 1)", value_str(s.config.damping));
   s.config.gravity = r.vec3(sol, "solver", "gravity_m_s2", false, Eigen::Vector3d::Zero());
-  s.steps = r.integer(sol, "solver", "steps", true, 0, 0);
+  s.steps = r.integer(sol, "solver", "steps", s.test.empty(), 0, 0);
   s.config.threads = static_cast<int>(r.integer(sol, "solver", "threads", false, 1, 1));
   s.config.skin = r.number(sol, "solver", "skin_m", false, 0);
   s.config.max_overlap_ratio = r.positive(sol, "solver", "max_overlap_ratio", false, 0.1);
   s.config.max_energy_residual = r.positive(sol, "solver", "max_energy_residual", false, 0.2);
 
   const auto* out = r.table("output", false);
+  r.only(out, "output",
+         {"trajectory", "every", "contacts", "history", "history_every", "checkpoint_every",
+          "curve", "curve_every", "specimen", "preparation"});
   s.output.trajectory = r.string(out, "output", "trajectory", false, s.output.trajectory);
   s.output.every = r.integer(out, "output", "every", false, s.output.every, 1);
   s.output.contacts = out && out->contains("contacts") ? (*out)["contacts"].value_or(true) : true;
@@ -173,12 +340,22 @@ Scene load_scene(const std::filesystem::path& path) {
       r.integer(out, "output", "history_every", false, s.output.history_every, 1);
   s.output.checkpoint_every =
       r.integer(out, "output", "checkpoint_every", false, s.output.checkpoint_every, 1);
+  s.output.curve = r.string(out, "output", "curve", false, s.output.curve);
+  s.output.curve_every = r.integer(out, "output", "curve_every", false, s.output.curve_every, 1);
+  s.output.specimen = r.string(out, "output", "specimen", false, s.output.specimen);
+  s.output.preparation = r.string(out, "output", "preparation", false, s.output.preparation);
+  read_lab_sections(r, root, s);
 
+  if (!s.test.empty() && root.contains("walls"))
+    r.fail("[[walls]]", "a laboratory test builds its own walls; remove [[walls]]");
   if (const auto* walls = root["walls"].as_array()) {
     for (std::size_t i = 0; i < walls->size(); ++i) {
       const auto* w = (*walls)[i].as_table();
       const std::string sec = "walls[" + std::to_string(i) + "]";
       if (!w) r.fail(sec, "expected a table");
+      r.only(w, sec,
+             {"name", "shape", "center_m", "half_extents_m", "point_m", "normal",
+              "angular_velocity_rad_s", "velocity_m_s", "servo", "friction_deg"});
       WallSpec spec;
       spec.name = r.string(w, sec, "name", false, "wall" + std::to_string(i));
       const std::string shape = r.string(w, sec, "shape", true, "");
@@ -200,8 +377,10 @@ Scene load_scene(const std::filesystem::path& path) {
         r.fail(sec + ".shape", "expected \"box\" or \"plane\"", shape);
       }
       spec.velocity = r.vec3(w, sec, "velocity_m_s", false, Eigen::Vector3d::Zero());
+      spec.friction_deg = r.number(w, sec, "friction_deg", false, -1);
       if (const auto* servo = (*w)["servo"].as_table()) {
         const std::string ss = sec + ".servo";
+        r.only(servo, ss, {"stress_Pa", "area_m2", "gain_m_s_per_Pa", "max_velocity_m_s", "axis"});
         spec.servo_stress_Pa = r.number(servo, ss, "stress_Pa", true, 0);
         spec.servo_area_m2 = r.positive(servo, ss, "area_m2", true, 0);
         spec.servo_gain = r.positive(servo, ss, "gain_m_s_per_Pa", true, 0);

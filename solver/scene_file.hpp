@@ -7,8 +7,17 @@
 #include <string>
 #include <vector>
 
+#include <memory>
+#include <optional>
+
+#include "direct_shear_test.hpp"
+#include "loading_programme.hpp"
+#include "plane_strain_test.hpp"
 #include "simulation.hpp"
 #include "snapshot.hpp"
+#include "specimen_generation.hpp"
+#include "specimen_preparation.hpp"
+#include "triaxial_test.hpp"
 
 namespace gs::solver {
 
@@ -19,6 +28,19 @@ struct OutputSpec {
   std::string history = "history.csv";  // monitors
   std::int64_t history_every = 100;
   std::int64_t checkpoint_every = 10000;
+  std::string curve = "curve.csv";  // macroscopic curve of a laboratory test
+  std::int64_t curve_every = 200;
+  std::string specimen = "specimen.h5";  // the prepared specimen (one frame)
+  std::string preparation = "preparation.csv";
+};
+
+/// [specimen]: a seeded random specimen generated instead of reading a packing.
+struct SpecimenSpec {
+  Eigen::Vector3d size_m = Eigen::Vector3d::Zero();  // target specimen box (x, y, z)
+  SizeSpec sizes;
+  double void_ratio = 0.55;  // sets the number of spheres: Σ V = V_box / (1 + e)
+  std::uint64_t seed = 1;
+  double cloud_solid_fraction = 0.3;  // density of the loose cloud they are placed in
 };
 
 struct Scene {
@@ -31,6 +53,43 @@ struct Scene {
   OutputSpec output;
   std::vector<std::pair<std::string, std::string>> parameters;  // flattened, for run metadata
   double dt_pwave = 0;  // YADE's PWaveTimeStep of the packing (s)
+
+  // Laboratory tests (docs/scenes.md): empty `test` is a plain run of `steps` steps.
+  std::string test;  // "", "triaxial", "plane_strain", "direct_shear"
+  std::optional<SpecimenSpec> specimen;
+  std::optional<PreparationSpec> preparation;
+  double wall_friction_deg = 0;  // smooth walls by default (seed 004 §4.1.2, seed 000 §3)
+  TriaxialSpec triaxial;
+  PlaneStrainSpec plane_strain;
+  DirectShearSpec direct_shear;
+  ShearBoxGeometry shear_box;
+};
+
+/// Generates the specimen when the scene asks for one, builds the walls of its test and returns
+/// the loading programmes to run in turn (preparation, then the test; a plain scene gets one
+/// programme of `steps` steps). Throws InputError naming the scene file.
+std::vector<std::unique_ptr<LoadingProgramme>> scene_programmes(Scene& scene);
+
+/// A plain run: `steps` steps, a frame every `every` steps.
+class FixedSteps final : public LoadingProgramme {
+ public:
+  FixedSteps(std::int64_t steps, std::int64_t every) : steps_(steps), every_(every) {}
+  std::string name() const override { return "steps"; }
+  void start(Simulation& sim) override { first_ = sim.step_count(); }
+  void control(Simulation&) override {}
+  bool finished(const Simulation& sim) const override { return sim.step_count() >= steps_; }
+  double progress(const Simulation& sim) const override;
+  std::string curve_header() const override { return {}; }
+  std::string curve_row(const Simulation&) const override { return {}; }
+  std::int64_t frame_index(const Simulation& sim) const override {
+    return sim.step_count() / every_;
+  }
+  std::string summary(const Simulation&) const override { return {}; }
+  std::string save_state() const override;
+  void load_state(const std::string& state) override;
+
+ private:
+  std::int64_t steps_, every_, first_ = 0;
 };
 
 /// Reads and checks a scene file. Throws InputError "FILE: key: what (value)".

@@ -44,6 +44,7 @@ Simulation::Simulation(SimulationConfig config, const std::vector<Particle>& par
   p_.ori.resize(n);
   p_.fixed.assign(n, 0);
   p_.rot_blocked.assign(n, 0);
+  p_.external_force.assign(n, Eigen::Vector3d::Zero());
   std::int64_t max_id = -1;
   double rmin = std::numeric_limits<double>::infinity();
   for (std::size_t i = 0; i < n; ++i) {
@@ -98,7 +99,30 @@ void Simulation::attach_histories(const std::vector<ContactHistory>& old) {
     const double ra = p_.radius[pr.first];
     const double rb = pr.second >= kWallBase ? ra : p_.radius[pr.second];
     params_[k] = contact_params(cfg_.material, ra, rb, cfg_.twist_beta, cfg_.twist_eta);
+    if (pr.second >= kWallBase) {
+      const double wf = walls_[pr.second - kWallBase].spec.friction_deg;
+      if (wf >= 0) params_[k].tan_friction = std::tan(wf * M_PI / 180.0);
+    }
   }
+}
+
+std::pair<double, std::size_t> Simulation::wall_stiffness(std::size_t w) const {
+  return {walls_.at(w).contact_stiffness, walls_[w].contacts};
+}
+
+void Simulation::set_friction_deg(double friction_deg) {
+  cfg_.material.friction_deg = friction_deg;
+  const double t = std::tan(friction_deg * M_PI / 180.0);
+  for (std::size_t k = 0; k < params_.size(); ++k)
+    if (nl_.pairs[k].second < kWallBase) params_[k].tan_friction = t;
+}
+
+void Simulation::set_wall_active(std::size_t w, bool active) {
+  if (walls_.at(w).active == active) return;
+  walls_[w].active = active;
+  walls_[w].force.setZero();
+  walls_[w].torque.setZero();
+  invalidate_neighbors();
 }
 
 bool Simulation::pair_geometry(std::size_t k, ContactGeometry& g, BodyMotion& m1,
@@ -161,11 +185,13 @@ void Simulation::step() {
 
   // Accumulate in pair order: deterministic whatever the thread count.
   const std::size_t n = p_.size();
-  std::fill(p_.force.begin(), p_.force.end(), Eigen::Vector3d::Zero());
+  std::copy(p_.external_force.begin(), p_.external_force.end(), p_.force.begin());
   std::fill(p_.torque.begin(), p_.torque.end(), Eigen::Vector3d::Zero());
   for (auto& w : walls_) {
     w.force.setZero();
     w.torque.setZero();
+    w.contact_stiffness = 0;
+    w.contacts = 0;
   }
   double max_overlap_ratio = 0;
   for (std::size_t k = 0; k < np; ++k) {
@@ -177,6 +203,8 @@ void Simulation::step() {
     if (b >= kWallBase) {
       WallState& w = walls_[b - kWallBase];
       w.force += L.force1;
+      w.contact_stiffness += params_[k].kn;
+      ++w.contacts;
       w.torque += L.arm1;
       w.torque += -L.moment;
       p_.force[a] += -L.force1;
@@ -207,6 +235,10 @@ void Simulation::step() {
     if (!p_.fixed[i]) grav += p_.mass[i] * cfg_.gravity.dot(p_.vel[i]);
   ledger_.gravity_work += grav * dt;
   for (const auto& w : walls_) ledger_.wall_work += -w.force.dot(w.vel) * dt;
+  double ext = 0;
+  for (std::size_t i = 0; i < n; ++i)
+    if (!p_.fixed[i]) ext += p_.external_force[i].dot(p_.vel[i]);
+  ledger_.external_work += ext * dt;
 
   damp_.resize(n);
   auto& damp = damp_;
@@ -236,6 +268,12 @@ void Simulation::run(std::int64_t steps) {
 std::size_t Simulation::contact_count() const {
   std::size_t c = 0;
   for (const auto& h : hist_) c += h.real;
+  return c;
+}
+
+std::size_t Simulation::sphere_contact_count() const {
+  std::size_t c = 0;
+  for (const auto& h : hist_) c += (h.real && h.b < kWallBase);
   return c;
 }
 
@@ -403,7 +441,7 @@ Frame Simulation::frame() const {
 // ------------------------------------------------------------------ checkpoints
 
 namespace {
-constexpr char kMagic[8] = {'G', 'S', 'C', 'K', 'P', 'T', '0', '1'};
+constexpr char kMagic[8] = {'G', 'S', 'C', 'K', 'P', 'T', '0', '2'};
 
 template <class T>
 void put(std::ostream& o, const T& v) {
@@ -432,7 +470,8 @@ void get_vec(std::istream& i, std::vector<T>& v, std::size_t expect, const std::
 }
 }  // namespace
 
-void Simulation::save_checkpoint(const std::filesystem::path& path) const {
+void Simulation::save_checkpoint(const std::filesystem::path& path,
+                                 const std::string& extra) const {
   AtomicOutput out(path);
   {
     std::ofstream o(out.temp_path(), std::ios::binary);
@@ -448,11 +487,20 @@ void Simulation::save_checkpoint(const std::filesystem::path& path) const {
     put_vec(o, p_.ori);
     put_vec(o, p_.fixed);
     put_vec(o, p_.rot_blocked);
+    put_vec(o, p_.external_force);
+    put(o, cfg_.material.friction_deg);
+    put(o, cfg_.damping);
+    put(o, cfg_.gravity);
     put(o, static_cast<std::uint64_t>(walls_.size()));
     for (const auto& w : walls_) {
       put(o, w.pos);
       put(o, w.normal);
       put(o, w.vel);
+      put(o, static_cast<std::uint8_t>(w.active));
+      put(o, w.force);  // loads of the last step: what a servo reads before the next one
+      put(o, w.torque);
+      put(o, w.contact_stiffness);
+      put(o, static_cast<std::uint64_t>(w.contacts));
     }
     // Contact histories of real contacts, sorted by pair.
     std::vector<ContactHistory> real;
@@ -460,12 +508,14 @@ void Simulation::save_checkpoint(const std::filesystem::path& path) const {
       if (h.real) real.push_back(h);
     put(o, static_cast<std::uint64_t>(real.size()));
     for (const auto& h : real) put(o, h);
+    put(o, static_cast<std::uint64_t>(extra.size()));
+    o.write(extra.data(), static_cast<std::streamsize>(extra.size()));
     if (!o.flush()) throw InputError(path.string(), "cannot write checkpoint");
   }
   out.commit();
 }
 
-void Simulation::load_checkpoint(const std::filesystem::path& path) {
+std::string Simulation::load_checkpoint(const std::filesystem::path& path) {
   const std::string file = path.string();
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(file, "cannot open checkpoint");
@@ -487,6 +537,10 @@ void Simulation::load_checkpoint(const std::filesystem::path& path) {
   get_vec(in, p_.ori, n, file);
   get_vec(in, p_.fixed, n, file);
   get_vec(in, p_.rot_blocked, n, file);
+  get_vec(in, p_.external_force, n, file);
+  get(in, cfg_.material.friction_deg, file);
+  get(in, cfg_.damping, file);
+  get(in, cfg_.gravity, file);
   std::uint64_t nw = 0;
   get(in, nw, file);
   if (nw != walls_.size())
@@ -495,6 +549,15 @@ void Simulation::load_checkpoint(const std::filesystem::path& path) {
     get(in, w.pos, file);
     get(in, w.normal, file);
     get(in, w.vel, file);
+    std::uint8_t active = 1;
+    get(in, active, file);
+    w.active = active != 0;
+    get(in, w.force, file);
+    get(in, w.torque, file);
+    get(in, w.contact_stiffness, file);
+    std::uint64_t contacts = 0;
+    get(in, contacts, file);
+    w.contacts = static_cast<std::size_t>(contacts);
   }
   std::uint64_t nc = 0;
   get(in, nc, file);
@@ -502,9 +565,17 @@ void Simulation::load_checkpoint(const std::filesystem::path& path) {
     throw InputError(file, "corrupt checkpoint (contact count)", std::to_string(nc));
   std::vector<ContactHistory> real(nc);
   for (auto& h : real) get(in, h, file);
+  std::uint64_t extra_size = 0;
+  get(in, extra_size, file);
+  if (extra_size > (1ull << 30))
+    throw InputError(file, "corrupt checkpoint (scene state size)", std::to_string(extra_size));
+  std::string extra(extra_size, '\0');
+  in.read(extra.data(), static_cast<std::streamsize>(extra_size));
+  if (!in) throw InputError(file, "truncated checkpoint");
   // Rebuild the neighbour list from the restored state and put the histories back.
   nl_.build(p_, walls_);
   attach_histories(real);
+  return extra;
 }
 
 }  // namespace gs::solver

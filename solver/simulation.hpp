@@ -33,14 +33,16 @@ struct SimulationConfig {
 struct EnergyLedger {
   double kinetic = 0, elastic_normal = 0, elastic_shear = 0, elastic_rolling = 0;
   double friction_dissipation = 0, rolling_dissipation = 0, damping_dissipation = 0;
-  double gravity_work = 0, wall_work = 0;
+  double gravity_work = 0, wall_work = 0, external_work = 0;
   double initial = 0;  // kinetic + elastic at the start
   double stored() const { return kinetic + elastic_normal + elastic_shear + elastic_rolling; }
   double dissipated() const {
     return friction_dissipation + rolling_dissipation + damping_dissipation;
   }
   /// stored + dissipated − (initial + work in): zero for an exact integration.
-  double residual() const { return stored() + dissipated() - (initial + gravity_work + wall_work); }
+  double residual() const {
+    return stored() + dissipated() - (initial + gravity_work + wall_work + external_work);
+  }
 };
 
 /// Thrown when the state becomes unphysical (NaN, excessive overlap).
@@ -72,6 +74,8 @@ class Simulation {
   /// Snapshot of the current state: particles, real contacts, walls with their loads.
   Frame frame() const;
   std::size_t contact_count() const;
+  /// Real sphere–sphere contacts (wall contacts not counted).
+  std::size_t sphere_contact_count() const;
   /// YADE's unbalancedForce: mean |resultant force| on free particles / mean |contact force|.
   double unbalanced_force() const;
   double kinetic_energy() const;
@@ -88,9 +92,23 @@ class Simulation {
   std::int64_t wall_id(std::size_t w) const { return wall_id_base_ + static_cast<std::int64_t>(w); }
   std::int64_t neighbor_list_builds() const { return nl_.builds; }
 
-  /// Complete state, for bit-for-bit resumption.
-  void save_checkpoint(const std::filesystem::path& path) const;
-  void load_checkpoint(const std::filesystem::path& path);
+  /// Sum of the normal stiffnesses Kn (N/m) of the real contacts on wall w, and their count:
+  /// what a stiffness-based servo needs (YADE TriaxialStressController).
+  std::pair<double, std::size_t> wall_stiffness(std::size_t w) const;
+  /// Changes the inter-particle friction angle of every existing and future sphere–sphere
+  /// contact (YADE's setContactFriction); walls keep their own friction.
+  void set_friction_deg(double friction_deg);
+  void set_damping(double damping) { cfg_.damping = damping; }
+  void set_gravity(const Eigen::Vector3d& g) { cfg_.gravity = g; }
+  /// Switches a wall on or off; contacts with an inactive wall are dropped.
+  void set_wall_active(std::size_t w, bool active);
+  /// Forces a neighbour-list rebuild before the next step.
+  void invalidate_neighbors() { nl_.ref_pos.clear(); }
+
+  /// Complete state, for bit-for-bit resumption. `extra` is stored alongside (the state of a
+  /// scene's loading programme) and returned by load_checkpoint.
+  void save_checkpoint(const std::filesystem::path& path, const std::string& extra = {}) const;
+  std::string load_checkpoint(const std::filesystem::path& path);
 
  private:
   void rebuild_neighbors();

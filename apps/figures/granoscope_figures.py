@@ -12,7 +12,7 @@ import sys
 
 # format attribute -> figure modules (first is the default for that format)
 FIGURES = {
-    "granoscope-trajectory": ["fig_positions", "fig_history"],
+    "granoscope-trajectory": ["fig_positions", "fig_history", "fig_labcurve"],
     "granoscope-dic": ["fig_dic"],
     "granoscope-strain": ["fig_strain"],
     "granoscope-voidcells": ["fig_strain"],

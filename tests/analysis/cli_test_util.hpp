@@ -1,5 +1,5 @@
 // Helpers of the end-to-end CLI tests of the analyses: scratch directory, running the built
-// `granoscope`, reading HDF5 outputs back.
+// `granoscope` with one log, reading HDF5 outputs back (on top of tests/apps/cli_util.hpp).
 #pragma once
 
 #include <gtest/gtest.h>
@@ -8,10 +8,10 @@
 
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 #include <string>
 #include <vector>
+
+#include "../apps/cli_util.hpp"
 
 namespace gs::test {
 
@@ -27,17 +27,9 @@ inline std::filesystem::path cli_temp_dir(const std::string& prefix) {
 
 /// Runs `granoscope ARGS` with stdout and stderr to `log`; the exit code (-1 if killed).
 inline int run_granoscope(const std::string& args, const std::filesystem::path& log) {
-  const std::string cmd =
-      std::string(GS_BINARY_DIR) + "/bin/granoscope " + args + " > " + log.string() + " 2>&1";
+  const std::string cmd = kGranoscope + " " + args + " > " + log.string() + " 2>&1";
   const int rc = std::system(cmd.c_str());
   return WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
-}
-
-inline std::string slurp(const std::filesystem::path& p) {
-  std::ifstream in(p);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
 }
 
 /// Whole dataset `name` of an HDF5 file, converted to `type` (e.g. H5T_NATIVE_DOUBLE).

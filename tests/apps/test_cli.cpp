@@ -8,44 +8,19 @@
 #include <sstream>
 
 #include "../io/test_util.hpp"
+#include "cli_util.hpp"
 #include "trajectory_io.hpp"
 
 namespace {
 
 const std::filesystem::path kData = GS_TEST_DATA_DIR;
-const std::string kExe = std::string(GS_BINARY_DIR) + "/bin/granoscope";
 
-struct Result {
-  int rc = -1;
-  std::string out, err;
-};
-
-std::string slurp(const std::filesystem::path& p) {
-  std::ifstream in(p);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using gs::test::expect_rejected;
+using gs::test::slurp;
+using Result = gs::test::CliResult;
 
 Result run(const std::string& args, const std::filesystem::path& scratch) {
-  const auto o = scratch / "stdout.txt", e = scratch / "stderr.txt";
-  const std::string cmd =
-      kExe + " " + args + " >" + o.string() + " 2>" + e.string() + " </dev/null";
-  const int status = std::system(cmd.c_str());
-  Result r;
-  r.rc = WIFEXITED(status) ? WEXITSTATUS(status) : 128;
-  r.out = slurp(o);
-  r.err = slurp(e);
-  std::filesystem::remove(o);
-  std::filesystem::remove(e);
-  return r;
-}
-
-// One line "error: FILE: ...", exit code 2.
-void expect_rejected(const Result& r, const std::string& file) {
-  EXPECT_EQ(r.rc, 2) << r.err;
-  EXPECT_EQ(r.err.rfind("error: " + file + ": ", 0), 0u) << r.err;
-  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  return gs::test::run_cli(args, scratch);
 }
 
 std::vector<std::string> listing(const std::filesystem::path& dir) {

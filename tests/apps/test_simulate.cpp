@@ -13,19 +13,15 @@
 #include <thread>
 
 #include "../io/test_util.hpp"
+#include "cli_util.hpp"
 #include "hdf5_trajectory.hpp"
 
 namespace {
 
+using gs::test::slurp;
+
 const std::filesystem::path kData = GS_TEST_DATA_DIR;
 const std::string kExe = std::string(GS_BINARY_DIR) + "/bin/granoscope";
-
-std::string slurp(const std::filesystem::path& p) {
-  std::ifstream in(p);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
 
 int run(const std::string& args, std::string* err = nullptr) {
   const auto e =
@@ -59,8 +55,8 @@ TEST(Simulate, ResumeAfterKillIsBitForBitIdentical) {
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
   while (std::chrono::steady_clock::now() < deadline) {
     const std::string idx = slurp(killed / "checkpoint.txt");
-    const auto k = idx.find("step ");
-    if (k != std::string::npos && std::stol(idx.substr(k + 5)) >= 2000) break;
+    const auto k = idx.find("\nstep ");
+    if (k != std::string::npos && std::stol(idx.substr(k + 6)) >= 2000) break;
     std::this_thread::sleep_for(std::chrono::microseconds(200));
   }
   kill(pid, SIGKILL);

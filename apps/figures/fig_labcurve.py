@@ -1,0 +1,91 @@
+"""Macroscopic curves of a laboratory-test run (`granoscope simulate` with scene.test): reads
+curve.csv (and preparation.csv) beside the trajectory; nothing when there is none.
+  triaxial / plane strain: mobilised friction angle and σ1/σ3 vs ε1, volumetric strain vs ε1
+  (dilation positive, as seed 004 Figs 4.2-4.8 and seed 000 Fig 3);
+  direct shear: τ/σn and volumetric strain vs horizontal displacement u (seed 004 Fig 4.12);
+  preparation: void ratio and friction against steps."""
+import csv
+import os
+
+import matplotlib.pyplot as plt
+import numpy as np
+
+import figutil
+
+
+def read(path):
+    with open(path) as f:
+        rows = list(csv.reader(f))
+    if len(rows) < 2:
+        raise ValueError(f"{path}: no rows")
+    head = rows[0]
+    data = np.array([[float(v) for v in r] for r in rows[1:]])
+    return {h: data[:, i] for i, h in enumerate(head)}
+
+
+def compression(c, title):
+    fig, (a1, a2) = plt.subplots(2, 1, figsize=(6.5, 7), sharex=True)
+    e1 = 100 * c["eps1_shortening"]
+    a1.plot(e1, c["phi_deg"], "k-")
+    a1.set_ylabel("mobilised friction angle φ (°)")
+    k = int(np.argmax(c["phi_deg"]))
+    a1.plot(e1[k], c["phi_deg"][k], "ro")
+    a1.annotate(f"peak {c['phi_deg'][k]:.1f}° at ε1 = {e1[k]:.1f} %", (e1[k], c["phi_deg"][k]),
+                textcoords="offset points", xytext=(8, -14), fontsize=8)
+    r = a1.twinx()
+    r.plot(e1, c["sigma1_Pa"] / c["sigma3_Pa"], color="0.6", lw=0.8)
+    r.set_ylabel("σ1/σ3", color="0.5")
+    a2.plot(e1, 100 * c["eps_v_dilation"], "k-")
+    a2.axhline(0, color="0.7", lw=0.5)
+    a2.set_ylabel("volumetric strain εv (%, dilation +)")
+    a2.set_xlabel("axial strain ε1 (%)")
+    a1.set_title(title)
+    return fig
+
+
+def shear(c, title):
+    fig, (a1, a2) = plt.subplots(2, 1, figsize=(6.5, 7), sharex=True)
+    u = 1e3 * c["u_m"]
+    a1.plot(u, c["tau_over_sigma_n"], "k-")
+    a1.set_ylabel("τ/σn")
+    a2.plot(u, 100 * c["eps_v_dilation"], "k-")
+    a2.axhline(0, color="0.7", lw=0.5)
+    a2.set_ylabel("volumetric strain εv (%, dilation +)")
+    a2.set_xlabel("horizontal displacement u (mm)")
+    a1.set_title(title)
+    return fig
+
+
+def preparation(c, title):
+    fig, a1 = plt.subplots(figsize=(6.5, 4))
+    a1.plot(c["step"], c["void_ratio"], "k-", label="whole box")
+    a1.plot(c["step"], c["core_void_ratio"], "b-", label="core")
+    a1.set_xlabel("step")
+    a1.set_ylabel("void ratio e")
+    a1.legend(fontsize=8)
+    r = a1.twinx()
+    r.plot(c["step"], c["friction_deg"], color="tab:red", lw=0.8)
+    r.set_ylabel("friction during compaction (°)", color="tab:red")
+    a1.set_title(title)
+    return fig
+
+
+def make(path, out_dir, args):
+    here = os.path.dirname(os.path.abspath(path))
+    stem = os.path.splitext(os.path.basename(path))[0]
+    written = []
+    curve = os.path.join(here, "curve.csv")
+    if os.path.exists(curve):
+        c = read(curve)
+        if "u_m" in c:
+            fig = shear(c, f"{stem}: direct shear")
+        elif "eps1_shortening" in c:
+            fig = compression(c, f"{stem}: {'plane strain' if 'width_m' in c else 'triaxial'}")
+        else:
+            raise ValueError(f"{curve}: not a laboratory-test curve")
+        written.append(figutil.save(fig, out_dir, f"{stem}_curve.png"))
+    prep = os.path.join(here, "preparation.csv")
+    if os.path.exists(prep):
+        written.append(figutil.save(preparation(read(prep), f"{stem}: preparation"), out_dir,
+                                    f"{stem}_preparation.png"))
+    return written

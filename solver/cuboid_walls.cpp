@@ -1,0 +1,62 @@
+#include "cuboid_walls.hpp"
+
+#include <cmath>
+
+namespace gs::solver {
+
+std::vector<WallSpec> cuboid_planes(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi,
+                                    double friction_deg) {
+  static const char* names[6] = {"x-", "x+", "y-", "y+", "z-", "z+"};
+  std::vector<WallSpec> walls;
+  for (std::size_t f = 0; f < 6; ++f) {
+    WallSpec w;
+    w.name = names[f];
+    w.shape = WallShape::Plane;
+    const int axis = static_cast<int>(f / 2);
+    w.center = 0.5 * (lo + hi);
+    w.center[axis] = (f % 2 == 0) ? lo[axis] : hi[axis];
+    w.normal = cuboid_inward(f);
+    w.friction_deg = friction_deg;
+    walls.push_back(w);
+  }
+  return walls;
+}
+
+Eigen::Vector3d cuboid_inward(std::size_t f) {
+  Eigen::Vector3d n = Eigen::Vector3d::Zero();
+  n[static_cast<int>(f / 2)] = (f % 2 == 0) ? 1.0 : -1.0;
+  return n;
+}
+
+Eigen::Vector3d cuboid_lo(const Simulation& sim) {
+  const auto& w = sim.walls();
+  return {w[kXmin].pos.x(), w[kYmin].pos.y(), w[kZmin].pos.z()};
+}
+
+Eigen::Vector3d cuboid_hi(const Simulation& sim) {
+  const auto& w = sim.walls();
+  return {w[kXmax].pos.x(), w[kYmax].pos.y(), w[kZmax].pos.z()};
+}
+
+double cuboid_face_area(const Simulation& sim, std::size_t f) {
+  const Eigen::Vector3d size = cuboid_hi(sim) - cuboid_lo(sim);
+  const int axis = static_cast<int>(f / 2);
+  return size[(axis + 1) % 3] * size[(axis + 2) % 3];
+}
+
+double solid_volume(const Simulation& sim) {
+  double v = 0;
+  for (const double r : sim.particles().radius) v += 4.0 / 3.0 * M_PI * r * r * r;
+  return v;
+}
+
+SpecimenGauge cuboid_gauge() {
+  SpecimenGauge g;
+  g.box = [](const Simulation& sim) { return std::make_pair(cuboid_lo(sim), cuboid_hi(sim)); };
+  g.servo_walls = {kXmin, kXmax, kYmin, kYmax, kZmin, kZmax};
+  g.inward = [](const Simulation&, std::size_t w) { return cuboid_inward(w); };
+  g.area_m2 = [](const Simulation& sim, std::size_t w) { return cuboid_face_area(sim, w); };
+  return g;
+}
+
+}  // namespace gs::solver

@@ -1,0 +1,35 @@
+// Six rigid planes bounding a cuboid specimen (triaxial and plane-strain scenes): their specs,
+// the current box between them, and the gauge the servo and the curves use.
+#pragma once
+
+#include <Eigen/Core>
+#include <array>
+#include <vector>
+
+#include "specimen_preparation.hpp"
+
+namespace gs::solver {
+
+/// Order of the six planes in the wall list.
+enum CuboidFace : std::size_t { kXmin = 0, kXmax, kYmin, kYmax, kZmin, kZmax };
+
+/// Planes through the faces of [lo, hi], normals pointing inwards, named x-, x+, y-, y+, z-, z+,
+/// with the given wall friction (deg; negative: the material's).
+std::vector<WallSpec> cuboid_planes(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi,
+                                    double friction_deg);
+
+/// The box between the six planes (walls 0..5 of the simulation).
+Eigen::Vector3d cuboid_lo(const Simulation& sim);
+Eigen::Vector3d cuboid_hi(const Simulation& sim);
+/// Inward unit normal of face f.
+Eigen::Vector3d cuboid_inward(std::size_t f);
+/// Area of face f of the current box.
+double cuboid_face_area(const Simulation& sim, std::size_t f);
+
+/// Σ 4/3·π·r³ over all particles.
+double solid_volume(const Simulation& sim);
+
+/// Gauge of the cuboid: servo on every face, volume of the box.
+SpecimenGauge cuboid_gauge();
+
+}  // namespace gs::solver

@@ -1,0 +1,137 @@
+// Builds a scene's specimen, walls and loading programmes (scene_file.hpp: scene_programmes).
+#include <algorithm>
+#include <cmath>
+#include <random>
+
+#include "cuboid_walls.hpp"
+#include "errors.hpp"
+#include "scene_file.hpp"
+
+namespace gs::solver {
+
+double FixedSteps::progress(const Simulation& sim) const {
+  const auto span = std::max<std::int64_t>(1, steps_ - first_);
+  return std::clamp(static_cast<double>(sim.step_count() - first_) / static_cast<double>(span), 0.0,
+                    1.0);
+}
+
+std::string FixedSteps::save_state() const {
+  ProgrammeState st;
+  st.set("first", first_);
+  return st.text();
+}
+
+void FixedSteps::load_state(const std::string& state) {
+  first_ = ProgrammeState(state).integer("first");
+}
+
+namespace {
+
+double max_diameter(const std::vector<Particle>& p) {
+  double d = 0;
+  for (const auto& q : p) d = std::max(d, 2 * q.radius);
+  return d;
+}
+
+double mean_diameter(const std::vector<Particle>& p) {
+  double d = 0;
+  for (const auto& q : p) d += 2 * q.radius;
+  return p.empty() ? 0 : d / static_cast<double>(p.size());
+}
+
+/// Seeded specimen in the box [0, cloud]: the number of spheres is set by the target box and
+/// void ratio, the cloud is the loose box they are placed in.
+std::vector<Particle> generate(const Scene& s, const Eigen::Vector3d& cloud) {
+  const SpecimenSpec& sp = *s.specimen;
+  std::mt19937_64 rng(sp.seed);
+  const double solid = sp.size_m.prod() / (1 + sp.void_ratio);
+  try {
+    const auto d = draw_diameters(sp.sizes, solid, rng);
+    return random_sequential_packing(d, Eigen::Vector3d::Zero(), cloud, rng);
+  } catch (const std::invalid_argument& e) {
+    throw InputError(s.file.string(), std::string("[specimen]: ") + e.what());
+  }
+}
+
+}  // namespace
+
+std::vector<std::unique_ptr<LoadingProgramme>> scene_programmes(Scene& s) {
+  std::vector<std::unique_ptr<LoadingProgramme>> out;
+  if (s.test.empty()) {
+    out.push_back(std::make_unique<FixedSteps>(s.steps, s.output.every));
+    return out;
+  }
+  const double test_friction = s.config.material.friction_deg;
+  std::optional<SpecimenGauge> gauge;
+  std::unique_ptr<LoadingProgramme> test;
+  if (s.test == "triaxial" || s.test == "plane_strain") {
+    Eigen::Vector3d lo, hi;
+    if (s.specimen) {
+      const double phi = 1 / (1 + s.specimen->void_ratio);
+      const double scale = std::cbrt(phi / s.specimen->cloud_solid_fraction);
+      lo.setZero();
+      hi = s.specimen->size_m * scale;
+      s.particles = generate(s, hi);
+    } else {
+      Frame f;
+      f.particles = s.particles;
+      std::tie(lo, hi) = particle_bounds(f);
+    }
+    s.walls = cuboid_planes(lo, hi, s.wall_friction_deg);
+    gauge = cuboid_gauge();
+    s.triaxial.core_inset_m = s.plane_strain.core_inset_m = max_diameter(s.particles);
+    if (s.test == "triaxial") {
+      s.triaxial.d50_m = mean_diameter(s.particles);
+      test = std::make_unique<TriaxialTest>(s.triaxial);
+    } else {
+      s.plane_strain.d50_m = mean_diameter(s.particles);
+      test = std::make_unique<PlaneStrainTest>(s.plane_strain);
+    }
+  } else {  // direct shear
+    ShearBoxGeometry& g = s.shear_box;
+    double top;
+    if (s.specimen) {
+      const auto& sp = *s.specimen;
+      g.length_m = sp.size_m.x();
+      g.width_m = sp.size_m.y();
+      g.height_m = sp.size_m.z();
+      top = g.height_m * (1 / (1 + sp.void_ratio)) / sp.cloud_solid_fraction;
+      s.particles = generate(s, {g.length_m, g.width_m, top});
+    } else {
+      Frame f;
+      f.particles = s.particles;
+      const auto [lo, hi] = particle_bounds(f);
+      for (auto& p : s.particles) p.position -= lo;
+      g.length_m = hi.x() - lo.x();
+      g.width_m = hi.y() - lo.y();
+      g.height_m = hi.z() - lo.z();
+      top = g.height_m;
+    }
+    const double dmax = max_diameter(s.particles);
+    if (g.gap_m < 0) g.gap_m = dmax;
+    g.wall_thickness_m = std::max(2 * dmax, 0.05 * g.length_m);
+    g.platen_z_m = top;
+    g.frame_top_m = top + g.wall_thickness_m;
+    ShearBoxWalls idx;
+    try {
+      s.walls = shear_box_walls(g, idx);
+      gauge = shear_box_gauge(g, idx);
+      test = std::make_unique<DirectShearTest>(s.direct_shear, g, idx);
+    } catch (const std::invalid_argument& e) {
+      throw InputError(s.file.string(), std::string("[direct_shear]: ") + e.what());
+    }
+  }
+  const double inset = max_diameter(s.particles);  // the loose layer along a wall
+  if (s.preparation) {
+    if (s.preparation->core_inset_m < 0) s.preparation->core_inset_m = inset;
+    try {
+      out.push_back(std::make_unique<SpecimenPreparation>(*s.preparation, *gauge, test_friction));
+    } catch (const std::invalid_argument& e) {
+      throw InputError(s.file.string(), std::string("[preparation]: ") + e.what());
+    }
+  }
+  out.push_back(std::move(test));
+  return out;
+}
+
+}  // namespace gs::solver

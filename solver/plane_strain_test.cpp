@@ -1,0 +1,159 @@
+#include "plane_strain_test.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <stdexcept>
+
+#include "cuboid_walls.hpp"
+#include "specimen_preparation.hpp"
+#include "triaxial_test.hpp"
+
+namespace gs::solver {
+
+PlaneStrainTest::PlaneStrainTest(PlaneStrainSpec spec) : spec_(spec) {
+  if (!(spec_.confining_Pa > 0)) throw std::invalid_argument("confining pressure must be positive");
+  if (!(spec_.strain_rate_1_s > 0)) throw std::invalid_argument("strain rate must be positive");
+  if (!(spec_.max_strain > 0 && spec_.max_strain < 1))
+    throw std::invalid_argument("max strain must be in (0, 1)");
+  if (spec_.refresh_steps < 1) throw std::invalid_argument("refresh_steps must be >= 1");
+}
+
+MembraneLoads PlaneStrainTest::membrane(const Simulation& sim) const {
+  const Eigen::Vector3d lo = cuboid_lo(sim), hi = cuboid_hi(sim);
+  MembraneSpec m;
+  m.pressure_Pa = spec_.confining_Pa;
+  m.bin_m = spec_.membrane_bin_m > 0 ? spec_.membrane_bin_m : 0.5 * d50_;
+  m.normal_stencil_m = spec_.membrane_stencil_m > 0 ? spec_.membrane_stencil_m : d50_;
+  return membrane_loads(sim.particles(), lo.y(), hi.y(), lo.z(), hi.z(), m);
+}
+
+void PlaneStrainTest::refresh(Simulation& sim) {
+  const MembraneLoads m = membrane(sim);
+  auto& ext = sim.particles().external_force;
+  std::fill(ext.begin(), ext.end(), Eigen::Vector3d::Zero());
+  for (std::size_t k = 0; k < m.particle.size(); ++k) ext[m.particle[k]] = m.force[k];
+}
+
+void PlaneStrainTest::start(Simulation& sim) {
+  if (spec_.d50_m > 0) {
+    d50_ = spec_.d50_m;
+  } else {
+    double d = 0;
+    for (const double r : sim.particles().radius) d += 2 * r;
+    d50_ = d / static_cast<double>(std::max<std::size_t>(1, sim.particles().size()));
+  }
+  for (std::size_t f = 0; f < 6; ++f) sim.walls()[f].vel.setZero();
+  sim.set_wall_active(kXmin, false);
+  sim.set_wall_active(kXmax, false);
+  h0_ = cuboid_hi(sim).z() - cuboid_lo(sim).z();
+  v0_ = membrane(sim).volume_m3;
+  start_step_ = sim.step_count();
+}
+
+void PlaneStrainTest::control(Simulation& sim) {
+  sim.walls()[kZmax].vel = spec_.strain_rate_1_s * h0_ * cuboid_inward(kZmax);
+  if ((sim.step_count() - start_step_) % spec_.refresh_steps == 0) refresh(sim);
+}
+
+double PlaneStrainTest::axial_strain(const Simulation& sim) const {
+  return (h0_ - (cuboid_hi(sim).z() - cuboid_lo(sim).z())) / h0_;
+}
+
+bool PlaneStrainTest::finished(const Simulation& sim) const {
+  return axial_strain(sim) >= spec_.max_strain;
+}
+
+double PlaneStrainTest::progress(const Simulation& sim) const {
+  return std::clamp(axial_strain(sim) / spec_.max_strain, 0.0, 1.0);
+}
+
+std::int64_t PlaneStrainTest::frame_index(const Simulation& sim) const {
+  return static_cast<std::int64_t>(std::floor(axial_strain(sim) / spec_.frame_every_strain));
+}
+
+std::string PlaneStrainTest::curve_header() const {
+  return "step,time_s,eps1_shortening,eps_v_dilation,sigma1_Pa,sigma2_Pa,sigma3_Pa,p_Pa,q_Pa,"
+         "sin_phi,phi_deg,void_ratio,core_void_ratio,width_m,coordination,inertial_number,"
+         "unbalanced_force,"
+         "membrane_particles";
+}
+
+std::string PlaneStrainTest::curve_row(const Simulation& sim) const {
+  const MembraneLoads m = membrane(sim);
+  const Eigen::Vector3d lo = cuboid_lo(sim), hi = cuboid_hi(sim);
+  const double depth = hi.y() - lo.y(), h = hi.z() - lo.z();
+  const double width = m.mean_width_m;
+  auto stress = [&](std::size_t f, double area) {
+    return wall_stress(sim, f, cuboid_inward(f), area);
+  };
+  const double s1 = 0.5 * (stress(kZmin, width * depth) + stress(kZmax, width * depth));
+  const double s2 = 0.5 * (stress(kYmin, width * h) + stress(kYmax, width * h));
+  const double s3 = spec_.confining_Pa;
+  const double p = (s1 + s2 + s3) / 3;
+  // q = sqrt(((σ1−σ2)² + (σ2−σ3)² + (σ3−σ1)²)/2) (von Mises, seed 003 eq 17).
+  const double q =
+      std::sqrt(0.5 * ((s1 - s2) * (s1 - s2) + (s2 - s3) * (s2 - s3) + (s3 - s1) * (s3 - s1)));
+  const double phi = mobilised_friction_deg(s1, s3);
+  if (phi > max_phi_deg_) max_phi_deg_ = phi;
+  const double inertial =
+      p > 0 ? spec_.strain_rate_1_s * d50_ / std::sqrt(p / sim.config().material.density)
+            : std::numeric_limits<double>::quiet_NaN();
+  if (inertial > spec_.inertial_warning && !warned_) {
+    warned_ = true;
+    std::cerr << "warning: plane_strain: inertial number " << inertial << " exceeds "
+              << spec_.inertial_warning << " (not quasi-static; lower the strain rate)\n";
+  }
+  // Core: between the mean membrane positions and the caps / plane-strain walls, inset.
+  double xm = 0, xp = 0;
+  std::size_t hits = 0;
+  for (std::size_t b = 0; b < m.x_minus.size(); ++b) {
+    if (!std::isfinite(m.x_minus[b])) continue;
+    xm += m.x_minus[b];
+    xp += m.x_plus[b];
+    ++hits;
+  }
+  const double in = spec_.core_inset_m;
+  const Eigen::Vector3d clo(xm / std::max<std::size_t>(1, hits) + in, lo.y() + in, lo.z() + in);
+  const Eigen::Vector3d chi(xp / std::max<std::size_t>(1, hits) - in, hi.y() - in, hi.z() - in);
+  const double e_core = box_void_ratio(sim.particles(), clo, chi);
+  char buf[512];
+  std::snprintf(buf, sizeof buf,
+                "%lld,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.6g,%.6g,"
+                "%.6g,%zu",
+                static_cast<long long>(sim.step_count()), sim.time(), axial_strain(sim),
+                (m.volume_m3 - v0_) / v0_, s1, s2, s3, p, q, (s1 - s3) / (s1 + s3), phi,
+                m.volume_m3 / solid_volume(sim) - 1, e_core, width, coordination_number(sim),
+                inertial, sim.unbalanced_force(), m.particle.size());
+  return buf;
+}
+
+std::string PlaneStrainTest::summary(const Simulation& sim) const {
+  char buf[256];
+  std::snprintf(buf, sizeof buf, "plane strain: eps1 %.4f, peak mobilised friction angle %.2f deg",
+                axial_strain(sim), max_phi_deg_);
+  return buf;
+}
+
+std::string PlaneStrainTest::save_state() const {
+  ProgrammeState st;
+  st.set("h0", h0_);
+  st.set("v0", v0_);
+  st.set("d50", d50_);
+  st.set("start_step", start_step_);
+  st.set("max_phi", max_phi_deg_);
+  st.set("warned", static_cast<std::int64_t>(warned_));
+  return st.text();
+}
+
+void PlaneStrainTest::load_state(const std::string& state) {
+  const ProgrammeState st(state);
+  h0_ = st.number("h0");
+  v0_ = st.number("v0");
+  d50_ = st.number("d50");
+  start_step_ = st.integer("start_step");
+  max_phi_deg_ = st.number("max_phi");
+  warned_ = st.integer("warned") != 0;
+}
+
+}  // namespace gs::solver

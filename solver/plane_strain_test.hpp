@@ -1,0 +1,56 @@
+// Plane-strain compression (seed 000 §3; Kozicki & Tejchman): specimen b × h × l with x the
+// width b (flexible lateral membranes at σc, flexible_membrane.hpp), z the height h (bottom cap
+// fixed, top cap moving down at a constant strain rate) and y the depth l (front and back planes
+// fixed: plane strain). Caps and membranes are frictionless in the seed; the walls take the
+// friction the scene gives them. The membrane's rays are refreshed every `refresh_steps` steps,
+// so the loaded boundary follows the specimen as a shear zone forms.
+#pragma once
+
+#include "flexible_membrane.hpp"
+#include "loading_programme.hpp"
+
+namespace gs::solver {
+
+struct PlaneStrainSpec {
+  double confining_Pa = 2e5;
+  double strain_rate_1_s = 0.1;
+  double max_strain = 0.1;
+  double frame_every_strain = 0.01;
+  double membrane_bin_m = 0;      // ray spacing (0: d50 / 2)
+  double membrane_stencil_m = 0;  // slope stencil half-width (0: d50)
+  std::int64_t refresh_steps = 20;
+  double inertial_warning = 1e-4;
+  double d50_m = 0;         // 0: mean diameter
+  double core_inset_m = 0;  // core void ratio: box inset by this from the boundaries
+};
+
+class PlaneStrainTest final : public LoadingProgramme {
+ public:
+  explicit PlaneStrainTest(PlaneStrainSpec spec);
+  std::string name() const override { return "plane_strain"; }
+  void start(Simulation& sim) override;
+  void control(Simulation& sim) override;
+  bool finished(const Simulation& sim) const override;
+  double progress(const Simulation& sim) const override;
+  std::string curve_header() const override;
+  std::string curve_row(const Simulation& sim) const override;
+  std::int64_t frame_index(const Simulation& sim) const override;
+  std::string summary(const Simulation& sim) const override;
+  std::string save_state() const override;
+  void load_state(const std::string& state) override;
+
+  double axial_strain(const Simulation& sim) const;
+  /// The membrane loads the current state would get (not applied).
+  MembraneLoads membrane(const Simulation& sim) const;
+
+ private:
+  void refresh(Simulation& sim);
+
+  PlaneStrainSpec spec_;
+  double h0_ = 0, v0_ = 0, d50_ = 0;
+  std::int64_t start_step_ = 0;
+  mutable double max_phi_deg_ = 0;
+  mutable bool warned_ = false;
+};
+
+}  // namespace gs::solver
