@@ -1,55 +1,17 @@
 // Delaunay simplex strain (seed 002 eq 4, Bagi 1996; 3D analogue as SPAM FfieldBagi).
 #include "tet_strain.hpp"
 
-#include <CGAL/Delaunay_triangulation_2.h>
-#include <CGAL/Delaunay_triangulation_3.h>
-#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
-#include <CGAL/Regular_triangulation_3.h>
-#include <CGAL/Triangulation_vertex_base_with_info_2.h>
-#include <CGAL/Triangulation_vertex_base_with_info_3.h>
-
 #include <Eigen/LU>
-#include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <map>
 #include <stdexcept>
 #include <string>
-#include <utility>
 
 namespace gs::analysis {
 namespace {
 
-using K = CGAL::Exact_predicates_inexact_constructions_kernel;
-using Vb3 = CGAL::Triangulation_vertex_base_with_info_3<std::int32_t, K>;
-using Tds3 = CGAL::Triangulation_data_structure_3<Vb3>;
-using Delaunay3 = CGAL::Delaunay_triangulation_3<K, Tds3>;
-using RVb =
-    CGAL::Triangulation_vertex_base_with_info_3<std::int32_t, K,
-                                                CGAL::Regular_triangulation_vertex_base_3<K>>;
-using RCb = CGAL::Regular_triangulation_cell_base_3<K>;
-using RTds = CGAL::Triangulation_data_structure_3<RVb, RCb>;
-using Regular3 = CGAL::Regular_triangulation_3<K, RTds>;
-using Vb2 = CGAL::Triangulation_vertex_base_with_info_2<std::int32_t, K>;
-using Tds2 = CGAL::Triangulation_data_structure_2<Vb2>;
-using Delaunay2 = CGAL::Delaunay_triangulation_2<K, Tds2>;
-
 double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
-
-template <class Vec>
-[[noreturn]] void throw_duplicate(const std::vector<Vec>& points) {
-  std::map<std::vector<double>, std::size_t> seen;
-  for (std::size_t i = 0; i < points.size(); ++i) {
-    std::vector<double> key(points[i].data(), points[i].data() + points[i].size());
-    auto [it, fresh] = seen.emplace(key, i);
-    if (!fresh) {
-      throw std::invalid_argument("duplicate particle centres (points " +
-                                  std::to_string(it->second) + " and " + std::to_string(i) + ")");
-    }
-  }
-  throw std::invalid_argument("duplicate particle centres");
 }
 
 template <class Vec>
@@ -60,14 +22,6 @@ void check_finite(const std::vector<Vec>& v, const char* what) {
                                   std::to_string(i) + ")");
     }
   }
-}
-
-double tet_quality(const std::array<Eigen::Vector3d, 4>& x, double volume) {
-  double l2 = 0.0;
-  for (int a = 0; a < 4; ++a)
-    for (int b = a + 1; b < 4; ++b) l2 += (x[b] - x[a]).squaredNorm();
-  const double lrms = std::sqrt(l2 / 6.0);
-  return lrms > 0.0 ? 6.0 * std::sqrt(2.0) * volume / (lrms * lrms * lrms) : 0.0;
 }
 
 // Per-particle and assembly averages over the good simplices; serial accumulation in simplex
@@ -99,105 +53,6 @@ void average(SimplexStrain& r, std::size_t n_points, int nv) {
 }
 
 }  // namespace
-
-std::vector<std::array<std::int32_t, 4>> delaunay_tetrahedra(
-    const std::vector<Eigen::Vector3d>& points) {
-  if (points.size() < 4) {
-    throw std::invalid_argument("Delaunay tetrahedra need at least 4 points (" +
-                                std::to_string(points.size()) + ")");
-  }
-  check_finite(points, "particle centre");
-  std::vector<std::pair<K::Point_3, std::int32_t>> pts;
-  pts.reserve(points.size());
-  for (std::size_t i = 0; i < points.size(); ++i) {
-    pts.emplace_back(K::Point_3(points[i].x(), points[i].y(), points[i].z()),
-                     static_cast<std::int32_t>(i));
-  }
-  const Delaunay3 dt(pts.begin(), pts.end());
-  if (dt.number_of_vertices() != points.size()) throw_duplicate(points);
-  if (dt.dimension() < 3) {
-    throw std::invalid_argument("all particle centres are coplanar (dimension " +
-                                std::to_string(dt.dimension()) + ")");
-  }
-  std::vector<std::array<std::int32_t, 4>> tets;
-  tets.reserve(dt.number_of_finite_cells());
-  for (auto c = dt.finite_cells_begin(); c != dt.finite_cells_end(); ++c) {
-    tets.push_back(
-        {c->vertex(0)->info(), c->vertex(1)->info(), c->vertex(2)->info(), c->vertex(3)->info()});
-  }
-  return tets;
-}
-
-std::vector<std::array<std::int32_t, 4>> regular_tetrahedra(
-    const std::vector<Eigen::Vector3d>& points, const std::vector<double>& radii) {
-  if (radii.size() != points.size()) {
-    throw std::invalid_argument("one radius per point needed (" + std::to_string(radii.size()) +
-                                " for " + std::to_string(points.size()) + ")");
-  }
-  for (std::size_t i = 0; i < radii.size(); ++i) {
-    if (!(radii[i] > 0.0) || !std::isfinite(radii[i])) {
-      throw std::invalid_argument("radius not positive (point " + std::to_string(i) + ")");
-    }
-  }
-  // Delaunay first: the same checks (count, finite, coplanar, duplicates) with the same messages.
-  if (points.size() < 4) {
-    throw std::invalid_argument("Delaunay tetrahedra need at least 4 points (" +
-                                std::to_string(points.size()) + ")");
-  }
-  check_finite(points, "particle centre");
-  {
-    std::vector<std::vector<double>> keys;
-    keys.reserve(points.size());
-    for (const auto& p : points) keys.push_back({p.x(), p.y(), p.z()});
-    std::sort(keys.begin(), keys.end());
-    if (std::adjacent_find(keys.begin(), keys.end()) != keys.end()) throw_duplicate(points);
-  }
-  std::vector<std::pair<K::Weighted_point_3, std::int32_t>> pts;
-  pts.reserve(points.size());
-  for (std::size_t i = 0; i < points.size(); ++i) {
-    pts.emplace_back(K::Weighted_point_3(K::Point_3(points[i].x(), points[i].y(), points[i].z()),
-                                         radii[i] * radii[i]),
-                     static_cast<std::int32_t>(i));
-  }
-  const Regular3 rt(pts.begin(), pts.end());
-  if (rt.dimension() < 3) {
-    throw std::invalid_argument("all particle centres are coplanar (dimension " +
-                                std::to_string(rt.dimension()) + ")");
-  }
-  std::vector<std::array<std::int32_t, 4>> tets;
-  tets.reserve(rt.number_of_finite_cells());
-  for (auto c = rt.finite_cells_begin(); c != rt.finite_cells_end(); ++c) {
-    tets.push_back(
-        {c->vertex(0)->info(), c->vertex(1)->info(), c->vertex(2)->info(), c->vertex(3)->info()});
-  }
-  return tets;
-}
-
-std::vector<std::array<std::int32_t, 3>> delaunay_triangles(
-    const std::vector<Eigen::Vector2d>& points) {
-  if (points.size() < 3) {
-    throw std::invalid_argument("Delaunay triangles need at least 3 points (" +
-                                std::to_string(points.size()) + ")");
-  }
-  check_finite(points, "particle centre");
-  std::vector<std::pair<K::Point_2, std::int32_t>> pts;
-  pts.reserve(points.size());
-  for (std::size_t i = 0; i < points.size(); ++i) {
-    pts.emplace_back(K::Point_2(points[i].x(), points[i].y()), static_cast<std::int32_t>(i));
-  }
-  const Delaunay2 dt(pts.begin(), pts.end());
-  if (dt.number_of_vertices() != points.size()) throw_duplicate(points);
-  if (dt.dimension() < 2) {
-    throw std::invalid_argument("all particle centres are collinear (dimension " +
-                                std::to_string(dt.dimension()) + ")");
-  }
-  std::vector<std::array<std::int32_t, 3>> tris;
-  tris.reserve(dt.number_of_faces());
-  for (auto f = dt.finite_faces_begin(); f != dt.finite_faces_end(); ++f) {
-    tris.push_back({f->vertex(0)->info(), f->vertex(1)->info(), f->vertex(2)->info()});
-  }
-  return tris;
-}
 
 Eigen::Matrix3d tet_gradient(const std::array<Eigen::Vector3d, 4>& x,
                              const std::array<Eigen::Vector3d, 4>& u) {
@@ -253,7 +108,7 @@ SimplexStrain tet_strain(const std::vector<Eigen::Vector3d>& reference,
     const double vol = dx.determinant() / 6.0;  // > 0: CGAL cells are positively oriented
     const auto ts = static_cast<std::size_t>(t);
     r.measure[ts] = std::abs(vol);
-    r.quality[ts] = tet_quality(x, std::abs(vol));
+    r.quality[ts] = tetrahedron_quality(x, std::abs(vol));
     // A cell flat in floating point (quality ~ 0) keeps a zero gradient and is a sliver.
     if (r.quality[ts] > 1e-12) {
       r.gradient[ts] = dx.transpose().partialPivLu().solve(du.transpose()).transpose();
@@ -301,11 +156,8 @@ SimplexStrain triangle_strain(const std::vector<Eigen::Vector2d>& reference,
     }
     const Eigen::Vector2d e1 = x[1] - x[0], e2 = x[2] - x[0];
     const double area = 0.5 * (e1.x() * e2.y() - e1.y() * e2.x());  // > 0: CGAL faces are CCW
-    double l2 = 0.0;
-    for (int a = 0; a < 3; ++a) l2 += (x[(a + 1) % 3] - x[a]).squaredNorm();
-    const double lrms2 = l2 / 3.0;
     r.measure[ts] = std::abs(area);
-    r.quality[ts] = lrms2 > 0.0 ? 4.0 * std::sqrt(3.0) * std::abs(area) / (3.0 * lrms2) : 0.0;
+    r.quality[ts] = triangle_quality(x, std::abs(area));
     if (r.quality[ts] > 1e-12) {
       // Seed 002 eq 4: L_pq = 1/(6A) sum_{j1<j2} (v^{j1} - v^{j2})_p (b^{j1} - b^{j2})_q with
       // b^j the outward normal of the edge opposite vertex j, scaled by its length.

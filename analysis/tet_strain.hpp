@@ -16,6 +16,8 @@
 #include <cstdint>
 #include <vector>
 
+#include "delaunay_mesh.hpp"  // delaunay_tetrahedra, regular_tetrahedra, delaunay_triangles
+
 namespace gs::analysis {
 
 struct SimplexStrainOptions {
@@ -42,22 +44,6 @@ struct SimplexStrain {
   // Time split of the last computation in seconds (bench/).
   double seconds_delaunay = 0.0, seconds_gradients = 0.0, seconds_averaging = 0.0;
 };
-
-/// Delaunay tetrahedra of the points (CGAL, exact predicates), positively oriented.
-/// Throws std::invalid_argument for fewer than 4 points, all points coplanar, or duplicate
-/// centres (the message names the first duplicate pair: a displacement there is ambiguous).
-std::vector<std::array<std::int32_t, 4>> delaunay_tetrahedra(
-    const std::vector<Eigen::Vector3d>& points);
-
-/// Regular (weighted Delaunay) tetrahedra with weights radii^2; same errors, plus radii of the
-/// wrong size or not positive and finite. Hidden points take part in no tetrahedron.
-std::vector<std::array<std::int32_t, 4>> regular_tetrahedra(
-    const std::vector<Eigen::Vector3d>& points, const std::vector<double>& radii);
-
-/// Delaunay triangles of the (x, y) coordinates, counterclockwise. Same errors in 2D (fewer than
-/// 3 points, all collinear, duplicate centres).
-std::vector<std::array<std::int32_t, 3>> delaunay_triangles(
-    const std::vector<Eigen::Vector2d>& points);
 
 /// Displacement gradient of one tetrahedron: H with u(X) = u0 + H (X - X0) through the four
 /// vertices. Throws std::invalid_argument when the tetrahedron is flat.

@@ -22,6 +22,7 @@
 #include "hdf5_trajectory.hpp"
 #include "kuhn_void_cells.hpp"
 #include "particle_graph.hpp"
+#include "slab_options.hpp"
 #include "slab_projection.hpp"
 #include "snapshot.hpp"
 #include "tet_strain.hpp"
@@ -105,8 +106,7 @@ struct StrainArgs {
   long from = 0;
   std::optional<long> to;
   double min_quality = 0.02;
-  std::vector<double> slab_origin, slab_normal, slab_axis;
-  double slab_thickness = 0.0, slab_d50 = 0.0;
+  SlabArgs slab;
   bool weighted = false;
 };
 
@@ -115,7 +115,7 @@ void run_strain(const StrainArgs& a) {
     throw InputError(a.input, "--min-quality must be in [0, 1)", value_str(a.min_quality));
   }
   const FrameMotion m = read_frame_motion(a.input, a.from, a.to);
-  const bool slab = !a.slab_normal.empty() || a.slab_thickness > 0.0 || a.slab_d50 > 0.0;
+  const bool slab = a.slab.any();
   SimplexStrain r;
   std::vector<std::int32_t> index = m.index;
   std::vector<Eigen::Vector3d> x3;
@@ -126,13 +126,7 @@ void run_strain(const StrainArgs& a) {
       std::vector<Eigen::Vector2d> x2, u2;
       if (slab) {
         if (m.frame.two_d) throw InputError(a.input, "--slab needs a 3D frame");
-        analysis::Slab s;
-        if (a.slab_origin.size() == 3) s.origin = Eigen::Vector3d(a.slab_origin.data());
-        if (a.slab_normal.size() == 3) s.normal = Eigen::Vector3d(a.slab_normal.data());
-        if (a.slab_axis.size() == 3) s.axis1 = Eigen::Vector3d(a.slab_axis.data());
-        s.thickness = a.slab_thickness;
-        if (a.slab_d50 > 0.0) s.thickness = a.slab_d50 * analysis::d50(m.frame);
-        const auto p = analysis::project_slab(m.x, m.u, s);
+        const auto p = analysis::project_slab(m.x, m.u, make_slab(a.slab, m.frame));
         std::vector<std::int32_t> sub;
         for (const auto k : p.index) sub.push_back(index[static_cast<std::size_t>(k)]);
         index = sub;
@@ -371,11 +365,7 @@ void register_analyze_strain(CLI::App& app) {
                   "simplices of lower quality are slivers, excluded from averages (0.02)");
     s->add_flag("--weighted", a->weighted,
                 "3D: regular (weighted Delaunay) triangulation with weights radius^2");
-    s->add_option("--slab-origin", a->slab_origin, "slab mid-plane point x y z")->expected(3);
-    s->add_option("--slab-normal", a->slab_normal, "slab normal x y z")->expected(3);
-    s->add_option("--slab-axis", a->slab_axis, "in-plane x axis x y z")->expected(3);
-    s->add_option("--slab-thickness", a->slab_thickness, "slab thickness in m");
-    s->add_option("--slab-d50", a->slab_d50, "slab thickness in units of d50 (seed 000: 5)");
+    add_slab_options(s, a->slab);
     s->callback([a] { run_strain(*a); });
   }
   {

@@ -29,4 +29,7 @@ void register_analyze_rev(CLI::App& app);
 /// `granoscope analyze fabric | rose | chains | walls` (apps/cmd_contacts.cpp).
 void register_analyze_contacts(CLI::App& app);
 
+/// `granoscope analyze hhd` and `granoscope analyze vortices` (apps/cmd_hhd.cpp).
+void register_analyze_hhd(CLI::App& app);
+
 }  // namespace gs::cli

@@ -31,6 +31,7 @@ int main(int argc, char** argv) {
   gs::cli::register_analyze_strain(app);
   gs::cli::register_analyze_rev(app);
   gs::cli::register_analyze_contacts(app);
+  gs::cli::register_analyze_hhd(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

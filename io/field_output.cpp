@@ -285,6 +285,10 @@ void write_vtp_polylines(const std::filesystem::path& path,
   vtkNew<vtkCellArray> cells;
   std::vector<vtkIdType> ids;
   for (const auto& l : lines) {
+    if (l.size() < 2) {  // VTK rejects (and may crash on) one-point lines
+      throw InputError(path.string(), "VTP line with fewer than 2 points",
+                       std::to_string(l.size()));
+    }
     ids.assign(l.begin(), l.end());
     for (const auto id : ids) {
       if (id < 0 || id >= static_cast<vtkIdType>(points.size()))

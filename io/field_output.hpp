@@ -74,7 +74,7 @@ void write_vtu_mesh(const std::filesystem::path& path, const std::vector<Eigen::
                     const std::vector<VtkArray>& point_data,
                     const std::vector<VtkArray>& cell_data);
 
-/// Polylines (one cell per line) as .vtp.
+/// Polylines (one cell per line, each of at least 2 points) as .vtp.
 void write_vtp_polylines(const std::filesystem::path& path,
                          const std::vector<Eigen::Vector3d>& points,
                          const std::vector<std::vector<std::int64_t>>& lines,

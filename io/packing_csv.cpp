@@ -19,14 +19,9 @@ Frame read_packing_csv(const std::filesystem::path& path) {
   if (li == lines.size()) throw InputError(name, "empty file");
   const auto header = text::split_csv(lines[li]);
   const std::array<const char*, 5> need{"id", "x", "y", "z", "r"};
-  std::array<std::size_t, 5> col{};
-  for (std::size_t k = 0; k < need.size(); ++k) {
-    std::size_t found = header.size();
-    for (std::size_t c = 0; c < header.size(); ++c)
-      if (header[c] == need[k]) found = c;
-    if (found == header.size()) throw InputError(name, "missing column in header", need[k]);
-    col[k] = found;
-  }
+  const auto col = text::column_indices(header, {need.begin(), need.end()});
+  for (std::size_t k = 0; k < need.size(); ++k)
+    if (col[k] == header.size()) throw InputError(name, "missing column in header", need[k]);
   Frame f;
   for (++li; li < lines.size(); ++li) {
     const auto l = text::trim(lines[li]);

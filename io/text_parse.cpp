@@ -77,6 +77,15 @@ std::vector<std::string_view> split_csv(std::string_view line) {
   return out;
 }
 
+std::vector<std::size_t> column_indices(const std::vector<std::string_view>& header,
+                                        const std::vector<std::string_view>& names) {
+  std::vector<std::size_t> col(names.size(), header.size());
+  for (std::size_t k = 0; k < names.size(); ++k)
+    for (std::size_t c = 0; c < header.size(); ++c)
+      if (header[c] == names[k]) col[k] = c;
+  return col;
+}
+
 double to_double(std::string_view tok, const std::string& file, std::size_t line,
                  const std::string& field) {
   double v = 0;

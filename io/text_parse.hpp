@@ -25,6 +25,11 @@ std::vector<std::string_view> split_csv(std::string_view line);
 
 std::string_view trim(std::string_view s);
 
+/// Index of each of `names` among the header fields (exact match; the last one if repeated),
+/// header.size() where a name is absent.
+std::vector<std::size_t> column_indices(const std::vector<std::string_view>& header,
+                                        const std::vector<std::string_view>& names);
+
 /// Parses a whole token as a double (finite or not: callers check). Throws InputError
 /// "FILE: line N: bad number in FIELD (token)".
 double to_double(std::string_view tok, const std::string& file, std::size_t line,

@@ -15,14 +15,9 @@ import figutil
 from figutil import plt
 
 
-def _attr(f, name, default=None):
-    v = f.attrs.get(name, default)
-    return v.decode() if isinstance(v, bytes) else v
-
-
 def make(input_path, out_dir, args):
     with h5py.File(input_path, "r") as f:
-        fmt = _attr(f, "format", "")
+        fmt = figutil.attr(f, "format", "")
         if fmt == "granoscope-voidcells":
             return _voidcells(f, out_dir)
         if fmt == "granoscope-strain":

@@ -1,4 +1,4 @@
-"""Shared helpers for figure modules: headless matplotlib and atomic PNG writing."""
+"""Shared helpers for figure modules: headless matplotlib, HDF5 attributes, atomic PNG writing."""
 import os
 
 import matplotlib
@@ -18,6 +18,6 @@ def save(fig, out_dir, name, dpi=150):
 
 
 def attr(obj, name, default=None):
-    """An HDF5 attribute, bytes decoded to str."""
+    """An HDF5 attribute of a file, group or dataset, bytes decoded to str."""
     v = obj.attrs.get(name, default)
     return v.decode() if isinstance(v, bytes) else v

@@ -12,6 +12,8 @@
 #include <string>
 #include <vector>
 
+#include "../apps/cli_util.hpp"
+
 namespace gs::test {
 
 /// A fresh directory named after the running test (removed by the caller).
@@ -26,23 +28,28 @@ inline std::filesystem::path temp_dir(const std::string& prefix) {
 
 /// Runs `granoscope ARGS`, stdout and stderr into `log`; returns the exit code.
 inline int run(const std::string& args, const std::filesystem::path& log) {
-  const std::string cmd =
-      std::string(GS_BINARY_DIR) + "/bin/granoscope " + args + " > " + log.string() + " 2>&1";
+  const std::string cmd = kGranoscope + " " + args + " > " + log.string() + " 2>&1";
   const int rc = std::system(cmd.c_str());
   return WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
 }
 
-inline std::vector<double> read_doubles(const std::filesystem::path& file, const char* name) {
+/// Whole dataset `name` of an HDF5 file, converted to `type` (e.g. H5T_NATIVE_DOUBLE).
+template <class T>
+std::vector<T> read_array(const std::filesystem::path& file, const char* name, hid_t type) {
   const hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
   EXPECT_GE(f, 0);
   const hid_t d = H5Dopen2(f, name, H5P_DEFAULT);
   const hid_t s = H5Dget_space(d);
-  std::vector<double> v(static_cast<std::size_t>(H5Sget_simple_extent_npoints(s)));
-  H5Dread(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data());
+  std::vector<T> v(static_cast<std::size_t>(H5Sget_simple_extent_npoints(s)));
+  H5Dread(d, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data());
   H5Sclose(s);
   H5Dclose(d);
   H5Fclose(f);
   return v;
+}
+
+inline std::vector<double> read_doubles(const std::filesystem::path& file, const char* name) {
+  return read_array<double>(file, name, H5T_NATIVE_DOUBLE);
 }
 
 /// A numeric attribute of an object ("/" for the root).

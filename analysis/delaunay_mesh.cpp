@@ -1,0 +1,222 @@
+// Delaunay meshes of particle centres with CGAL (exact predicates, inexact constructions).
+#include "delaunay_mesh.hpp"
+
+#include <CGAL/Delaunay_triangulation_2.h>
+#include <CGAL/Delaunay_triangulation_3.h>
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Regular_triangulation_3.h>
+#include <CGAL/Triangulation_vertex_base_with_info_2.h>
+#include <CGAL/Triangulation_vertex_base_with_info_3.h>
+
+#include <algorithm>
+#include <cmath>
+#include <iterator>
+#include <map>
+#include <stdexcept>
+#include <string>
+#include <utility>
+
+namespace gs::analysis {
+namespace {
+
+using K = CGAL::Exact_predicates_inexact_constructions_kernel;
+using Vb3 = CGAL::Triangulation_vertex_base_with_info_3<std::int32_t, K>;
+using Tds3 = CGAL::Triangulation_data_structure_3<Vb3>;
+using Delaunay3 = CGAL::Delaunay_triangulation_3<K, Tds3>;
+using RVb =
+    CGAL::Triangulation_vertex_base_with_info_3<std::int32_t, K,
+                                                CGAL::Regular_triangulation_vertex_base_3<K>>;
+using RCb = CGAL::Regular_triangulation_cell_base_3<K>;
+using RTds = CGAL::Triangulation_data_structure_3<RVb, RCb>;
+using Regular3 = CGAL::Regular_triangulation_3<K, RTds>;
+using Vb2 = CGAL::Triangulation_vertex_base_with_info_2<std::int32_t, K>;
+using Tds2 = CGAL::Triangulation_data_structure_2<Vb2>;
+using Delaunay2 = CGAL::Delaunay_triangulation_2<K, Tds2>;
+
+template <class Vec>
+[[noreturn]] void throw_duplicate(const std::vector<Vec>& points) {
+  std::map<std::vector<double>, std::size_t> seen;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    std::vector<double> key(points[i].data(), points[i].data() + points[i].size());
+    auto [it, fresh] = seen.emplace(key, i);
+    if (!fresh) {
+      throw std::invalid_argument("duplicate particle centres (points " +
+                                  std::to_string(it->second) + " and " + std::to_string(i) + ")");
+    }
+  }
+  throw std::invalid_argument("duplicate particle centres");
+}
+
+template <class Vec>
+void check_input(const std::vector<Vec>& points, std::size_t min_points, const char* what) {
+  if (points.size() < min_points) {
+    throw std::invalid_argument(std::string("Delaunay ") + what + " need at least " +
+                                std::to_string(min_points) + " points (" +
+                                std::to_string(points.size()) + ")");
+  }
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    if (!points[i].allFinite()) {
+      throw std::invalid_argument("non-finite particle centre (point " + std::to_string(i) + ")");
+    }
+  }
+}
+
+}  // namespace
+
+DelaunayMesh delaunay_mesh(const std::vector<Eigen::Vector3d>& points) {
+  check_input(points, 4, "tetrahedra");
+  std::vector<std::pair<K::Point_3, std::int32_t>> pts;
+  pts.reserve(points.size());
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    pts.emplace_back(K::Point_3(points[i].x(), points[i].y(), points[i].z()),
+                     static_cast<std::int32_t>(i));
+  }
+  const Delaunay3 dt(pts.begin(), pts.end());  // spatially sorted insertion
+  if (dt.number_of_vertices() != points.size()) throw_duplicate(points);
+  if (dt.dimension() < 3) {
+    throw std::invalid_argument("all particle centres are coplanar (dimension " +
+                                std::to_string(dt.dimension()) + ")");
+  }
+  DelaunayMesh m;
+  m.dim = 3;
+  m.simplices.reserve(dt.number_of_finite_cells());
+  for (auto c = dt.finite_cells_begin(); c != dt.finite_cells_end(); ++c) {
+    m.simplices.push_back(
+        {c->vertex(0)->info(), c->vertex(1)->info(), c->vertex(2)->info(), c->vertex(3)->info()});
+  }
+  m.on_hull.assign(points.size(), 0);
+  std::vector<Delaunay3::Vertex_handle> hull;
+  dt.finite_adjacent_vertices(dt.infinite_vertex(), std::back_inserter(hull));
+  for (const auto& v : hull) m.on_hull[static_cast<std::size_t>(v->info())] = 1;
+  return m;
+}
+
+DelaunayMesh delaunay_mesh(const std::vector<Eigen::Vector2d>& points) {
+  check_input(points, 3, "triangles");
+  std::vector<std::pair<K::Point_2, std::int32_t>> pts;
+  pts.reserve(points.size());
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    pts.emplace_back(K::Point_2(points[i].x(), points[i].y()), static_cast<std::int32_t>(i));
+  }
+  const Delaunay2 dt(pts.begin(), pts.end());
+  if (dt.number_of_vertices() != points.size()) throw_duplicate(points);
+  if (dt.dimension() < 2) {
+    throw std::invalid_argument("all particle centres are collinear (dimension " +
+                                std::to_string(dt.dimension()) + ")");
+  }
+  DelaunayMesh m;
+  m.dim = 2;
+  m.simplices.reserve(dt.number_of_faces());
+  for (auto f = dt.finite_faces_begin(); f != dt.finite_faces_end(); ++f) {
+    m.simplices.push_back({f->vertex(0)->info(), f->vertex(1)->info(), f->vertex(2)->info(), -1});
+  }
+  m.on_hull.assign(points.size(), 0);
+  auto c = dt.incident_vertices(dt.infinite_vertex()), done = c;
+  do {
+    if (!dt.is_infinite(c)) m.on_hull[static_cast<std::size_t>(c->info())] = 1;
+  } while (++c != done);
+  return m;
+}
+
+std::vector<std::array<std::int32_t, 4>> delaunay_tetrahedra(
+    const std::vector<Eigen::Vector3d>& points) {
+  return delaunay_mesh(points).simplices;
+}
+
+std::vector<std::array<std::int32_t, 3>> delaunay_triangles(
+    const std::vector<Eigen::Vector2d>& points) {
+  const auto m = delaunay_mesh(points);
+  std::vector<std::array<std::int32_t, 3>> tris;
+  tris.reserve(m.simplices.size());
+  for (const auto& s : m.simplices) tris.push_back({s[0], s[1], s[2]});
+  return tris;
+}
+
+std::vector<std::array<std::int32_t, 4>> regular_tetrahedra(
+    const std::vector<Eigen::Vector3d>& points, const std::vector<double>& radii) {
+  if (radii.size() != points.size()) {
+    throw std::invalid_argument("one radius per point needed (" + std::to_string(radii.size()) +
+                                " for " + std::to_string(points.size()) + ")");
+  }
+  for (std::size_t i = 0; i < radii.size(); ++i) {
+    if (!(radii[i] > 0.0) || !std::isfinite(radii[i])) {
+      throw std::invalid_argument("radius not positive (point " + std::to_string(i) + ")");
+    }
+  }
+  // The Delaunay checks (count, finite, duplicates; coplanar below) with the same messages.
+  check_input(points, 4, "tetrahedra");
+  {
+    std::vector<std::vector<double>> keys;
+    keys.reserve(points.size());
+    for (const auto& p : points) keys.push_back({p.x(), p.y(), p.z()});
+    std::sort(keys.begin(), keys.end());
+    if (std::adjacent_find(keys.begin(), keys.end()) != keys.end()) throw_duplicate(points);
+  }
+  std::vector<std::pair<K::Weighted_point_3, std::int32_t>> pts;
+  pts.reserve(points.size());
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    pts.emplace_back(K::Weighted_point_3(K::Point_3(points[i].x(), points[i].y(), points[i].z()),
+                                         radii[i] * radii[i]),
+                     static_cast<std::int32_t>(i));
+  }
+  const Regular3 rt(pts.begin(), pts.end());
+  if (rt.dimension() < 3) {
+    throw std::invalid_argument("all particle centres are coplanar (dimension " +
+                                std::to_string(rt.dimension()) + ")");
+  }
+  std::vector<std::array<std::int32_t, 4>> tets;
+  tets.reserve(rt.number_of_finite_cells());
+  for (auto c = rt.finite_cells_begin(); c != rt.finite_cells_end(); ++c) {
+    tets.push_back(
+        {c->vertex(0)->info(), c->vertex(1)->info(), c->vertex(2)->info(), c->vertex(3)->info()});
+  }
+  return tets;
+}
+
+double tetrahedron_quality(const std::array<Eigen::Vector3d, 4>& x, double volume) {
+  double l2 = 0.0;
+  for (std::size_t a = 0; a < 4; ++a)
+    for (std::size_t b = a + 1; b < 4; ++b) l2 += (x[b] - x[a]).squaredNorm();
+  const double lrms = std::sqrt(l2 / 6.0);
+  return lrms > 0.0 ? 6.0 * std::sqrt(2.0) * volume / (lrms * lrms * lrms) : 0.0;
+}
+
+double triangle_quality(const std::array<Eigen::Vector2d, 3>& x, double area) {
+  double l2 = 0.0;
+  for (std::size_t a = 0; a < 3; ++a) l2 += (x[(a + 1) % 3] - x[a]).squaredNorm();
+  const double lrms2 = l2 / 3.0;
+  return lrms2 > 0.0 ? 4.0 * std::sqrt(3.0) * area / (3.0 * lrms2) : 0.0;
+}
+
+VertexRings vertex_rings(int dim, const std::vector<std::array<std::int32_t, 4>>& simplices,
+                         std::size_t n_points) {
+  const int nv = dim + 1;
+  // Each simplex lists its nv (nv - 1) directed edges; sort and make unique per vertex.
+  std::vector<std::int64_t> count(n_points + 1, 0);
+  for (const auto& s : simplices)
+    for (int a = 0; a < nv; ++a)
+      count[static_cast<std::size_t>(s[static_cast<std::size_t>(a)]) + 1] += nv - 1;
+  for (std::size_t i = 0; i < n_points; ++i) count[i + 1] += count[i];
+  std::vector<std::int32_t> all(static_cast<std::size_t>(count[n_points]));
+  std::vector<std::int64_t> fill(count.begin(), count.end() - 1);
+  for (const auto& s : simplices)
+    for (int a = 0; a < nv; ++a)
+      for (int b = 0; b < nv; ++b) {
+        if (a == b) continue;
+        const auto i = static_cast<std::size_t>(s[static_cast<std::size_t>(a)]);
+        all[static_cast<std::size_t>(fill[i]++)] = s[static_cast<std::size_t>(b)];
+      }
+  VertexRings r;
+  r.offset.assign(n_points + 1, 0);
+  r.index.reserve(all.size() / 4);
+  for (std::size_t i = 0; i < n_points; ++i) {
+    const auto b = all.begin() + count[i], e = all.begin() + count[i + 1];
+    std::sort(b, e);
+    const auto last = std::unique(b, e);
+    r.index.insert(r.index.end(), b, last);
+    r.offset[i + 1] = static_cast<std::int64_t>(r.index.size());
+  }
+  return r;
+}
+
+}  // namespace gs::analysis

@@ -1,0 +1,486 @@
+// Helmholtz–Hodge decomposition on Delaunay meshes: seed 000 §4.1–4.2, eq 9–18.
+#include "hhd.hpp"
+
+#include <Eigen/CholmodSupport>
+#include <Eigen/Geometry>
+#include <Eigen/IterativeLinearSolvers>
+#include <Eigen/LU>
+#include <Eigen/Sparse>
+#include <Eigen/SparseCholesky>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include "delaunay_mesh.hpp"
+
+namespace gs::analysis {
+namespace {
+
+using SpMat = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+int vertices_of(const HhdMesh& m) {
+  return m.dim + 1;
+}
+
+// z component of the cross product of two in-plane vectors (2D).
+double cross_z(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  return a.x() * b.y() - a.y() * b.x();
+}
+
+void check_mesh(const HhdMesh& m) {
+  if (m.dim != 2 && m.dim != 3) {
+    throw std::invalid_argument("HHD mesh dimension must be 2 or 3 (" + std::to_string(m.dim) +
+                                ")");
+  }
+  if (m.dirichlet.size() != m.points.size()) {
+    throw std::invalid_argument("one Dirichlet flag per node needed (" +
+                                std::to_string(m.dirichlet.size()) + " for " +
+                                std::to_string(m.points.size()) + ")");
+  }
+  const auto n = static_cast<std::int32_t>(m.points.size());
+  for (const auto& s : m.simplices)
+    for (int a = 0; a < vertices_of(m); ++a) {
+      const auto i = s[static_cast<std::size_t>(a)];
+      if (i < 0 || i >= n) {
+        throw std::invalid_argument("simplex vertex out of range (" + std::to_string(i) + ")");
+      }
+    }
+}
+
+// Node -> unknown index (-1: Dirichlet or in no simplex of positive measure).
+std::vector<int> unknown_index(const HhdMesh& m, const P1Geometry& g, int& count) {
+  std::vector<std::uint8_t> used(m.points.size(), 0);
+  for (std::size_t k = 0; k < m.simplices.size(); ++k) {
+    if (!(g.measure[k] > 0.0)) continue;
+    for (int a = 0; a < vertices_of(m); ++a)
+      used[static_cast<std::size_t>(m.simplices[k][static_cast<std::size_t>(a)])] = 1;
+  }
+  std::vector<int> idx(m.points.size(), -1);
+  count = 0;
+  for (std::size_t i = 0; i < m.points.size(); ++i)
+    if (used[i] && !m.dirichlet[i]) idx[i] = count++;
+  return idx;
+}
+
+// Right-hand sides over the unknowns. bu: Σ_k |T_k| ∇φ_i·ξ_k (eq 17). b18: Σ_k |T_k| ∇φ_i × ξ_k
+// (eq 18 as written; 1 column in 2D, its z component, 3 columns in 3D).
+void right_hand_sides(const HhdMesh& m, const P1Geometry& g, const std::vector<int>& idx, int n,
+                      const std::vector<Eigen::Vector3d>& field, Eigen::VectorXd& bu,
+                      Eigen::MatrixXd& b18) {
+  const int nv = m.dim == 3 ? 3 : 1;
+  bu = Eigen::VectorXd::Zero(n);
+  b18 = Eigen::MatrixXd::Zero(n, nv);
+  for (std::size_t k = 0; k < m.simplices.size(); ++k) {
+    const double w = g.measure[k];
+    if (!(w > 0.0)) continue;
+    for (int a = 0; a < vertices_of(m); ++a) {
+      const int i = idx[static_cast<std::size_t>(m.simplices[k][static_cast<std::size_t>(a)])];
+      if (i < 0) continue;
+      const Eigen::Vector3d& gi = g.gradient[k][static_cast<std::size_t>(a)];
+      bu(i) += w * gi.dot(field[k]);
+      if (nv == 3) {
+        b18.row(i) += w * gi.cross(field[k]).transpose();
+      } else {
+        b18(i, 0) += w * cross_z(gi, field[k]);
+      }
+    }
+  }
+}
+
+// P1 stiffness K_ij = Σ_k |T_k| (∇φ_i)_k·(∇φ_j)_k over the unknowns, full symmetric storage
+// (compressed, inner indices sorted).
+SpMat stiffness(const HhdMesh& m, const P1Geometry& g, const std::vector<int>& idx, int n) {
+  const int nvert = vertices_of(m);
+  std::vector<Eigen::Triplet<double, int>> t;
+  t.reserve(m.simplices.size() * static_cast<std::size_t>(nvert * nvert));
+  for (std::size_t k = 0; k < m.simplices.size(); ++k) {
+    const double w = g.measure[k];
+    if (!(w > 0.0)) continue;
+    for (int a = 0; a < nvert; ++a) {
+      const int i = idx[static_cast<std::size_t>(m.simplices[k][static_cast<std::size_t>(a)])];
+      if (i < 0) continue;
+      for (int b = 0; b < nvert; ++b) {
+        const int j = idx[static_cast<std::size_t>(m.simplices[k][static_cast<std::size_t>(b)])];
+        if (j < 0) continue;
+        t.emplace_back(i, j,
+                       w * g.gradient[k][static_cast<std::size_t>(a)].dot(
+                               g.gradient[k][static_cast<std::size_t>(b)]));
+      }
+    }
+  }
+  SpMat k(n, n);
+  k.setFromTriplets(t.begin(), t.end());
+  return k;
+}
+
+// Eq 18 as written in 3D: block (i, j) = Σ_k |T_k| (∇φ_j ∇φ_iᵀ − (∇φ_i·∇φ_j) I), i.e. the
+// coefficient of v_j[q] in row (i, p) of Σ_k |T_k| ∇φ_i × (∇×v)_k. Assembled directly in
+// compressed storage on the pattern of K expanded to 3×3 blocks (no triplet list: 144 entries
+// per tetrahedron would need ~1 GB at 56 000 nodes).
+SpMat curl_curl_eq18(const HhdMesh& m, const P1Geometry& g, const std::vector<int>& idx,
+                     const SpMat& k) {
+  const int n = static_cast<int>(k.cols());
+  SpMat a(3 * n, 3 * n);
+  const auto nnz = static_cast<Eigen::Index>(9 * k.nonZeros());
+  a.resizeNonZeros(nnz);
+  int* outer = a.outerIndexPtr();
+  int* inner = a.innerIndexPtr();
+  double* val = a.valuePtr();
+  std::fill(val, val + nnz, 0.0);
+  const int* kouter = k.outerIndexPtr();
+  const int* kinner = k.innerIndexPtr();
+  for (int j = 0; j < n; ++j) {
+    const int c = kouter[j + 1] - kouter[j];
+    for (int q = 0; q < 3; ++q) {
+      const int col = 3 * j + q;
+      outer[col] = 9 * kouter[j] + 3 * q * c;
+      for (int e = 0; e < c; ++e)
+        for (int p = 0; p < 3; ++p) inner[outer[col] + 3 * e + p] = 3 * kinner[kouter[j] + e] + p;
+    }
+  }
+  outer[3 * n] = static_cast<int>(nnz);
+  for (std::size_t s = 0; s < m.simplices.size(); ++s) {
+    const double w = g.measure[s];
+    if (!(w > 0.0)) continue;
+    for (std::size_t b = 0; b < 4; ++b) {
+      const int j = idx[static_cast<std::size_t>(m.simplices[s][b])];
+      if (j < 0) continue;
+      const int c = kouter[j + 1] - kouter[j];
+      const Eigen::Vector3d& gj = g.gradient[s][b];
+      for (std::size_t a4 = 0; a4 < 4; ++a4) {
+        const int i = idx[static_cast<std::size_t>(m.simplices[s][a4])];
+        if (i < 0) continue;
+        const int e = static_cast<int>(
+            std::lower_bound(kinner + kouter[j], kinner + kouter[j + 1], i) - (kinner + kouter[j]));
+        const Eigen::Vector3d& gi = g.gradient[s][a4];
+        const double dot = gi.dot(gj);
+        for (int q = 0; q < 3; ++q) {
+          double* column = val + 9 * kouter[j] + 3 * q * c + 3 * e;
+          for (int p = 0; p < 3; ++p) column[p] += w * (gj[p] * gi[q] - (p == q ? dot : 0.0));
+        }
+      }
+    }
+  }
+  return a;
+}
+
+template <class Solver>
+Eigen::VectorXd iterate(Solver& s, const Eigen::VectorXd& b, int& iterations, bool& converged) {
+  if (b.norm() == 0.0) return Eigen::VectorXd::Zero(b.size());
+  const Eigen::VectorXd x = s.solve(b);
+  iterations = std::max(iterations, static_cast<int>(s.iterations()));
+  if (s.info() != Eigen::Success) converged = false;
+  return x;
+}
+
+double dot(const std::vector<double>& w, const std::vector<Eigen::Vector3d>& a,
+           const std::vector<Eigen::Vector3d>& b) {
+  double s = 0.0;
+  for (std::size_t k = 0; k < w.size(); ++k) s += w[k] * a[k].dot(b[k]);
+  return s;
+}
+
+}  // namespace
+
+const char* hhd_solver_name(HhdSolver s) {
+  switch (s) {
+    case HhdSolver::Auto:
+      return "auto";
+    case HhdSolver::Cholmod:
+      return "cholmod";
+    case HhdSolver::Ldlt:
+      return "ldlt";
+    case HhdSolver::Cg:
+      return "cg";
+    case HhdSolver::BiCgStab:
+      return "bicgstab";
+  }
+  return "?";
+}
+
+HhdSolver hhd_solver_from_name(const std::string& name) {
+  for (auto s :
+       {HhdSolver::Auto, HhdSolver::Cholmod, HhdSolver::Ldlt, HhdSolver::Cg, HhdSolver::BiCgStab})
+    if (name == hhd_solver_name(s)) return s;
+  throw std::invalid_argument("unknown HHD solver, expected auto, cholmod, ldlt, cg or bicgstab (" +
+                              name + ")");
+}
+
+P1Geometry p1_geometry(const HhdMesh& m) {
+  check_mesh(m);
+  P1Geometry g;
+  const std::size_t ns = m.simplices.size();
+  g.measure.assign(ns, 0.0);
+  g.gradient.assign(ns, {Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(),
+                         Eigen::Vector3d::Zero()});
+  const auto n = static_cast<std::ptrdiff_t>(ns);
+#pragma omp parallel for schedule(static)
+  for (std::ptrdiff_t kk = 0; kk < n; ++kk) {
+    const auto k = static_cast<std::size_t>(kk);
+    const auto& s = m.simplices[k];
+    auto& gr = g.gradient[k];
+    if (m.dim == 3) {
+      std::array<Eigen::Vector3d, 4> x;
+      for (std::size_t a = 0; a < 4; ++a) x[a] = m.points[static_cast<std::size_t>(s[a])];
+      Eigen::Matrix3d j;
+      for (int a = 0; a < 3; ++a) j.col(a) = x[static_cast<std::size_t>(a) + 1] - x[0];
+      const double volume = std::abs(j.determinant()) / 6.0;
+      if (!(tetrahedron_quality(x, volume) > 1e-12)) continue;
+      // Barycentric λ = J⁻¹ (x − x0): the rows of J⁻¹ are ∇φ_1..3; ∇φ_0 = −Σ. Equal to the
+      // paper's face normal of length area(f) / (3 |T|) (tested).
+      const Eigen::Matrix3d inv = j.inverse();
+      gr[0] = Eigen::Vector3d::Zero();
+      for (int a = 0; a < 3; ++a) {
+        gr[static_cast<std::size_t>(a) + 1] = inv.row(a).transpose();
+        gr[0] -= gr[static_cast<std::size_t>(a) + 1];
+      }
+      g.measure[k] = volume;
+    } else {
+      std::array<Eigen::Vector2d, 3> x;
+      for (std::size_t a = 0; a < 3; ++a) x[a] = m.points[static_cast<std::size_t>(s[a])].head<2>();
+      Eigen::Matrix2d j;
+      j.col(0) = x[1] - x[0];
+      j.col(1) = x[2] - x[0];
+      const double area = std::abs(j.determinant()) / 2.0;
+      if (!(triangle_quality(x, area) > 1e-12)) continue;
+      const Eigen::Matrix2d inv = j.inverse();
+      gr[0] = Eigen::Vector3d::Zero();
+      for (int a = 0; a < 2; ++a) {
+        gr[static_cast<std::size_t>(a) + 1] = Eigen::Vector3d(inv(a, 0), inv(a, 1), 0.0);
+        gr[0] -= gr[static_cast<std::size_t>(a) + 1];
+      }
+      g.measure[k] = area;
+    }
+  }
+  return g;
+}
+
+std::vector<Eigen::Vector3d> simplex_mean(const HhdMesh& m,
+                                          const std::vector<Eigen::Vector3d>& nodal) {
+  check_mesh(m);
+  if (nodal.size() != m.points.size()) {
+    throw std::invalid_argument("one vector per node needed (" + std::to_string(nodal.size()) +
+                                " for " + std::to_string(m.points.size()) + ")");
+  }
+  const int nv = vertices_of(m);
+  std::vector<Eigen::Vector3d> xi(m.simplices.size(), Eigen::Vector3d::Zero());
+  for (std::size_t k = 0; k < m.simplices.size(); ++k) {
+    for (int a = 0; a < nv; ++a)
+      xi[k] += nodal[static_cast<std::size_t>(m.simplices[k][static_cast<std::size_t>(a)])];
+    xi[k] /= nv;
+    if (m.dim == 2) xi[k].z() = 0.0;
+  }
+  return xi;
+}
+
+std::vector<Eigen::Vector3d> p1_gradient(const HhdMesh& m, const P1Geometry& g,
+                                         const Eigen::VectorXd& u) {
+  std::vector<Eigen::Vector3d> out(m.simplices.size(), Eigen::Vector3d::Zero());
+  for (std::size_t k = 0; k < m.simplices.size(); ++k)
+    for (int a = 0; a < vertices_of(m); ++a)
+      out[k] += u(m.simplices[k][static_cast<std::size_t>(a)]) *
+                g.gradient[k][static_cast<std::size_t>(a)];
+  return out;
+}
+
+std::vector<Eigen::Vector3d> p1_curl(const HhdMesh& m, const P1Geometry& g,
+                                     const Eigen::MatrixXd& v) {
+  std::vector<Eigen::Vector3d> out(m.simplices.size(), Eigen::Vector3d::Zero());
+  for (std::size_t k = 0; k < m.simplices.size(); ++k)
+    for (int a = 0; a < vertices_of(m); ++a) {
+      const auto i = m.simplices[k][static_cast<std::size_t>(a)];
+      const Eigen::Vector3d& gr = g.gradient[k][static_cast<std::size_t>(a)];
+      if (m.dim == 3) {
+        out[k] += gr.cross(Eigen::Vector3d(v(i, 0), v(i, 1), v(i, 2)));
+      } else {
+        out[k] += v(i, 0) * Eigen::Vector3d(gr.y(), -gr.x(), 0.0);
+      }
+    }
+  return out;
+}
+
+std::vector<double> p1_divergence(const HhdMesh& m, const P1Geometry& g, const Eigen::MatrixXd& v) {
+  std::vector<double> out(m.simplices.size(), 0.0);
+  if (m.dim != 3) return out;
+  for (std::size_t k = 0; k < m.simplices.size(); ++k)
+    for (std::size_t a = 0; a < 4; ++a) {
+      const auto i = m.simplices[k][a];
+      out[k] += g.gradient[k][a].dot(Eigen::Vector3d(v(i, 0), v(i, 1), v(i, 2)));
+    }
+  return out;
+}
+
+HhdResult helmholtz_hodge(const HhdMesh& m, const std::vector<Eigen::Vector3d>& xi,
+                          const HhdOptions& o) {
+  check_mesh(m);
+  if (xi.size() != m.simplices.size()) {
+    throw std::invalid_argument("one vector per simplex needed (" + std::to_string(xi.size()) +
+                                " for " + std::to_string(m.simplices.size()) + ")");
+  }
+  for (std::size_t k = 0; k < xi.size(); ++k) {
+    if (!xi[k].allFinite()) {
+      throw std::invalid_argument("non-finite vector (simplex " + std::to_string(k) + ")");
+    }
+  }
+  if (!(o.tolerance > 0.0) || o.max_iterations < 1) {
+    throw std::invalid_argument("iterative solver needs tolerance > 0 and max_iterations >= 1");
+  }
+  HhdResult r;
+  r.dim = m.dim;
+  const int nv = m.dim == 3 ? 3 : 1;
+  auto t0 = Clock::now();
+  const P1Geometry g = p1_geometry(m);
+  int n = 0;
+  const std::vector<int> idx = unknown_index(m, g, n);
+  if (n == 0) throw std::invalid_argument("HHD mesh has no interior node to solve for");
+  r.report.unknowns = static_cast<std::size_t>(n);
+  HhdSolver solver = o.solver;
+  if (solver == HhdSolver::Auto) {
+    solver =
+        m.dim == 3 && r.report.unknowns > kHhdAutoDirectMax ? HhdSolver::Cg : HhdSolver::Cholmod;
+  }
+  r.report.solver = hhd_solver_name(solver);
+  r.xi = xi;
+  if (m.dim == 2)
+    for (auto& x : r.xi) x.z() = 0.0;
+  Eigen::VectorXd bu;
+  Eigen::MatrixXd b18;
+  right_hand_sides(m, g, idx, n, r.xi, bu, b18);
+  const SpMat k = stiffness(m, g, idx, n);
+  r.report.seconds_assembly = seconds_since(t0);
+
+  // Solutions over the unknowns: column 0 = u, columns 1.. = v.
+  Eigen::MatrixXd x(n, 1 + nv);
+  Eigen::MatrixXd rhs(n, 1 + nv);
+  rhs.col(0) = bu;
+  rhs.rightCols(nv) = -b18;  // path (b): K v = Σ |T| ξ × ∇φ_i (docs/hhd.md)
+  auto direct = [&](auto& factor) {
+    t0 = Clock::now();
+    factor.compute(k);
+    r.report.seconds_factor = seconds_since(t0);
+    if (factor.info() != Eigen::Success) {
+      throw std::invalid_argument(
+          "HHD stiffness matrix factorization failed (not positive "
+          "definite: degenerate mesh?)");
+    }
+    t0 = Clock::now();
+    x = factor.solve(rhs);
+    r.report.seconds_solve = seconds_since(t0);
+  };
+  switch (solver) {
+    case HhdSolver::Auto:  // resolved above
+    case HhdSolver::Cholmod: {
+      Eigen::CholmodDecomposition<SpMat, Eigen::Lower> s;
+      direct(s);
+      break;
+    }
+    case HhdSolver::Ldlt: {
+      Eigen::SimplicialLDLT<SpMat, Eigen::Lower> s;
+      direct(s);
+      break;
+    }
+    case HhdSolver::Cg: {
+      // One CG per right-hand side, the right-hand sides spread over the threads: no barrier
+      // inside the iterations (a parallel SpMV stalls badly on a loaded 2-core machine), and
+      // each column is computed the same way whatever the thread count.
+      t0 = Clock::now();
+      r.report.seconds_factor = 0.0;
+      const int cols = 1 + nv;
+      std::vector<int> its(static_cast<std::size_t>(cols), 0);
+      std::vector<char> ok(static_cast<std::size_t>(cols), 1);
+#pragma omp parallel for schedule(dynamic, 1)
+      for (int c = 0; c < cols; ++c) {
+        Eigen::ConjugateGradient<SpMat, Eigen::Lower> s;
+        s.setTolerance(o.tolerance);
+        s.setMaxIterations(o.max_iterations);
+        s.compute(k);
+        bool conv = true;
+        x.col(c) = iterate(s, rhs.col(c), its[static_cast<std::size_t>(c)], conv);
+        ok[static_cast<std::size_t>(c)] = conv ? 1 : 0;
+      }
+      r.report.iterations_u = its[0];
+      for (int c = 1; c < cols; ++c) {
+        r.report.iterations_v = std::max(r.report.iterations_v, its[static_cast<std::size_t>(c)]);
+      }
+      r.report.converged = std::all_of(ok.begin(), ok.end(), [](char b) { return b != 0; });
+      r.report.seconds_solve = seconds_since(t0);
+      break;
+    }
+    case HhdSolver::BiCgStab: {
+      // Eq 17 as written (matrix K) and eq 18 as written (2D: −K; 3D: the block matrix).
+      t0 = Clock::now();
+      Eigen::BiCGSTAB<SpMat> su;
+      su.setTolerance(o.tolerance);
+      su.setMaxIterations(o.max_iterations);
+      su.compute(k);
+      SpMat a18 = m.dim == 3 ? curl_curl_eq18(m, g, idx, k) : SpMat(-k);
+      Eigen::BiCGSTAB<SpMat> sv;
+      sv.setTolerance(o.tolerance);
+      sv.setMaxIterations(o.max_iterations);
+      sv.compute(a18);
+      r.report.seconds_factor = seconds_since(t0);
+      t0 = Clock::now();
+      x.col(0) = iterate(su, bu, r.report.iterations_u, r.report.converged);
+      if (m.dim == 3) {
+        Eigen::VectorXd b(3 * n);
+        for (int i = 0; i < n; ++i) b.segment<3>(3 * i) = b18.row(i).transpose();
+        const Eigen::VectorXd v = iterate(sv, b, r.report.iterations_v, r.report.converged);
+        for (int i = 0; i < n; ++i) x.row(i).tail<3>() = v.segment<3>(3 * i).transpose();
+      } else {
+        x.col(1) = iterate(sv, b18.col(0), r.report.iterations_v, r.report.converged);
+      }
+      r.report.seconds_solve = seconds_since(t0);
+      break;
+    }
+  }
+
+  // Nodal potentials (zero at the Dirichlet nodes) and the per-simplex parts.
+  r.u = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(m.points.size()));
+  r.v = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(m.points.size()), nv);
+  for (std::size_t i = 0; i < m.points.size(); ++i) {
+    if (idx[i] < 0) continue;
+    r.u(static_cast<Eigen::Index>(i)) = x(idx[i], 0);
+    r.v.row(static_cast<Eigen::Index>(i)) = x.row(idx[i]).tail(nv);
+  }
+  r.measure = g.measure;
+  r.grad_u = p1_gradient(m, g, r.u);
+  r.curl_v = p1_curl(m, g, r.v);
+  r.harmonic.resize(r.xi.size());
+  for (std::size_t s = 0; s < r.xi.size(); ++s) r.harmonic[s] = r.xi[s] - r.grad_u[s] - r.curl_v[s];
+  r.norm_xi = std::sqrt(dot(r.measure, r.xi, r.xi));
+  r.norm_grad_u = std::sqrt(dot(r.measure, r.grad_u, r.grad_u));
+  r.norm_curl_v = std::sqrt(dot(r.measure, r.curl_v, r.curl_v));
+  r.norm_harmonic = std::sqrt(dot(r.measure, r.harmonic, r.harmonic));
+  r.dot_grad_curl = dot(r.measure, r.grad_u, r.curl_v);
+  r.dot_grad_harmonic = dot(r.measure, r.grad_u, r.harmonic);
+  r.dot_curl_harmonic = dot(r.measure, r.curl_v, r.harmonic);
+  const auto div = p1_divergence(m, g, r.v);
+  double d2 = 0.0;
+  for (std::size_t s = 0; s < div.size(); ++s) d2 += r.measure[s] * div[s] * div[s];
+  r.norm_div_v = std::sqrt(d2);
+
+  // Residuals of eq 17 and eq 18 as written, matrix-free: Σ_k |T_k| ∇φ_i·(∇u − ξ)_k and
+  // Σ_k |T_k| ∇φ_i × (∇×v − ξ)_k.
+  std::vector<Eigen::Vector3d> du(r.xi.size()), dv(r.xi.size());
+  for (std::size_t s = 0; s < r.xi.size(); ++s) {
+    du[s] = r.grad_u[s] - r.xi[s];
+    dv[s] = r.curl_v[s] - r.xi[s];
+  }
+  Eigen::VectorXd res17, unused;
+  Eigen::MatrixXd res18, unused18;
+  right_hand_sides(m, g, idx, n, du, res17, unused18);
+  right_hand_sides(m, g, idx, n, dv, unused, res18);
+  const auto relative = [](double num, double den) { return den > 0.0 ? num / den : num; };
+  r.report.residual_eq17 = relative(res17.norm(), bu.norm());
+  r.report.residual_eq18 = relative(res18.norm(), b18.norm());
+  return r;
+}
+
+}  // namespace gs::analysis

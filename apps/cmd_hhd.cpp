@@ -1,0 +1,611 @@
+// `granoscope analyze hhd` (seed 000: Helmholtz–Hodge decomposition of one displacement
+// increment, vortex centres, sources/sinks and vortex tubes) and `granoscope analyze vortices`
+// (the same on every IT-frame increment of a trajectory: counts of right/left-handed vortices
+// against strain and their Fourier spectrum, seed 000 Figs 16–18). Outputs: HDF5 (root attribute
+// format = granoscope-hhd / granoscope-vortices, for `granoscope figures`), VTU, CSV of extrema,
+// VTP of tubes, each written under a temporary name and renamed.
+
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "atomic_file.hpp"
+#include "commands.hpp"
+#include "errors.hpp"
+#include "field_output.hpp"
+#include "frame_motion.hpp"
+#include "grain_size.hpp"
+#include "point_vectors_csv.hpp"
+#include "slab_options.hpp"
+#include "slab_projection.hpp"
+#include "snapshot.hpp"
+#include "vortex_analysis.hpp"
+#include "vortex_series.hpp"
+
+namespace gs::cli {
+namespace {
+
+namespace fs = std::filesystem;
+using analysis::VortexAnalysis;
+
+// ---- options shared by hhd and vortices -----------------------------------------------------
+
+struct FieldArgs {
+  SlabArgs slab;
+  bool slice = false;
+  bool ghosts = false;
+  double ghost_spacing = 0.0, ghost_min_distance = -1.0, ghost_extent = 0.0, ghost_radius = 0.0;
+  double d50 = 0.0;
+  std::string solver = "auto";
+  double tolerance = 1e-10;
+  int max_iterations = 10000;
+  std::vector<double> axis;
+  double delta = 0.05;
+};
+
+void add_field_options(CLI::App* s, FieldArgs& a) {
+  s->add_flag("--slice", a.slice,
+              "2D slice mode (seed 000 §5): the particles of a slab, 5 d50 thick at mid-depth "
+              "unless --slab-* say otherwise, projected on its plane");
+  add_slab_options(s, a.slab);
+  s->add_flag("--ghosts", a.ghosts,
+              "add ghost nodes outside the specimen (seed 000 §4.2); defaults scale the paper's "
+              "4.5/4/50/80 mm with d50 and the specimen width");
+  s->add_option("--ghost-spacing", a.ghost_spacing, "ghost lattice spacing h_g in m (1.8 d50)");
+  s->add_option("--ghost-min-distance", a.ghost_min_distance,
+                "least distance of a ghost from a centre in m (1.6 d50)");
+  s->add_option("--ghost-extent", a.ghost_extent, "ghosts up to this distance in m (1.25 width)");
+  s->add_option("--ghost-radius", a.ghost_radius, "Gaussian averaging radius R in m (2 width)");
+  s->add_option("--d50", a.d50, "d50 in m for the ghost defaults (default: from the frame)");
+  s->add_option(
+      "--solver", a.solver,
+      "auto (default: cholmod, or cg for 3D meshes over 20000 nodes) | cholmod (path b) | "
+      "ldlt (path c) | cg (path b, iterative) | bicgstab (path a: eq 17-18 as written, "
+      "the paper's)");
+  s->add_option("--tolerance", a.tolerance, "iterative solvers: relative residual (1e-10)");
+  s->add_option("--max-iterations", a.max_iterations, "iterative solvers (10000)");
+  s->add_option("--axis", a.axis,
+                "3D: out-of-plane axis x y z giving the handedness of vortices (default z, or the "
+                "slab normal)")
+      ->expected(3);
+  s->add_option("--delta", a.delta, "vortex-tube threshold delta (seed 000 §6: 0.05)");
+}
+
+// One field to decompose: positions and vectors of the nodes (2D: in-plane coordinates).
+struct Field {
+  int dim = 3;
+  std::vector<Eigen::Vector3d> x, u;
+  std::vector<std::int64_t> id;
+  double d50 = 0.0;  // 0: unknown (CSV)
+  bool slab = false;
+  analysis::Slab plane;
+  Eigen::Vector3d e1 = Eigen::Vector3d::UnitX(), e2 = Eigen::Vector3d::UnitY();
+};
+
+Field field_from_motion(const FrameMotion& m, const FieldArgs& a, const std::string& source) {
+  Field f;
+  f.d50 = analysis::d50(m.frame);
+  f.slab = a.slice || a.slab.any();
+  for (const auto k : m.index) f.id.push_back(m.frame.particles[static_cast<std::size_t>(k)].id);
+  if (f.slab) {
+    if (m.frame.two_d) throw InputError(source, "--slice/--slab needs a 3D frame");
+    SlabArgs s = a.slab;
+    if (s.thickness <= 0.0 && s.d50_multiple <= 0.0) s.d50_multiple = 5.0;
+    f.plane = make_slab(s, m.frame);
+    if (s.origin.empty()) {  // mid-depth: the centre of the particles' box
+      const auto [lo, hi] = particle_bounds(m.frame);
+      f.plane.origin = 0.5 * (lo + hi);
+    }
+    analysis::SlabProjection p;
+    try {
+      p = analysis::project_slab(m.x, m.u, f.plane);
+    } catch (const std::invalid_argument& e) {
+      throw InputError(source, e.what());
+    }
+    f.dim = 2;
+    f.e1 = p.e1;
+    f.e2 = p.e2;
+    std::vector<std::int64_t> ids;
+    for (std::size_t i = 0; i < p.index.size(); ++i) {
+      f.x.emplace_back(p.position[i].x(), p.position[i].y(), 0.0);
+      f.u.emplace_back(p.vector[i].x(), p.vector[i].y(), 0.0);
+      ids.push_back(f.id[static_cast<std::size_t>(p.index[i])]);
+    }
+    f.id = ids;
+    return f;
+  }
+  f.dim = m.frame.two_d ? 2 : 3;
+  f.x = m.x;
+  f.u = m.u;
+  return f;
+}
+
+analysis::VortexAnalysisOptions analysis_options(const FieldArgs& a, const Field& f,
+                                                 const std::string& source) {
+  analysis::VortexAnalysisOptions o;
+  try {
+    o.hhd.solver = analysis::hhd_solver_from_name(a.solver);
+  } catch (const std::invalid_argument& e) {
+    throw InputError(source, "--solver: unknown solver", a.solver);
+  }
+  if (!(a.tolerance > 0.0 && a.tolerance < 1.0)) {
+    throw InputError(source, "--tolerance must be in (0, 1)", value_str(a.tolerance));
+  }
+  if (a.max_iterations < 1) {
+    throw InputError(source, "--max-iterations must be >= 1", std::to_string(a.max_iterations));
+  }
+  if (!(a.delta >= 0.0 && a.delta < 1.0)) {
+    throw InputError(source, "--delta must be in [0, 1)", value_str(a.delta));
+  }
+  o.hhd.tolerance = a.tolerance;
+  o.hhd.max_iterations = a.max_iterations;
+  o.tube_delta = a.delta;
+  if (a.axis.size() == 3) {
+    o.axis = Eigen::Vector3d(a.axis.data());
+    if (!(o.axis.norm() > 0.0) || !o.axis.allFinite()) {
+      throw InputError(source, "--axis must be a non-zero vector");
+    }
+  } else if (a.slab.normal.size() == 3) {
+    o.axis = Eigen::Vector3d(a.slab.normal.data());
+  }
+  o.ghosts = a.ghosts;
+  if (a.ghosts) {
+    const double d50 = a.d50 > 0.0 ? a.d50 : f.d50;
+    Eigen::Vector3d lo = f.x.empty() ? Eigen::Vector3d::Zero() : f.x[0], hi = lo;
+    for (const auto& p : f.x) {
+      lo = lo.cwiseMin(p);
+      hi = hi.cwiseMax(p);
+    }
+    double width = hi.x() - lo.x();
+    for (int d = 1; d < f.dim; ++d) width = std::min(width, hi[d] - lo[d]);
+    if (!(d50 > 0.0) && (a.ghost_spacing <= 0.0 || a.ghost_min_distance < 0.0)) {
+      throw InputError(source,
+                       "--ghosts: no radii in the input; give --d50, or --ghost-spacing and "
+                       "--ghost-min-distance");
+    }
+    o.ghost = analysis::paper_ghost_options(d50, width);
+    if (a.ghost_spacing > 0.0) o.ghost.spacing = a.ghost_spacing;
+    if (a.ghost_min_distance >= 0.0) o.ghost.min_distance = a.ghost_min_distance;
+    if (a.ghost_extent > 0.0) o.ghost.extent = a.ghost_extent;
+    if (a.ghost_radius > 0.0) o.ghost.radius = a.ghost_radius;
+  }
+  return o;
+}
+
+VortexAnalysis run_analysis(const Field& f, const analysis::VortexAnalysisOptions& o,
+                            const std::string& source) {
+  try {
+    return analysis::analyze_vortices(f.x, f.u, f.dim, o);
+  } catch (const std::invalid_argument& e) {
+    throw InputError(source, e.what());
+  }
+}
+
+// ---- hhd outputs ------------------------------------------------------------------------------
+
+template <class T>
+void write_rows(H5FieldFile& h, const std::string& name, const std::vector<T>& v,
+                std::size_t cols) {
+  h.write(name, v, {cols > 0 ? v.size() / cols : 0, cols});
+}
+
+std::vector<double> flat(const std::vector<Eigen::Vector3d>& v) {
+  std::vector<double> out;
+  out.reserve(3 * v.size());
+  for (const auto& x : v) out.insert(out.end(), x.data(), x.data() + 3);
+  return out;
+}
+
+std::vector<double> flat(const Eigen::MatrixXd& m) {
+  std::vector<double> out;
+  out.reserve(static_cast<std::size_t>(m.size()));
+  for (Eigen::Index i = 0; i < m.rows(); ++i)
+    for (Eigen::Index j = 0; j < m.cols(); ++j) out.push_back(m(i, j));
+  return out;
+}
+
+void write_extrema_csv(const fs::path& path, const VortexAnalysis& a, const Field& f) {
+  AtomicOutput out(path);
+  {
+    std::ofstream o(out.temp_path());
+    if (!o) throw InputError(path.string(), "cannot write file");
+    o << "kind,node,id,x,y,z,value,magnitude,vx,vy,vz\n";
+    char buf[512];
+    for (const auto& e : a.extrema) {
+      const auto& p = a.mesh.points[static_cast<std::size_t>(e.node)];
+      std::snprintf(buf, sizeof buf, "%s,%d,%lld,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n",
+                    analysis::extremum_kind_name(e.kind), e.node,
+                    static_cast<long long>(f.id[static_cast<std::size_t>(e.node)]), p.x(), p.y(),
+                    p.z(), e.value, e.magnitude, e.v.x(), e.v.y(), e.v.z());
+      o << buf;
+    }
+    if (!o.flush()) throw InputError(path.string(), "write failed");
+  }
+  out.commit();
+}
+
+void write_tubes_vtp(const fs::path& path, const VortexAnalysis& a) {
+  std::vector<Eigen::Vector3d> pts;
+  std::vector<std::vector<std::int64_t>> lines;
+  std::vector<double> vnorm, kind, magnitude;
+  for (const auto& t : a.tubes) {
+    if (t.nodes.size() < 2) continue;  // a centre without a tube: in the extrema only
+    lines.emplace_back();
+    for (const auto i : t.nodes) {
+      lines.back().push_back(static_cast<std::int64_t>(pts.size()));
+      pts.push_back(a.mesh.points[static_cast<std::size_t>(i)]);
+      vnorm.push_back(a.hhd.v.row(i).norm());
+    }
+    kind.push_back(static_cast<double>(a.extrema[t.extremum].kind));
+    magnitude.push_back(a.extrema[t.extremum].magnitude);
+  }
+  write_vtp_polylines(path, pts, lines, {{"v_norm", 1, vnorm}},
+                      {{"kind", 1, kind}, {"magnitude", 1, magnitude}});
+}
+
+void write_hhd_vtu(const fs::path& path, const VortexAnalysis& a,
+                   const std::vector<Eigen::Vector3d>& vectors) {
+  const int dim = a.mesh.dim;
+  std::vector<std::vector<std::int64_t>> cells;
+  cells.reserve(a.mesh.simplices.size());
+  for (const auto& s : a.mesh.simplices) cells.emplace_back(s.begin(), s.begin() + dim + 1);
+  std::vector<double> ghost(a.mesh.points.size(), 0.0);
+  for (std::size_t i = a.true_nodes; i < ghost.size(); ++i) ghost[i] = 1.0;
+  const auto& r = a.hhd;
+  write_vtu_mesh(path, a.mesh.points, dim == 3 ? 10 : 5, cells,
+                 {{"u", 1, std::vector<double>(r.u.data(), r.u.data() + r.u.size())},
+                  {"v", static_cast<int>(r.v.cols()), flat(r.v)},
+                  {"vector", 3, flat(vectors)},
+                  {"ghost", 1, ghost}},
+                 {{"xi", 3, flat(r.xi)},
+                  {"grad_u", 3, flat(r.grad_u)},
+                  {"curl_v", 3, flat(r.curl_v)},
+                  {"h", 3, flat(r.harmonic)},
+                  {"measure", 1, r.measure}});
+}
+
+void write_report_attrs(H5FieldFile& h, const VortexAnalysis& a) {
+  const auto& r = a.hhd;
+  h.attr("dim", static_cast<long long>(r.dim));
+  h.attr("solver", r.report.solver);
+  h.attr("unknowns", static_cast<long long>(r.report.unknowns));
+  h.attr("iterations_u", static_cast<long long>(r.report.iterations_u));
+  h.attr("iterations_v", static_cast<long long>(r.report.iterations_v));
+  h.attr("converged", static_cast<long long>(r.report.converged ? 1 : 0));
+  h.attr("residual_eq17", r.report.residual_eq17);
+  h.attr("residual_eq18", r.report.residual_eq18);
+  h.attr("norm_xi", r.norm_xi);
+  h.attr("norm_grad_u", r.norm_grad_u);
+  h.attr("norm_curl_v", r.norm_curl_v);
+  h.attr("norm_harmonic", r.norm_harmonic);
+  h.attr("norm_div_v", r.norm_div_v);
+  h.attr("dot_grad_curl", r.dot_grad_curl);
+  h.attr("dot_grad_harmonic", r.dot_grad_harmonic);
+  h.attr("dot_curl_harmonic", r.dot_curl_harmonic);
+  h.attr("seconds_ghosts", a.seconds_ghosts);
+  h.attr("seconds_delaunay", a.seconds_delaunay);
+  h.attr("seconds_assembly", r.report.seconds_assembly);
+  h.attr("seconds_factor", r.report.seconds_factor);
+  h.attr("seconds_solve", r.report.seconds_solve);
+  h.attr("seconds_detection", a.seconds_detection);
+}
+
+double cosine(double dot, double a, double b) {
+  return a > 0.0 && b > 0.0 ? dot / (a * b) : 0.0;
+}
+
+void print_summary(const char* what, const VortexAnalysis& a) {
+  const auto& r = a.hhd;
+  const auto c = analysis::count_extrema(a.extrema);
+  std::printf(
+      "%s: %zu nodes (%zu ghosts), %zu %s, solver %s (%s%d/%d iterations), "
+      "residual eq17 %.2e eq18 %.2e\n"
+      "  |xi| %.4g  |grad u| %.4g  |curl v| %.4g  |h| %.4g  cos(grad,curl) %.2e "
+      "cos(grad,h) %.2e cos(curl,h) %.2e |div v| %.3g\n"
+      "  vortices right %zu left %zu, sources %zu, sinks %zu, tubes %zu\n"
+      "  time ghosts %.3f s, delaunay %.3f s, assembly %.3f s, factor %.3f s, solve %.3f s, "
+      "detection %.3f s\n",
+      what, a.mesh.points.size(), a.mesh.points.size() - a.true_nodes, a.mesh.simplices.size(),
+      r.dim == 3 ? "tetrahedra" : "triangles", r.report.solver.c_str(),
+      r.report.converged ? "" : "NOT CONVERGED, ", r.report.iterations_u, r.report.iterations_v,
+      r.report.residual_eq17, r.report.residual_eq18, r.norm_xi, r.norm_grad_u, r.norm_curl_v,
+      r.norm_harmonic, cosine(r.dot_grad_curl, r.norm_grad_u, r.norm_curl_v),
+      cosine(r.dot_grad_harmonic, r.norm_grad_u, r.norm_harmonic),
+      cosine(r.dot_curl_harmonic, r.norm_curl_v, r.norm_harmonic), r.norm_div_v, c[0], c[1], c[2],
+      c[3], a.tubes.size(), a.seconds_ghosts, a.seconds_delaunay, r.report.seconds_assembly,
+      r.report.seconds_factor, r.report.seconds_solve, a.seconds_detection);
+}
+
+// ---- analyze hhd ---------------------------------------------------------------------------
+
+struct HhdArgs {
+  std::string input, csv, output, vtu, extrema, tubes;
+  long from = 0;
+  std::optional<long> to;
+  FieldArgs field;
+};
+
+void run_hhd(const HhdArgs& a) {
+  if (a.input.empty() == a.csv.empty()) {
+    throw InputError(a.input.empty() ? "granoscope analyze hhd" : a.input,
+                     "give either RUN.h5 or --csv FILE");
+  }
+  const std::string source = a.csv.empty() ? a.input : a.csv;
+  Field f;
+  std::string motion = "csv";
+  if (!a.csv.empty()) {
+    if (a.field.slice || a.field.slab.any()) {
+      throw InputError(source, "--slice/--slab need a trajectory (give a 2D CSV instead)");
+    }
+    const auto p = read_point_vectors_csv(a.csv);
+    f.dim = p.dim;
+    f.x = p.x;
+    f.u = p.u;
+    f.id = p.id;
+  } else {
+    const FrameMotion m = read_frame_motion(a.input, a.from, a.to);
+    motion = m.kind;
+    f = field_from_motion(m, a.field, a.input);
+  }
+  const auto opts = analysis_options(a.field, f, source);
+  const VortexAnalysis r = run_analysis(f, opts, source);
+  f.id.resize(r.mesh.points.size(), -1);  // ghosts: id -1
+  const auto& vectors = r.vectors;
+
+  H5FieldFile h(a.output, "granoscope-hhd");
+  h.attr("source", source);
+  h.attr("motion", motion);
+  h.attr("frame_from", static_cast<long long>(a.csv.empty() ? a.from : -1));
+  h.attr("frame_to", static_cast<long long>(a.csv.empty() ? a.to.value_or(-1) : -1));
+  h.attr("slab", static_cast<long long>(f.slab ? 1 : 0));
+  h.attr("ghosts", static_cast<long long>(r.mesh.points.size() - r.true_nodes));
+  if (opts.ghosts) {
+    h.attr("ghost_spacing", opts.ghost.spacing);
+    h.attr("ghost_min_distance", opts.ghost.min_distance);
+    h.attr("ghost_extent", opts.ghost.extent);
+    h.attr("ghost_radius", opts.ghost.radius);
+  }
+  h.attr("d50", f.d50);
+  h.attr("delta", a.field.delta);
+  write_report_attrs(h, r);
+  h.group("/nodes");
+  h.group("/simplices");
+  h.group("/extrema");
+  h.group("/tubes");
+  write_rows(h, "/nodes/position", flat(r.mesh.points), 3);
+  write_rows(h, "/nodes/vector", flat(vectors), 3);
+  h.write("/nodes/id", f.id);
+  h.write("/nodes/u", std::vector<double>(r.hhd.u.data(), r.hhd.u.data() + r.hhd.u.size()));
+  write_rows(h, "/nodes/v", flat(r.hhd.v), static_cast<std::size_t>(r.hhd.v.cols()));
+  std::vector<std::uint8_t> ghost(r.mesh.points.size(), 0);
+  for (std::size_t i = r.true_nodes; i < ghost.size(); ++i) ghost[i] = 1;
+  h.write("/nodes/ghost", ghost);
+  h.write("/nodes/dirichlet", r.mesh.dirichlet);
+  std::vector<std::int32_t> simp;
+  for (const auto& s : r.mesh.simplices)
+    for (int k = 0; k <= r.mesh.dim; ++k) simp.push_back(s[static_cast<std::size_t>(k)]);
+  write_rows(h, "/simplices/vertices", simp, static_cast<std::size_t>(r.mesh.dim + 1));
+  h.write("/simplices/measure", r.hhd.measure);
+  write_rows(h, "/simplices/xi", flat(r.hhd.xi), 3);
+  write_rows(h, "/simplices/grad_u", flat(r.hhd.grad_u), 3);
+  write_rows(h, "/simplices/curl_v", flat(r.hhd.curl_v), 3);
+  write_rows(h, "/simplices/harmonic", flat(r.hhd.harmonic), 3);
+  std::vector<std::int32_t> enode, ekind;
+  std::vector<double> evalue, emag;
+  std::vector<Eigen::Vector3d> epos, ev;
+  for (const auto& e : r.extrema) {
+    enode.push_back(e.node);
+    ekind.push_back(static_cast<std::int32_t>(e.kind));
+    evalue.push_back(e.value);
+    emag.push_back(e.magnitude);
+    epos.push_back(r.mesh.points[static_cast<std::size_t>(e.node)]);
+    ev.push_back(e.v);
+  }
+  h.attr("kinds", "0 right_vortex, 1 left_vortex, 2 source, 3 sink", "/extrema");
+  h.write("/extrema/node", enode);
+  h.write("/extrema/kind", ekind);
+  h.write("/extrema/value", evalue);
+  h.write("/extrema/magnitude", emag);
+  write_rows(h, "/extrema/position", flat(epos), 3);
+  write_rows(h, "/extrema/v", flat(ev), 3);
+  std::vector<std::int64_t> offsets{0};
+  std::vector<std::int32_t> tnodes, textremum;
+  for (const auto& t : r.tubes) {
+    tnodes.insert(tnodes.end(), t.nodes.begin(), t.nodes.end());
+    offsets.push_back(static_cast<std::int64_t>(tnodes.size()));
+    textremum.push_back(static_cast<std::int32_t>(t.extremum));
+  }
+  h.write("/tubes/offsets", offsets);
+  h.write("/tubes/nodes", tnodes);
+  h.write("/tubes/extremum", textremum);
+  if (f.slab) {
+    h.group("/slab");
+    h.write("/slab/origin", std::vector<Eigen::Vector3d>{f.plane.origin});
+    h.write("/slab/axes", std::vector<Eigen::Vector3d>{f.e1, f.e2});
+    h.attr("thickness", f.plane.thickness, "/slab");
+  }
+  h.commit();
+  if (!a.vtu.empty()) write_hhd_vtu(a.vtu, r, vectors);
+  if (!a.extrema.empty()) write_extrema_csv(a.extrema, r, f);
+  if (!a.tubes.empty()) write_tubes_vtp(a.tubes, r);
+  print_summary("hhd", r);
+  if (!r.hhd.report.converged) {
+    std::printf("warning: %s did not reach --tolerance %.1e in %d iterations\n",
+                r.hhd.report.solver.c_str(), a.field.tolerance, a.field.max_iterations);
+  }
+}
+
+// ---- analyze vortices ------------------------------------------------------------------------
+
+struct SeriesArgs {
+  std::string input, output;
+  long every = 0, stride = 0, from = 0;
+  std::optional<long> last;
+  std::string strain_axis;
+  FieldArgs field;
+};
+
+void run_vortices(const SeriesArgs& a) {
+  const auto n = static_cast<long>(frame_count(a.input));
+  if (a.every < 1) throw InputError(a.input, "--every must be >= 1", std::to_string(a.every));
+  const long stride = a.stride > 0 ? a.stride : a.every;
+  const long last = a.last.value_or(n - 1);
+  if (a.from < 0 || a.from >= n) {
+    throw InputError(a.input, "--from out of range 0.." + std::to_string(n - 1),
+                     std::to_string(a.from));
+  }
+  if (last < 0 || last >= n) {
+    throw InputError(a.input, "--last out of range 0.." + std::to_string(n - 1),
+                     std::to_string(last));
+  }
+  if (a.from + a.every > last) {
+    throw InputError(
+        a.input, "no frame pair: --from + --every beyond the last frame " + std::to_string(last),
+        std::to_string(a.from + a.every));
+  }
+  std::map<long, Frame> cache;  // frames still needed (reference and target of the increment)
+  const auto frame = [&](long i) -> const Frame& {
+    auto it = cache.find(i);
+    if (it == cache.end()) it = cache.emplace(i, read_frame(a.input, i)).first;
+    return it->second;
+  };
+  const Frame& first = frame(a.from);
+  const bool two_d = first.two_d;
+  int axis = two_d ? 1 : 2;
+  if (!a.strain_axis.empty()) {
+    if (a.strain_axis != "x" && a.strain_axis != "y" && a.strain_axis != "z") {
+      throw InputError(a.input, "--strain-axis must be x, y or z", a.strain_axis);
+    }
+    axis = a.strain_axis[0] - 'x';
+  }
+  const auto height = [&](const Frame& fr) {
+    const auto [lo, hi] = particle_bounds(fr);
+    return hi[axis] - lo[axis];
+  };
+  const double h0 = height(first);
+  if (!(h0 > 0.0)) throw InputError(a.input, "specimen has zero extent along the strain axis");
+  std::vector<std::int64_t> f0, f1;
+  std::vector<double> time, strain;
+  std::vector<std::int32_t> right, left, sources, sinks, tubes;
+  for (long k = a.from; k + a.every <= last; k += stride) {
+    cache.erase(cache.begin(), cache.lower_bound(k));
+    const Frame& ref = frame(k);
+    const double eps = (h0 - height(ref)) / h0;  // compression positive (seed 000: ε1 = u1/h)
+    const FrameMotion m = motion_between(ref, frame(k + a.every), a.input);
+    const Field f = field_from_motion(m, a.field, a.input);
+    const VortexAnalysis r = run_analysis(f, analysis_options(a.field, f, a.input), a.input);
+    const auto c = analysis::count_extrema(r.extrema);
+    f0.push_back(k);
+    f1.push_back(k + a.every);
+    time.push_back(ref.time);
+    strain.push_back(eps);
+    right.push_back(static_cast<std::int32_t>(c[0]));
+    left.push_back(static_cast<std::int32_t>(c[1]));
+    sources.push_back(static_cast<std::int32_t>(c[2]));
+    sinks.push_back(static_cast<std::int32_t>(c[3]));
+    tubes.push_back(static_cast<std::int32_t>(r.tubes.size()));
+    std::printf("frames %ld-%ld strain %.5f: right %zu left %zu sources %zu sinks %zu (%.2f s)\n",
+                k, k + a.every, eps, c[0], c[1], c[2], c[3],
+                r.seconds_delaunay + r.hhd.report.seconds_assembly + r.hhd.report.seconds_factor +
+                    r.hhd.report.seconds_solve + r.seconds_detection + r.seconds_ghosts);
+  }
+  H5FieldFile h(a.output, "granoscope-vortices");
+  h.attr("source", a.input);
+  h.attr("dim", static_cast<long long>(two_d || a.field.slice || a.field.slab.any() ? 2 : 3));
+  h.attr("every", static_cast<long long>(a.every));
+  h.attr("stride", static_cast<long long>(stride));
+  h.attr("strain_axis", std::string(1, static_cast<char>('x' + axis)));
+  h.attr("solver", a.field.solver);
+  h.attr("delta", a.field.delta);
+  h.attr("ghosts", static_cast<long long>(a.field.ghosts ? 1 : 0));
+  h.group("/series");
+  h.write("/series/frame_from", f0);
+  h.write("/series/frame_to", f1);
+  h.write("/series/time", time);
+  h.write("/series/strain", strain);
+  h.write("/series/right", right);
+  h.write("/series/left", left);
+  h.write("/series/sources", sources);
+  h.write("/series/sinks", sinks);
+  h.write("/series/tubes", tubes);
+  // Fourier spectrum of the counts against strain (Figs 17–18), when strain increases strictly.
+  const bool increasing =
+      strain.size() >= 4 && std::adjacent_find(strain.begin(), strain.end(),
+                                               std::greater_equal<double>()) == strain.end();
+  if (increasing) {
+    h.group("/spectrum");
+    for (const auto& [name, counts] :
+         {std::pair<const char*, const std::vector<std::int32_t>*>{"right", &right},
+          {"left", &left}}) {
+      const auto s =
+          analysis::amplitude_spectrum(strain, std::vector<double>(counts->begin(), counts->end()));
+      const std::string g = std::string("/spectrum/") + name;
+      h.group(g);
+      h.write(g + "/frequency", s.frequency);
+      h.write(g + "/period", s.period);
+      h.write(g + "/amplitude", s.amplitude);
+      h.attr("dominant_period", s.dominant_period, g);
+      std::printf("%s-handed vortices: dominant period %.4g of strain\n", name, s.dominant_period);
+    }
+  } else {
+    std::printf("no spectrum: fewer than 4 pairs or strain not increasing along the series\n");
+  }
+  h.commit();
+}
+
+}  // namespace
+
+void register_analyze_hhd(CLI::App& app) {
+  auto& analyze = analyze_command(app);
+  {
+    auto a = std::make_shared<HhdArgs>();
+    auto* s = analyze.add_subcommand(
+        "hhd",
+        "Helmholtz-Hodge decomposition of a displacement increment on the Delaunay mesh of the "
+        "particle centres (seed 000): potentials u, v, parts grad u, curl v, h, vortex centres, "
+        "sources/sinks, vortex tubes");
+    s->add_option("input", a->input, "RUN.h5 trajectory (or any snapshot file)");
+    s->add_option("--csv", a->csv, "points and vectors instead: header x,y[,z],ux,uy[,uz][,id]");
+    s->add_option("-o,--output", a->output, "output HDF5 (format granoscope-hhd)")->required();
+    s->add_option("--from", a->from, "reference frame index (default 0)");
+    s->add_option("--to", a->to,
+                  "target frame: displacement increment from --from to --to matched by id "
+                  "(seed 000: IT steps apart); without it the velocities of --from");
+    s->add_option("--vtu", a->vtu, "also write the mesh: point u, v; cell xi, grad_u, curl_v, h");
+    s->add_option("--extrema", a->extrema, "also write the extrema as CSV");
+    s->add_option("--tubes", a->tubes,
+                  "also write the vortex tubes of 2 or more nodes as VTP polylines (3D)");
+    add_field_options(s, a->field);
+    s->callback([a] { run_hhd(*a); });
+  }
+  {
+    auto a = std::make_shared<SeriesArgs>();
+    auto* s = analyze.add_subcommand(
+        "vortices",
+        "HHD of every IT-frame displacement increment of a trajectory: counts of right/left-"
+        "handed vortices, sources, sinks against strain and their Fourier spectrum (seed 000 "
+        "Figs 16-18)");
+    s->add_option("input", a->input, "RUN.h5 trajectory")->required();
+    s->add_option("-o,--output", a->output, "output HDF5 (format granoscope-vortices)")->required();
+    s->add_option("--every", a->every, "IT: frames between the two frames of an increment")
+        ->required();
+    s->add_option("--stride", a->stride, "frames between successive increments (default IT)");
+    s->add_option("--from", a->from, "first reference frame (default 0)");
+    s->add_option("--last", a->last, "last frame used (default: the last)");
+    s->add_option("--strain-axis", a->strain_axis,
+                  "x|y|z: strain = relative shortening of the particles' extent along it "
+                  "(default z, y for 2D frames)");
+    add_field_options(s, a->field);
+    s->callback([a] { run_vortices(*a); });
+  }
+}
+
+}  // namespace gs::cli
