@@ -72,6 +72,7 @@ DirectShearTest::DirectShearTest(DirectShearSpec spec, ShearBoxGeometry geometry
   if (!(spec_.max_displacement_m > 0))
     throw std::invalid_argument("max displacement must be positive");
   if (!(spec_.frame_every_m > 0)) spec_.frame_every_m = spec_.max_displacement_m / 10;
+  target_ = {spec_.max_displacement_m, spec_.frame_every_m};
 }
 
 double DirectShearTest::specimen_height(const Simulation& sim) const {
@@ -109,15 +110,15 @@ double DirectShearTest::shear_stress(const Simulation& sim) const {
 }
 
 bool DirectShearTest::finished(const Simulation& sim) const {
-  return displacement(sim) >= spec_.max_displacement_m;
+  return target_.reached(displacement(sim));
 }
 
 double DirectShearTest::progress(const Simulation& sim) const {
-  return std::clamp(displacement(sim) / spec_.max_displacement_m, 0.0, 1.0);
+  return target_.progress(displacement(sim));
 }
 
 std::int64_t DirectShearTest::frame_index(const Simulation& sim) const {
-  return static_cast<std::int64_t>(std::floor(displacement(sim) / spec_.frame_every_m));
+  return target_.frame_index(displacement(sim));
 }
 
 std::string DirectShearTest::curve_header() const {

@@ -74,6 +74,7 @@ class DirectShearTest final : public LoadingProgramme {
   ShearBoxGeometry g_;
   ShearBoxWalls w_;
   double x0_ = 0, h0_ = 0;
+  MeasureTarget target_;
   mutable double peak_ratio_ = 0;
 };
 

@@ -33,12 +33,6 @@ double max_diameter(const std::vector<Particle>& p) {
   return d;
 }
 
-double mean_diameter(const std::vector<Particle>& p) {
-  double d = 0;
-  for (const auto& q : p) d += 2 * q.radius;
-  return p.empty() ? 0 : d / static_cast<double>(p.size());
-}
-
 /// Seeded specimen in the box [0, cloud]: the number of spheres is set by the target box and
 /// void ratio, the cloud is the loose box they are placed in.
 std::vector<Particle> generate(const Scene& s, const Eigen::Vector3d& cloud) {
@@ -85,10 +79,8 @@ std::vector<std::unique_ptr<LoadingProgramme>> scene_programmes(Scene& s) {
     gauge = cuboid_gauge();
     s.triaxial.core_inset_m = s.plane_strain.core_inset_m = max_diameter(s.particles);
     if (s.test == "triaxial") {
-      s.triaxial.d50_m = mean_diameter(s.particles);
       test = std::make_unique<TriaxialTest>(s.triaxial);
     } else {
-      s.plane_strain.d50_m = mean_diameter(s.particles);
       test = std::make_unique<PlaneStrainTest>(s.plane_strain);
     }
   } else {  // direct shear

@@ -1,7 +1,9 @@
 #include "loading_programme.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
+#include <iostream>
 #include <sstream>
 #include <stdexcept>
 
@@ -53,6 +55,27 @@ double servo_speed(const Simulation& sim, std::size_t w, double stress_Pa, doubl
   if (count == 0 || !(k > 0)) return error > 0 ? max_speed : -max_speed;
   const double dt = sim.config().dt;
   return std::clamp(gain * error * area_m2 / k / dt, -max_speed, max_speed);
+}
+
+double mean_diameter(const ParticleState& p) {
+  double d = 0;
+  for (const double r : p.radius) d += 2 * r;
+  return p.size() == 0 ? 0.0 : d / static_cast<double>(p.size());
+}
+
+double MeasureTarget::progress(double v) const {
+  return std::clamp(v / max, 0.0, 1.0);
+}
+
+std::int64_t MeasureTarget::frame_index(double v) const {
+  return static_cast<std::int64_t>(std::floor(v / every));
+}
+
+void InertialWarning::check(double inertial, const std::string& test, double strain) {
+  if (warned || !(inertial > threshold)) return;
+  warned = true;
+  std::cerr << "warning: " << test << ": inertial number " << inertial << " exceeds " << threshold
+            << " at strain " << strain << " (not quasi-static; lower the loading rate)\n";
 }
 
 double coordination_number(const Simulation& sim) {

@@ -66,6 +66,25 @@ double wall_stress(const Simulation& sim, std::size_t w, const Eigen::Vector3d& 
 double servo_speed(const Simulation& sim, std::size_t w, double stress_Pa, double target_Pa,
                    double area_m2, double gain, double max_speed);
 
+/// Mean sphere diameter (m), the d50 of a test's inertial number when the scene gives none.
+double mean_diameter(const ParticleState& p);
+
+/// A programme that runs until a monotonic measure (axial strain, displacement) reaches `max`,
+/// with a trajectory frame every `every` of it.
+struct MeasureTarget {
+  double max = 0, every = 0;
+  bool reached(double v) const { return v >= max; }
+  double progress(double v) const;
+  std::int64_t frame_index(double v) const;
+};
+
+/// Warns once on stderr when the inertial number exceeds `threshold` (not quasi-static).
+struct InertialWarning {
+  double threshold = 1e-4;
+  bool warned = false;
+  void check(double inertial, const std::string& test, double strain);
+};
+
 /// Coordination number Z = 2·(sphere–sphere contacts) / particles (walls not counted).
 double coordination_number(const Simulation& sim);
 

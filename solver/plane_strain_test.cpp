@@ -28,7 +28,10 @@ std::vector<WallSpec> membrane_clamps() {
   return w;
 }
 
-PlaneStrainTest::PlaneStrainTest(PlaneStrainSpec spec) : spec_(spec) {
+PlaneStrainTest::PlaneStrainTest(PlaneStrainSpec spec)
+    : spec_(spec),
+      target_{spec.max_strain, spec.frame_every_strain},
+      inertial_warning_{spec.inertial_warning} {
   if (!(spec_.confining_Pa > 0)) throw std::invalid_argument("confining pressure must be positive");
   if (!(spec_.strain_rate_1_s > 0)) throw std::invalid_argument("strain rate must be positive");
   if (!(spec_.max_strain > 0 && spec_.max_strain < 1))
@@ -53,13 +56,7 @@ void PlaneStrainTest::refresh(Simulation& sim) {
 }
 
 void PlaneStrainTest::start(Simulation& sim) {
-  if (spec_.d50_m > 0) {
-    d50_ = spec_.d50_m;
-  } else {
-    double d = 0;
-    for (const double r : sim.particles().radius) d += 2 * r;
-    d50_ = d / static_cast<double>(std::max<std::size_t>(1, sim.particles().size()));
-  }
+  d50_ = spec_.d50_m > 0 ? spec_.d50_m : mean_diameter(sim.particles());
   for (std::size_t f = 0; f < 6; ++f) sim.walls()[f].vel.setZero();
   // Clamps where the x walls meet the caps; then the x walls give way to the membranes.
   const Eigen::Vector3d lo = cuboid_lo(sim), hi = cuboid_hi(sim);
@@ -100,15 +97,15 @@ double PlaneStrainTest::axial_strain(const Simulation& sim) const {
 }
 
 bool PlaneStrainTest::finished(const Simulation& sim) const {
-  return axial_strain(sim) >= spec_.max_strain;
+  return target_.reached(axial_strain(sim));
 }
 
 double PlaneStrainTest::progress(const Simulation& sim) const {
-  return std::clamp(axial_strain(sim) / spec_.max_strain, 0.0, 1.0);
+  return target_.progress(axial_strain(sim));
 }
 
 std::int64_t PlaneStrainTest::frame_index(const Simulation& sim) const {
-  return static_cast<std::int64_t>(std::floor(axial_strain(sim) / spec_.frame_every_strain));
+  return target_.frame_index(axial_strain(sim));
 }
 
 std::string PlaneStrainTest::curve_header() const {
@@ -139,11 +136,7 @@ std::string PlaneStrainTest::curve_row(const Simulation& sim) const {
   const double inertial =
       p > 0 ? spec_.strain_rate_1_s * d50_ / std::sqrt(p / sim.config().material.density)
             : std::numeric_limits<double>::quiet_NaN();
-  if (inertial > spec_.inertial_warning && !warned_) {
-    warned_ = true;
-    std::cerr << "warning: plane_strain: inertial number " << inertial << " exceeds "
-              << spec_.inertial_warning << " (not quasi-static; lower the strain rate)\n";
-  }
+  inertial_warning_.check(inertial, "plane_strain", axial_strain(sim));
   // Core: between the mean membrane positions and the caps / plane-strain walls, inset.
   double xm = 0, xp = 0;
   std::size_t hits = 0;
@@ -184,7 +177,7 @@ std::string PlaneStrainTest::save_state() const {
   st.set("clamp", clamp_);
   st.set("b0", b0_);
   st.set("max_phi", max_phi_deg_);
-  st.set("warned", static_cast<std::int64_t>(warned_));
+  st.set("warned", static_cast<std::int64_t>(inertial_warning_.warned));
   return st.text();
 }
 
@@ -197,7 +190,7 @@ void PlaneStrainTest::load_state(const std::string& state) {
   clamp_ = st.number("clamp");
   b0_ = st.number("b0");
   max_phi_deg_ = st.number("max_phi");
-  warned_ = st.integer("warned") != 0;
+  inertial_warning_.warned = st.integer("warned") != 0;
 }
 
 }  // namespace gs::solver

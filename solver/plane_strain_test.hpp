@@ -65,7 +65,8 @@ class PlaneStrainTest final : public LoadingProgramme {
   double h0_ = 0, v0_ = 0, d50_ = 0;
   std::int64_t start_step_ = 0;
   mutable double max_phi_deg_ = 0;
-  mutable bool warned_ = false;
+  MeasureTarget target_;
+  mutable InertialWarning inertial_warning_;
 };
 
 }  // namespace gs::solver

@@ -15,7 +15,10 @@ double mobilised_friction_deg(double sigma1, double sigma3) {
   return std::asin(std::clamp(s, -1.0, 1.0)) * 180.0 / M_PI;
 }
 
-TriaxialTest::TriaxialTest(TriaxialSpec spec) : spec_(spec) {
+TriaxialTest::TriaxialTest(TriaxialSpec spec)
+    : spec_(spec),
+      target_{spec.max_strain, spec.frame_every_strain},
+      inertial_warning_{spec.inertial_warning} {
   if (!(spec_.confining_Pa > 0)) throw std::invalid_argument("confining pressure must be positive");
   if (!(spec_.strain_rate_1_s > 0)) throw std::invalid_argument("strain rate must be positive");
   if (!(spec_.max_strain > 0 && spec_.max_strain < 1))
@@ -27,13 +30,7 @@ void TriaxialTest::start(Simulation& sim) {
   size0_ = hi - lo;
   h0_ = size0_.z();
   v0_ = size0_.prod();
-  if (spec_.d50_m > 0) {
-    d50_ = spec_.d50_m;
-  } else {
-    double d = 0;
-    for (const double r : sim.particles().radius) d += 2 * r;
-    d50_ = d / static_cast<double>(std::max<std::size_t>(1, sim.particles().size()));
-  }
+  d50_ = spec_.d50_m > 0 ? spec_.d50_m : mean_diameter(sim.particles());
   for (std::size_t f = 0; f < 6; ++f) sim.walls()[f].vel.setZero();
 }
 
@@ -74,15 +71,15 @@ double TriaxialTest::inertial_number(const Simulation& sim) const {
 }
 
 bool TriaxialTest::finished(const Simulation& sim) const {
-  return axial_strain(sim) >= spec_.max_strain;
+  return target_.reached(axial_strain(sim));
 }
 
 double TriaxialTest::progress(const Simulation& sim) const {
-  return std::clamp(axial_strain(sim) / spec_.max_strain, 0.0, 1.0);
+  return target_.progress(axial_strain(sim));
 }
 
 std::int64_t TriaxialTest::frame_index(const Simulation& sim) const {
-  return static_cast<std::int64_t>(std::floor(axial_strain(sim) / spec_.frame_every_strain));
+  return target_.frame_index(axial_strain(sim));
 }
 
 std::string TriaxialTest::curve_header() const {
@@ -103,12 +100,7 @@ std::string TriaxialTest::curve_row(const Simulation& sim) const {
   const double phi = mobilised_friction_deg(s[0], s[2]);
   const double inertial = inertial_number(sim);
   if (phi > max_phi_deg_) max_phi_deg_ = phi;
-  if (inertial > spec_.inertial_warning && !warned_) {
-    warned_ = true;
-    std::cerr << "warning: triaxial: inertial number " << inertial << " exceeds "
-              << spec_.inertial_warning << " at eps1 = " << e1
-              << " (not quasi-static; lower the strain rate)\n";
-  }
+  inertial_warning_.check(inertial, "triaxial", e1);
   const double e = box_void_ratio(sim.particles(), lo, hi);
   const Eigen::Vector3d inset = Eigen::Vector3d::Constant(spec_.core_inset_m);
   const double e_core = box_void_ratio(sim.particles(), lo + inset, hi - inset);
@@ -141,7 +133,7 @@ std::string TriaxialTest::save_state() const {
   st.set("sy", size0_.y());
   st.set("sz", size0_.z());
   st.set("max_phi", max_phi_deg_);
-  st.set("warned", static_cast<std::int64_t>(warned_));
+  st.set("warned", static_cast<std::int64_t>(inertial_warning_.warned));
   return st.text();
 }
 
@@ -152,7 +144,7 @@ void TriaxialTest::load_state(const std::string& state) {
   d50_ = st.number("d50");
   size0_ = {st.number("sx"), st.number("sy"), st.number("sz")};
   max_phi_deg_ = st.number("max_phi");
-  warned_ = st.integer("warned") != 0;
+  inertial_warning_.warned = st.integer("warned") != 0;
 }
 
 }  // namespace gs::solver

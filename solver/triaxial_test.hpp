@@ -48,7 +48,8 @@ class TriaxialTest final : public LoadingProgramme {
   double h0_ = 0, v0_ = 0, d50_ = 0;
   Eigen::Vector3d size0_ = Eigen::Vector3d::Zero();
   mutable double max_phi_deg_ = 0;
-  mutable bool warned_ = false;
+  MeasureTarget target_;
+  mutable InertialWarning inertial_warning_;
 };
 
 /// Mobilised friction angle (deg) from principal stresses: sin φ = (σ1 − σ3)/(σ1 + σ3).
