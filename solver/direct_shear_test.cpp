@@ -80,6 +80,7 @@ double DirectShearTest::specimen_height(const Simulation& sim) const {
 }
 
 void DirectShearTest::start(Simulation& sim) {
+  reset_rotations(sim);
   for (const auto c : w_.closer) sim.set_wall_active(c, false);
   for (auto& w : sim.walls()) w.vel.setZero();
   x0_ = sim.walls()[w_.upper[0]].pos.x();

@@ -57,6 +57,11 @@ double servo_speed(const Simulation& sim, std::size_t w, double stress_Pa, doubl
   return std::clamp(gain * error * area_m2 / k / dt, -max_speed, max_speed);
 }
 
+void reset_rotations(Simulation& sim) {
+  auto& rot = sim.particles().rot;
+  std::fill(rot.begin(), rot.end(), Eigen::Vector3d::Zero());
+}
+
 double mean_diameter(const ParticleState& p) {
   double d = 0;
   for (const double r : p.radius) d += 2 * r;

@@ -66,6 +66,10 @@ double wall_stress(const Simulation& sim, std::size_t w, const Eigen::Vector3d& 
 double servo_speed(const Simulation& sim, std::size_t w, double stress_Pa, double target_Pa,
                    double area_m2, double gain, double max_speed);
 
+/// Zeroes the particles' cumulative rotation vectors: the rotations of a test's frames count
+/// from the start of its loading (seed 000 Fig 4, seed 004 §4.2.3), not from the preparation.
+void reset_rotations(Simulation& sim);
+
 /// Mean sphere diameter (m), the d50 of a test's inertial number when the scene gives none.
 double mean_diameter(const ParticleState& p);
 

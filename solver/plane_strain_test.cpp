@@ -56,6 +56,7 @@ void PlaneStrainTest::refresh(Simulation& sim) {
 }
 
 void PlaneStrainTest::start(Simulation& sim) {
+  reset_rotations(sim);
   d50_ = spec_.d50_m > 0 ? spec_.d50_m : mean_diameter(sim.particles());
   for (std::size_t f = 0; f < 6; ++f) sim.walls()[f].vel.setZero();
   // Clamps where the x walls meet the caps; then the x walls give way to the membranes.

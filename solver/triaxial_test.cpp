@@ -26,6 +26,7 @@ TriaxialTest::TriaxialTest(TriaxialSpec spec)
 }
 
 void TriaxialTest::start(Simulation& sim) {
+  reset_rotations(sim);
   const Eigen::Vector3d lo = cuboid_lo(sim), hi = cuboid_hi(sim);
   size0_ = hi - lo;
   h0_ = size0_.z();

@@ -71,6 +71,12 @@ TEST(LabScenes, TriaxialPhasesCurveAndFrames) {
   const auto t = gs::read_hdf5_trajectory(dir / "triaxial.h5");
   ASSERT_EQ(t.frames.size(), 5u);  // eps1 = 0, 0.005, 0.01, 0.015, 0.02
   EXPECT_EQ(t.frames[0].step, specimen.frames[0].step);
+  // Rotations count from the start of loading: zero in its first frame, not in the specimen.
+  double rot_specimen = 0, rot_start = 0;
+  for (const auto& p : specimen.frames[0].particles) rot_specimen += p.rotation.norm();
+  for (const auto& p : t.frames[0].particles) rot_start += p.rotation.norm();
+  EXPECT_GT(rot_specimen, 0.0);
+  EXPECT_EQ(rot_start, 0.0);
   EXPECT_EQ(t.frames.back().step, static_cast<std::int64_t>(c.at(c.rows.size() - 1, "step")));
   EXPECT_GE(c.at(c.rows.size() - 1, "eps1_shortening"), 0.02);
   // The loading starts from the prepared state: same void ratios (box and core, the core inset
