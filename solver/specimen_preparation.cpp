@@ -76,8 +76,7 @@ bool SpecimenPreparation::equilibrium(Simulation& sim, bool with_stress) const {
 
 void SpecimenPreparation::next_stage(Simulation& sim) {
   stage_start_ = sim.step_count();
-  if (stage_ == kDeposition) {
-    sim.set_gravity(gravity_saved_);
+  if (stage_ == kDeposition) {  // gravity stays on until the preparation ends
     stage_ = spec_.pressure_Pa > 0 ? kCompaction : kSettling;
     if (stage_ == kSettling) {
       friction_ = test_friction_;
@@ -102,6 +101,7 @@ void SpecimenPreparation::next_stage(Simulation& sim) {
     return;
   }
   stage_ = kDone;
+  sim.set_gravity(gravity_saved_);  // the scene's own (deposition changed it)
 }
 
 void SpecimenPreparation::control(Simulation& sim) {
@@ -122,6 +122,7 @@ void SpecimenPreparation::control(Simulation& sim) {
   const std::int64_t s = sim.step_count();
   if (spec_.max_steps > 0 && s - first_step_ >= spec_.max_steps) {
     stage_ = kDone;
+    sim.set_gravity(gravity_saved_);
     return;
   }
   if (s - stage_start_ < spec_.stage_steps || (s - stage_start_) % spec_.check_every != 0) return;

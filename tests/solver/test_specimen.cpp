@@ -5,6 +5,7 @@
 #include <cmath>
 #include <random>
 
+#include "cuboid_walls.hpp"
 #include "flexible_membrane.hpp"
 #include "loading_programme.hpp"
 #include "specimen_generation.hpp"
@@ -215,6 +216,53 @@ TEST(ProgrammeState, RoundTripsDoublesExactly) {
   EXPECT_EQ(b.integer("n"), -42);
   EXPECT_EQ(b.number("tiny"), 5e-324);
   EXPECT_THROW(b.number("missing"), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace gs::solver
+
+namespace gs::solver {
+namespace {
+
+TEST(SpecimenPreparation, DepositionSettlesUnderGravityThenRestoresIt) {
+  // Spheres dropped in a box of planes: deposition ends when the pile is at rest, the pile
+  // settles with the test's friction, and at the end the scene's gravity (none) is restored.
+  std::mt19937_64 rng(2);
+  const SizeSpec sizes{0.002, 0.003, SizeDistribution::Uniform};
+  const Eigen::Vector3d lo(0, 0, 0), hi(0.012, 0.012, 0.06);
+  auto particles = random_sequential_packing(draw_diameters(sizes, 2.5e-7, rng), lo, hi, rng);
+  SimulationConfig cfg;
+  cfg.material = {1e7, 0.3, 20.0, 2600.0, 0.0, -1.0, RollingRadius::Min};
+  cfg.damping = 0.3;
+  cfg.dt = 0.3 * pwave_timestep({0.001}, 2600.0, 1e7);
+  Simulation sim(cfg, particles, cuboid_planes(lo, hi, 20.0));
+  PreparationSpec spec;
+  spec.deposition = true;
+  spec.pressure_Pa = 0;
+  spec.stage_steps = 200;
+  spec.check_every = 50;
+  spec.unbalanced_force = 0.05;
+  spec.kinetic_ratio = 1e-2;
+  spec.max_steps = 400000;
+  SpecimenPreparation prep(spec, cuboid_gauge(), 20.0);
+  double z0 = 0;
+  for (const auto& x : sim.particles().pos) z0 += x.z();
+  prep.start(sim);
+  EXPECT_EQ(prep.stage(), SpecimenPreparation::kDeposition);
+  EXPECT_EQ(sim.config().gravity, Eigen::Vector3d(0, 0, -9.81));
+  while (!prep.finished(sim)) {
+    prep.control(sim);
+    if (prep.finished(sim)) break;
+    sim.step();
+  }
+  EXPECT_LT(sim.step_count(), spec.max_steps) << "never came to rest";
+  EXPECT_EQ(sim.config().gravity, Eigen::Vector3d::Zero());
+  double z1 = 0;
+  for (std::size_t i = 0; i < sim.particles().size(); ++i) {
+    z1 += sim.particles().pos[i].z();
+    EXPECT_GT(sim.particles().pos[i].z(), 0.5 * sim.particles().radius[i]);  // above the floor
+  }
+  EXPECT_LT(z1, 0.5 * z0);  // the cloud fell: its mean height more than halved
 }
 
 }  // namespace
