@@ -105,6 +105,27 @@ void Simulation::attach_histories(const std::vector<ContactHistory>& old) {
       if (wf >= 0) params_[k].tan_friction = std::tan(wf * M_PI / 180.0);
     }
   }
+  // Pairs of each particle in pair order (entry = pair << 1 | 1 when the particle is the
+  // second body), and the wall pairs.
+  const std::size_t n = p_.size();
+  pair_start_.assign(n + 1, 0);
+  wall_pairs_.clear();
+  for (std::size_t k = 0; k < np; ++k) {
+    const auto [a, b] = nl_.pairs[k];
+    ++pair_start_[a + 1];
+    if (b < kWallBase)
+      ++pair_start_[b + 1];
+    else
+      wall_pairs_.push_back(static_cast<std::uint32_t>(k));
+  }
+  for (std::size_t i = 0; i < n; ++i) pair_start_[i + 1] += pair_start_[i];
+  pair_of_.resize(pair_start_[n]);
+  std::vector<std::uint32_t> fill(pair_start_.begin(), pair_start_.end() - 1);
+  for (std::size_t k = 0; k < np; ++k) {
+    const auto [a, b] = nl_.pairs[k];
+    pair_of_[fill[a]++] = static_cast<std::uint32_t>(k << 1);
+    if (b < kWallBase) pair_of_[fill[b]++] = static_cast<std::uint32_t>(k << 1 | 1u);
+  }
 }
 
 std::pair<double, std::size_t> Simulation::wall_stiffness(std::size_t w) const {
@@ -158,69 +179,124 @@ void Simulation::update_servos() {
   }
 }
 
-void Simulation::step() {
-  if (nl_.stale(p_, walls_)) rebuild_neighbors();
-  const double dt = cfg_.dt;
-  const std::size_t np = nl_.pairs.size();
-  loads_.resize(np);
-  active_.assign(np, 0);
-  const int threads = std::max(1, cfg_.threads);
-#pragma omp parallel for num_threads(threads) schedule(static)
-  for (std::size_t k = 0; k < np; ++k) {
-    ContactHistory& h = hist_[k];
-    ContactGeometry g;
-    BodyMotion m1, m2;
-    if (!pair_geometry(k, g, m1, m2)) {  // coincident centres
-      h.real = false;
-      continue;
-    }
-    if (g.penetration < 0) {  // not touching (YADE erases the interaction)
-      h.real = false;
-      continue;
-    }
-    const bool fresh = !h.real;
-    loads_[k] = cohesive_frictional_step(h, fresh, g, params_[k], m1, m2, dt);
-    h.real = true;
-    active_[k] = 1;
-  }
-
-  // Accumulate in pair order: deterministic whatever the thread count.
-  const std::size_t n = p_.size();
-  std::copy(p_.external_force.begin(), p_.external_force.end(), p_.force.begin());
-  std::fill(p_.torque.begin(), p_.torque.end(), Eigen::Vector3d::Zero());
+void Simulation::accumulate_walls_and_ledger(std::size_t np) {
   for (auto& w : walls_) {
     w.force.setZero();
     w.torque.setZero();
     w.contact_stiffness = 0;
     w.contacts = 0;
   }
-  double max_overlap_ratio = 0;
+  for (const std::uint32_t k : wall_pairs_) {
+    if (!active_[k]) continue;
+    const ContactLoads& L = loads_[k];
+    WallState& w = walls_[nl_.pairs[k].second - kWallBase];
+    w.force += L.force1;
+    w.contact_stiffness += params_[k].kn;
+    ++w.contacts;
+    w.torque += L.arm1;
+    w.torque += -L.moment;
+  }
   for (std::size_t k = 0; k < np; ++k) {
     if (!active_[k]) continue;
-    const auto [a, b] = nl_.pairs[k];
-    const ContactLoads& L = loads_[k];
-    ledger_.friction_dissipation += L.friction_dissipation;
-    ledger_.rolling_dissipation += L.rolling_dissipation;
-    if (b >= kWallBase) {
-      WallState& w = walls_[b - kWallBase];
-      w.force += L.force1;
-      w.contact_stiffness += params_[k].kn;
-      ++w.contacts;
-      w.torque += L.arm1;
-      w.torque += -L.moment;
-      p_.force[a] += -L.force1;
-      p_.torque[a] += L.arm2;
-      p_.torque[a] += L.moment;
-      max_overlap_ratio = std::max(max_overlap_ratio, hist_[k].overlap / p_.radius[a]);
-    } else {
-      p_.force[a] += L.force1;
-      p_.torque[a] += L.arm1;
-      p_.torque[a] += -L.moment;
-      p_.force[b] += -L.force1;
-      p_.torque[b] += L.arm2;
-      p_.torque[b] += L.moment;
-      max_overlap_ratio =
-          std::max(max_overlap_ratio, hist_[k].overlap / std::min(p_.radius[a], p_.radius[b]));
+    ledger_.friction_dissipation += dissipation_[2 * k];
+    ledger_.rolling_dissipation += dissipation_[2 * k + 1];
+  }
+  // Work of gravity, of the walls and of applied loads over this step (velocities of the step).
+  const double dt = cfg_.dt;
+  double grav = 0, ext = 0;
+  for (std::size_t i = 0; i < p_.size(); ++i) {
+    if (p_.fixed[i]) continue;
+    grav += p_.mass[i] * cfg_.gravity.dot(p_.vel[i]);
+    ext += p_.external_force[i].dot(p_.vel[i]);
+  }
+  ledger_.gravity_work += grav * dt;
+  ledger_.external_work += ext * dt;
+}
+
+void Simulation::step() {
+  if (nl_.stale(p_, walls_)) rebuild_neighbors();
+  const double dt = cfg_.dt;
+  const std::size_t np = nl_.pairs.size();
+  loads_.resize(np);
+  active_.assign(np, 0);
+  dissipation_.resize(2 * np);
+  const int threads = std::max(1, cfg_.threads);
+  const std::size_t n = p_.size();
+  damp_.resize(n);
+  double max_overlap_ratio = 0;
+  bool finite = true;
+  // One parallel region per step (a region per loop lets the idle thread fall asleep between
+  // them, and waking it costs more than the loops on small systems).
+#pragma omp parallel num_threads(threads)
+  {
+#pragma omp for schedule(static) reduction(max : max_overlap_ratio)
+    for (std::size_t k = 0; k < np; ++k) {
+      ContactHistory& h = hist_[k];
+      const auto [a, b] = nl_.pairs[k];
+      if (b < kWallBase) {  // sphere pair out of reach: no geometry needed
+        const double reach = p_.radius[a] + p_.radius[b];
+        if ((p_.pos[b] - p_.pos[a]).squaredNorm() > reach * reach) {
+          h.real = false;
+          continue;
+        }
+      }
+      ContactGeometry g;
+      BodyMotion m1, m2;
+      if (!pair_geometry(k, g, m1, m2)) {  // coincident centres
+        h.real = false;
+        continue;
+      }
+      if (g.penetration < 0) {  // not touching (YADE erases the interaction)
+        h.real = false;
+        continue;
+      }
+      const bool fresh = !h.real;
+      const ContactLoads& L = loads_[k] =
+          cohesive_frictional_step(h, fresh, g, params_[k], m1, m2, dt);
+      dissipation_[2 * k] = L.friction_dissipation;
+      dissipation_[2 * k + 1] = L.rolling_dissipation;
+      h.real = true;
+      active_[k] = 1;
+      const double rmin = b >= kWallBase ? p_.radius[a] : std::min(p_.radius[a], p_.radius[b]);
+      max_overlap_ratio = std::max(max_overlap_ratio, h.overlap / rmin);
+    }
+
+    // Loads gathered per particle in pair order (the pairs of each particle are listed in that
+    // order), so the sums are the same for any number of threads.
+#pragma omp for schedule(static)
+    for (std::size_t i = 0; i < n; ++i) {
+      Eigen::Vector3d f = p_.external_force[i], t = Eigen::Vector3d::Zero();
+      for (std::uint32_t e = pair_start_[i]; e < pair_start_[i + 1]; ++e) {
+        const std::uint32_t k = pair_of_[e] >> 1;
+        if (!active_[k]) continue;
+        const ContactLoads& L = loads_[k];
+        const bool first = (pair_of_[e] & 1u) == 0 && nl_.pairs[k].second < kWallBase;
+        if (first) {  // body 1 of a sphere pair
+          f += L.force1;
+          t += L.arm1;
+          t += -L.moment;
+        } else {  // body 2: the second sphere, or the sphere of a wall pair
+          f += -L.force1;
+          t += L.arm2;
+          t += L.moment;
+        }
+      }
+      p_.force[i] = f;
+      p_.torque[i] = t;
+    }
+
+#pragma omp single
+    {
+      accumulate_walls_and_ledger(np);
+      update_servos();
+      for (const auto& w : walls_) ledger_.wall_work += -w.force.dot(w.vel) * dt;
+    }  // (implicit barrier: servo velocities and the work terms use this step's loads)
+
+#pragma omp for schedule(static) reduction(&& : finite)
+    for (std::size_t i = 0; i < n; ++i) {
+      damp_[i] = integrate_particle(p_, i, cfg_.gravity, cfg_.damping, dt);
+      finite = finite && std::isfinite(p_.pos[i].squaredNorm()) &&
+               std::isfinite(p_.vel[i].squaredNorm());
     }
   }
   if (!(max_overlap_ratio <= cfg_.max_overlap_ratio))
@@ -228,30 +304,8 @@ void Simulation::step() {
                  std::to_string(max_overlap_ratio) + " radius exceeds " +
                  std::to_string(cfg_.max_overlap_ratio) +
                  " (time step too large or walls too fast?)");
-
-  update_servos();
-  // Work of gravity and walls over this step (velocities of the step).
-  double grav = 0;
-  for (std::size_t i = 0; i < n; ++i)
-    if (!p_.fixed[i]) grav += p_.mass[i] * cfg_.gravity.dot(p_.vel[i]);
-  ledger_.gravity_work += grav * dt;
-  for (const auto& w : walls_) ledger_.wall_work += -w.force.dot(w.vel) * dt;
-  double ext = 0;
-  for (std::size_t i = 0; i < n; ++i)
-    if (!p_.fixed[i]) ext += p_.external_force[i].dot(p_.vel[i]);
-  ledger_.external_work += ext * dt;
-
-  damp_.resize(n);
-  auto& damp = damp_;
-  bool finite = true;
-#pragma omp parallel for num_threads(threads) schedule(static) reduction(&& : finite)
-  for (std::size_t i = 0; i < n; ++i) {
-    damp[i] = integrate_particle(p_, i, cfg_.gravity, cfg_.damping, dt);
-    finite =
-        finite && std::isfinite(p_.pos[i].squaredNorm()) && std::isfinite(p_.vel[i].squaredNorm());
-  }
   if (!finite) throw BlowUp("step " + std::to_string(step_) + ": non-finite particle state");
-  for (double d : damp) ledger_.damping_dissipation += d;
+  for (const double d : damp_) ledger_.damping_dissipation += d;
   for (auto& w : walls_) {
     w.pos += w.vel * dt;
     const double om = w.spec.angular_velocity.norm();

@@ -117,6 +117,8 @@ class Simulation {
   /// Geometry and body motions of candidate pair k; false when the centres coincide.
   bool pair_geometry(std::size_t k, ContactGeometry& g, BodyMotion& m1, BodyMotion& m2) const;
   void update_servos();
+  /// Wall loads, dissipation and work terms of this step, summed in pair / particle order.
+  void accumulate_walls_and_ledger(std::size_t np);
 
   SimulationConfig cfg_;
   ParticleState p_;
@@ -126,7 +128,11 @@ class Simulation {
   std::vector<ContactParams> params_;
   std::vector<ContactLoads> loads_;
   std::vector<std::uint8_t> active_;
-  std::vector<double> damp_;  // per-particle damping dissipation of the step
+  std::vector<double> damp_;         // per-particle damping dissipation of the step
+  std::vector<double> dissipation_;  // friction and rolling dissipation of each pair this step
+  // Pairs of each particle, in pair order (CSR), and the wall pairs: loads are gathered per
+  // particle in parallel with the sums in the order of a serial pass over the pairs.
+  std::vector<std::uint32_t> pair_start_, pair_of_, wall_pairs_;
   std::int64_t step_ = 0;
   double time_ = 0;
   std::int64_t wall_id_base_ = 0;
