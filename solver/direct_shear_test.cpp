@@ -65,7 +65,10 @@ SpecimenGauge shear_box_gauge(const ShearBoxGeometry& g, const ShearBoxWalls& w)
 
 DirectShearTest::DirectShearTest(DirectShearSpec spec, ShearBoxGeometry geometry,
                                  ShearBoxWalls walls)
-    : spec_(spec), g_(geometry), w_(walls) {
+    : MeasuredProgramme({spec.max_displacement_m, spec.frame_every_m}),
+      spec_(spec),
+      g_(geometry),
+      w_(walls) {
   if (!(spec_.normal_stress_Pa > 0)) throw std::invalid_argument("normal stress must be positive");
   if (!(spec_.shear_velocity_m_s > 0))
     throw std::invalid_argument("shear velocity must be positive");
@@ -108,18 +111,6 @@ double DirectShearTest::shear_stress(const Simulation& sim) const {
   double fx = sim.walls()[w_.platen].force.x();
   for (const auto k : w_.upper) fx += sim.walls()[k].force.x();
   return -fx / (g_.length_m * g_.width_m);
-}
-
-bool DirectShearTest::finished(const Simulation& sim) const {
-  return target_.reached(displacement(sim));
-}
-
-double DirectShearTest::progress(const Simulation& sim) const {
-  return target_.progress(displacement(sim));
-}
-
-std::int64_t DirectShearTest::frame_index(const Simulation& sim) const {
-  return target_.frame_index(displacement(sim));
 }
 
 std::string DirectShearTest::curve_header() const {

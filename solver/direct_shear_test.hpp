@@ -48,17 +48,15 @@ struct DirectShearSpec {
   double max_platen_speed_m_s = 0.05;
 };
 
-class DirectShearTest final : public LoadingProgramme {
+class DirectShearTest final : public MeasuredProgramme {
  public:
   DirectShearTest(DirectShearSpec spec, ShearBoxGeometry geometry, ShearBoxWalls walls);
+  double measure(const Simulation& sim) const override { return displacement(sim); }
   std::string name() const override { return "direct_shear"; }
   void start(Simulation& sim) override;
   void control(Simulation& sim) override;
-  bool finished(const Simulation& sim) const override;
-  double progress(const Simulation& sim) const override;
   std::string curve_header() const override;
   std::string curve_row(const Simulation& sim) const override;
-  std::int64_t frame_index(const Simulation& sim) const override;
   std::string summary(const Simulation& sim) const override;
   std::string save_state() const override;
   void load_state(const std::string& state) override;
@@ -74,7 +72,6 @@ class DirectShearTest final : public LoadingProgramme {
   ShearBoxGeometry g_;
   ShearBoxWalls w_;
   double x0_ = 0, h0_ = 0;
-  MeasureTarget target_;
   mutable double peak_ratio_ = 0;
 };
 

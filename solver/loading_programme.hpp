@@ -82,6 +82,23 @@ struct MeasureTarget {
   std::int64_t frame_index(double v) const;
 };
 
+/// A test driven until a monotonic measure of its loading (axial strain, displacement) reaches
+/// the target's maximum, with a frame every `target.every` of it.
+class MeasuredProgramme : public LoadingProgramme {
+ public:
+  explicit MeasuredProgramme(MeasureTarget target) : target_(target) {}
+  /// The measure of the loading so far.
+  virtual double measure(const Simulation& sim) const = 0;
+  bool finished(const Simulation& sim) const final { return target_.reached(measure(sim)); }
+  double progress(const Simulation& sim) const final { return target_.progress(measure(sim)); }
+  std::int64_t frame_index(const Simulation& sim) const final {
+    return target_.frame_index(measure(sim));
+  }
+
+ protected:
+  MeasureTarget target_;
+};
+
 /// Warns once on stderr when the inertial number exceeds `threshold` (not quasi-static).
 struct InertialWarning {
   double threshold = 1e-4;

@@ -29,8 +29,8 @@ std::vector<WallSpec> membrane_clamps() {
 }
 
 PlaneStrainTest::PlaneStrainTest(PlaneStrainSpec spec)
-    : spec_(spec),
-      target_{spec.max_strain, spec.frame_every_strain},
+    : MeasuredProgramme({spec.max_strain, spec.frame_every_strain}),
+      spec_(spec),
       inertial_warning_{spec.inertial_warning} {
   if (!(spec_.confining_Pa > 0)) throw std::invalid_argument("confining pressure must be positive");
   if (!(spec_.strain_rate_1_s > 0)) throw std::invalid_argument("strain rate must be positive");
@@ -95,18 +95,6 @@ void PlaneStrainTest::control(Simulation& sim) {
 
 double PlaneStrainTest::axial_strain(const Simulation& sim) const {
   return (h0_ - (cuboid_hi(sim).z() - cuboid_lo(sim).z())) / h0_;
-}
-
-bool PlaneStrainTest::finished(const Simulation& sim) const {
-  return target_.reached(axial_strain(sim));
-}
-
-double PlaneStrainTest::progress(const Simulation& sim) const {
-  return target_.progress(axial_strain(sim));
-}
-
-std::int64_t PlaneStrainTest::frame_index(const Simulation& sim) const {
-  return target_.frame_index(axial_strain(sim));
 }
 
 std::string PlaneStrainTest::curve_header() const {

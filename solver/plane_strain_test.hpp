@@ -36,17 +36,15 @@ struct PlaneStrainSpec {
 /// cuboid planes.
 std::vector<WallSpec> membrane_clamps();
 
-class PlaneStrainTest final : public LoadingProgramme {
+class PlaneStrainTest final : public MeasuredProgramme {
  public:
   explicit PlaneStrainTest(PlaneStrainSpec spec);
+  double measure(const Simulation& sim) const override { return axial_strain(sim); }
   std::string name() const override { return "plane_strain"; }
   void start(Simulation& sim) override;
   void control(Simulation& sim) override;
-  bool finished(const Simulation& sim) const override;
-  double progress(const Simulation& sim) const override;
   std::string curve_header() const override;
   std::string curve_row(const Simulation& sim) const override;
-  std::int64_t frame_index(const Simulation& sim) const override;
   std::string summary(const Simulation& sim) const override;
   std::string save_state() const override;
   void load_state(const std::string& state) override;
@@ -65,7 +63,6 @@ class PlaneStrainTest final : public LoadingProgramme {
   double h0_ = 0, v0_ = 0, d50_ = 0;
   std::int64_t start_step_ = 0;
   mutable double max_phi_deg_ = 0;
-  MeasureTarget target_;
   mutable InertialWarning inertial_warning_;
 };
 

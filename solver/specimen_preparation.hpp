@@ -1,9 +1,10 @@
 // Specimen preparation (seed 004 §4.1.2, §4.2.2; seed 003 §2.4): optional gravitational
-// deposition (gravity on until the preparation ends, then the scene's restored), then compaction by servo-controlled walls to a target stress σc while the
-// inter-particle friction is lowered step by step until a target void ratio is reached (YADE's
-// classic "triax" procedure), then the friction of the test is restored and the specimen is left
-// to settle. Each stage ends on equilibrium: wall stresses within a tolerance of σc, YADE's
-// unbalanced-force ratio and the kinetic / elastic energy ratio below thresholds.
+// deposition (gravity on until the preparation ends, then the scene's restored), then compaction by
+// servo-controlled walls to a target stress σc while the inter-particle friction is lowered step by
+// step until a target void ratio is reached (YADE's classic "triax" procedure), then the friction
+// of the test is restored and the specimen is left to settle. Each stage ends on equilibrium: wall
+// stresses within a tolerance of σc, YADE's unbalanced-force ratio and the kinetic / elastic energy
+// ratio below thresholds.
 #pragma once
 
 #include <Eigen/Core>

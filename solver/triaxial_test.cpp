@@ -16,8 +16,8 @@ double mobilised_friction_deg(double sigma1, double sigma3) {
 }
 
 TriaxialTest::TriaxialTest(TriaxialSpec spec)
-    : spec_(spec),
-      target_{spec.max_strain, spec.frame_every_strain},
+    : MeasuredProgramme({spec.max_strain, spec.frame_every_strain}),
+      spec_(spec),
       inertial_warning_{spec.inertial_warning} {
   if (!(spec_.confining_Pa > 0)) throw std::invalid_argument("confining pressure must be positive");
   if (!(spec_.strain_rate_1_s > 0)) throw std::invalid_argument("strain rate must be positive");
@@ -69,18 +69,6 @@ double TriaxialTest::inertial_number(const Simulation& sim) const {
   const double p = s.mean();
   if (!(p > 0)) return std::numeric_limits<double>::quiet_NaN();
   return spec_.strain_rate_1_s * d50_ / std::sqrt(p / sim.config().material.density);
-}
-
-bool TriaxialTest::finished(const Simulation& sim) const {
-  return target_.reached(axial_strain(sim));
-}
-
-double TriaxialTest::progress(const Simulation& sim) const {
-  return target_.progress(axial_strain(sim));
-}
-
-std::int64_t TriaxialTest::frame_index(const Simulation& sim) const {
-  return target_.frame_index(axial_strain(sim));
 }
 
 std::string TriaxialTest::curve_header() const {

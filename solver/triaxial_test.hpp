@@ -21,17 +21,15 @@ struct TriaxialSpec {
   double core_inset_m = 0;  // core void ratio: box inset by this from the boundaries
 };
 
-class TriaxialTest final : public LoadingProgramme {
+class TriaxialTest final : public MeasuredProgramme {
  public:
   explicit TriaxialTest(TriaxialSpec spec);
+  double measure(const Simulation& sim) const override { return axial_strain(sim); }
   std::string name() const override { return "triaxial"; }
   void start(Simulation& sim) override;
   void control(Simulation& sim) override;
-  bool finished(const Simulation& sim) const override;
-  double progress(const Simulation& sim) const override;
   std::string curve_header() const override;
   std::string curve_row(const Simulation& sim) const override;
-  std::int64_t frame_index(const Simulation& sim) const override;
   std::string summary(const Simulation& sim) const override;
   std::string save_state() const override;
   void load_state(const std::string& state) override;
@@ -48,7 +46,6 @@ class TriaxialTest final : public LoadingProgramme {
   double h0_ = 0, v0_ = 0, d50_ = 0;
   Eigen::Vector3d size0_ = Eigen::Vector3d::Zero();
   mutable double max_phi_deg_ = 0;
-  MeasureTarget target_;
   mutable InertialWarning inertial_warning_;
 };
 
