@@ -1,5 +1,6 @@
 #include "plane_strain_test.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <iostream>
@@ -77,6 +78,7 @@ void PlaneStrainTest::start(Simulation& sim) {
   sim.set_wall_active(kXmax, false);
   h0_ = hi.z() - lo.z();
   v0_ = volume(sim);
+  top_x0_ = sim.walls()[kClamp + 2].pos.x();
   start_step_ = sim.step_count();
 }
 
@@ -85,11 +87,27 @@ double PlaneStrainTest::volume(const Simulation& sim) const {
   return membrane(sim).volume_m3 + 2 * clamp_ * b0_ * depth;
 }
 
+double PlaneStrainTest::top_shift(const Simulation& sim) const {
+  return sim.walls()[kClamp + 2].pos.x() - top_x0_;
+}
+
 void PlaneStrainTest::control(Simulation& sim) {
-  const Eigen::Vector3d v = spec_.strain_rate_1_s * h0_ * cuboid_inward(kZmax);
-  sim.walls()[kZmax].vel = v;
-  sim.walls()[kClamp + 2].vel = v;  // the top clamps move with the top cap
-  sim.walls()[kClamp + 3].vel = v;
+  const double axial_speed = spec_.strain_rate_1_s * h0_;
+  const Eigen::Vector3d v = axial_speed * cuboid_inward(kZmax);
+  sim.walls()[kZmax].vel = v;  // frictionless: its own lateral motion would change nothing
+  Eigen::Vector3d vc = v;      // the top clamps move with the top cap, and on the sledge
+  if (spec_.top_sledge) {
+    // Lateral force of the grains on the sledge (cap frictionless: the clamps take it all).
+    double fx = 0, k = 0;
+    for (const std::size_t w : {kClamp + 2, kClamp + 3}) {
+      fx += sim.walls()[w].force.x();
+      k += sim.wall_stiffness(w).first;
+    }
+    if (k > 0)
+      vc.x() = std::clamp(spec_.sledge_gain * fx / k / sim.config().dt, -axial_speed, axial_speed);
+  }
+  sim.walls()[kClamp + 2].vel = vc;
+  sim.walls()[kClamp + 3].vel = vc;
   if ((sim.step_count() - start_step_) % spec_.refresh_steps == 0) refresh(sim);
 }
 
@@ -101,7 +119,7 @@ std::string PlaneStrainTest::curve_header() const {
   return "step,time_s,eps1_shortening,eps_v_dilation,sigma1_Pa,sigma2_Pa,sigma3_Pa,p_Pa,q_Pa,"
          "sin_phi,phi_deg,void_ratio,core_void_ratio,width_m,coordination,inertial_number,"
          "unbalanced_force,"
-         "membrane_particles";
+         "membrane_particles,top_shift_m";
 }
 
 std::string PlaneStrainTest::curve_row(const Simulation& sim) const {
@@ -142,11 +160,11 @@ std::string PlaneStrainTest::curve_row(const Simulation& sim) const {
   char buf[512];
   std::snprintf(buf, sizeof buf,
                 "%lld,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.6g,%.6g,"
-                "%.6g,%zu",
+                "%.6g,%zu,%.9g",
                 static_cast<long long>(sim.step_count()), sim.time(), axial_strain(sim),
                 (vol - v0_) / v0_, s1, s2, s3, p, q, (s1 - s3) / (s1 + s3), phi,
                 vol / solid_volume(sim) - 1, e_core, width, coordination_number(sim), inertial,
-                sim.unbalanced_force(), m.particle.size());
+                sim.unbalanced_force(), m.particle.size(), top_shift(sim));
   return buf;
 }
 
@@ -165,6 +183,7 @@ std::string PlaneStrainTest::save_state() const {
   st.set("start_step", start_step_);
   st.set("clamp", clamp_);
   st.set("b0", b0_);
+  st.set("top_x0", top_x0_);
   st.set("max_phi", max_phi_deg_);
   st.set("warned", static_cast<std::int64_t>(inertial_warning_.warned));
   return st.text();
@@ -178,6 +197,7 @@ void PlaneStrainTest::load_state(const std::string& state) {
   start_step_ = st.integer("start_step");
   clamp_ = st.number("clamp");
   b0_ = st.number("b0");
+  top_x0_ = st.number("top_x0");
   max_phi_deg_ = st.number("max_phi");
   inertial_warning_.warned = st.integer("warned") != 0;
 }

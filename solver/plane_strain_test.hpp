@@ -11,6 +11,14 @@
 // top). Without the clamps nothing holds the ends of the specimen laterally — the caps are
 // frictionless — and a dense specimen sways as a whole into a parallelogram, shedding all its
 // strength (moment equilibrium then forces σ1 → σc), instead of forming a shear zone.
+//
+// The top cap rides on a lateral sledge, as in the biaxial apparatus of Vardoulakis and of
+// Tejchman: the top cap and its clamps move freely along x (no lateral force on them), while the
+// bottom is held. A single inclined shear zone moves the block above it sideways; with both ends
+// held laterally it must cross the specimen twice (crossed or reflected bands). The sledge has no
+// inertia: its x velocity is a servo that cancels the lateral force the grains exert on the top
+// clamps (gain `sledge_gain`, like the stress servos), capped at the cap's axial speed.
+// `top_cap = "fixed"` holds both ends.
 #pragma once
 
 #include "flexible_membrane.hpp"
@@ -27,6 +35,8 @@ struct PlaneStrainSpec {
   double membrane_stencil_m = 0;  // slope stencil half-width (0: d50)
   std::int64_t refresh_steps = 20;
   double clamp_height_m = 0;  // membrane clamped to the caps over this height (0: d50)
+  bool top_sledge = true;     // top cap free along x (false: held)
+  double sledge_gain = 0.25;  // fraction of the lateral force removed per step
   double inertial_warning = 1e-4;
   double d50_m = 0;         // 0: mean diameter
   double core_inset_m = 0;  // core void ratio: box inset by this from the boundaries
@@ -54,13 +64,15 @@ class PlaneStrainTest final : public MeasuredProgramme {
   MembraneLoads membrane(const Simulation& sim) const;
   /// Specimen volume: between the membranes, plus the clamped ends.
   double volume(const Simulation& sim) const;
+  /// Lateral (x) displacement of the top cap since the start of loading, m.
+  double top_shift(const Simulation& sim) const;
 
  private:
   void refresh(Simulation& sim);
 
   PlaneStrainSpec spec_;
   double clamp_ = 0, b0_ = 0;  // clamp height and the width between the clamps
-  double h0_ = 0, v0_ = 0, d50_ = 0;
+  double h0_ = 0, v0_ = 0, d50_ = 0, top_x0_ = 0;
   std::int64_t start_step_ = 0;
   mutable double max_phi_deg_ = 0;
   mutable InertialWarning inertial_warning_;

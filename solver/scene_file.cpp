@@ -131,7 +131,8 @@ void read_lab_sections(const Reader& r, const toml::table& root, Scene& s) {
     const auto* t = r.table("plane_strain", true);
     r.only(t, "plane_strain",
            {"confining_Pa", "strain_rate_1_s", "max_strain", "frame_every_strain", "membrane_bin_m",
-            "membrane_stencil_m", "refresh_steps", "inertial_warning"});
+            "membrane_stencil_m", "refresh_steps", "clamp_height_m", "top_cap", "sledge_gain",
+            "inertial_warning"});
     auto& x = s.plane_strain;
     x.confining_Pa = r.positive(t, "plane_strain", "confining_Pa", true, 0);
     x.strain_rate_1_s = r.positive(t, "plane_strain", "strain_rate_1_s", true, 0);
@@ -144,6 +145,14 @@ void read_lab_sections(const Reader& r, const toml::table& root, Scene& s) {
     x.membrane_stencil_m = r.number(t, "plane_strain", "membrane_stencil_m", false, 0);
     x.refresh_steps = r.integer(t, "plane_strain", "refresh_steps", false, x.refresh_steps, 1);
     x.clamp_height_m = r.number(t, "plane_strain", "clamp_height_m", false, 0);
+    const std::string cap = r.string(t, "plane_strain", "top_cap", false, "sledge");
+    if (cap == "sledge")
+      x.top_sledge = true;
+    else if (cap == "fixed")
+      x.top_sledge = false;
+    else
+      r.fail("plane_strain.top_cap", "expected \"sledge\" or \"fixed\"", cap);
+    x.sledge_gain = r.positive(t, "plane_strain", "sledge_gain", false, x.sledge_gain);
     x.inertial_warning =
         r.positive(t, "plane_strain", "inertial_warning", false, x.inertial_warning);
   } else if (s.test == "direct_shear") {

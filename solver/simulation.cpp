@@ -179,7 +179,7 @@ void Simulation::update_servos() {
   }
 }
 
-void Simulation::accumulate_walls_and_ledger(std::size_t np) {
+void Simulation::accumulate_walls() {
   for (auto& w : walls_) {
     w.force.setZero();
     w.torque.setZero();
@@ -196,21 +196,6 @@ void Simulation::accumulate_walls_and_ledger(std::size_t np) {
     w.torque += L.arm1;
     w.torque += -L.moment;
   }
-  for (std::size_t k = 0; k < np; ++k) {
-    if (!active_[k]) continue;
-    ledger_.friction_dissipation += dissipation_[2 * k];
-    ledger_.rolling_dissipation += dissipation_[2 * k + 1];
-  }
-  // Work of gravity, of the walls and of applied loads over this step (velocities of the step).
-  const double dt = cfg_.dt;
-  double grav = 0, ext = 0;
-  for (std::size_t i = 0; i < p_.size(); ++i) {
-    if (p_.fixed[i]) continue;
-    grav += p_.mass[i] * cfg_.gravity.dot(p_.vel[i]);
-    ext += p_.external_force[i].dot(p_.vel[i]);
-  }
-  ledger_.gravity_work += grav * dt;
-  ledger_.external_work += ext * dt;
 }
 
 void Simulation::step() {
@@ -222,7 +207,12 @@ void Simulation::step() {
   dissipation_.resize(2 * np);
   const int threads = std::max(1, cfg_.threads);
   const std::size_t n = p_.size();
-  damp_.resize(n);
+  // Ledger terms summed per particle (a pair's dissipation goes to its body 1, in pair order),
+  // then per chunk of kChunk particles, then over the chunks in order: the same sums for any
+  // number of threads, and for any Verlet list holding the same contacts (a resumed run).
+  const std::size_t chunks = (n + kChunk - 1) / kChunk;
+  chunk_sums_.resize(kSums * chunks);
+  particle_dissipation_.resize(2 * n);
   double max_overlap_ratio = 0;
   bool finite = true;
   // One parallel region per step (a region per loop lets the idle thread fall asleep between
@@ -266,10 +256,15 @@ void Simulation::step() {
 #pragma omp for schedule(static)
     for (std::size_t i = 0; i < n; ++i) {
       Eigen::Vector3d f = p_.external_force[i], t = Eigen::Vector3d::Zero();
+      double fr = 0, ro = 0;  // dissipation of the pairs whose body 1 this particle is
       for (std::uint32_t e = pair_start_[i]; e < pair_start_[i + 1]; ++e) {
         const std::uint32_t k = pair_of_[e] >> 1;
         if (!active_[k]) continue;
         const ContactLoads& L = loads_[k];
+        if ((pair_of_[e] & 1u) == 0) {
+          fr += dissipation_[2 * k];
+          ro += dissipation_[2 * k + 1];
+        }
         const bool first = (pair_of_[e] & 1u) == 0 && nl_.pairs[k].second < kWallBase;
         if (first) {  // body 1 of a sphere pair
           f += L.force1;
@@ -283,21 +278,46 @@ void Simulation::step() {
       }
       p_.force[i] = f;
       p_.torque[i] = t;
+      particle_dissipation_[2 * i] = fr;
+      particle_dissipation_[2 * i + 1] = ro;
     }
 
 #pragma omp single
     {
-      accumulate_walls_and_ledger(np);
+      accumulate_walls();
       update_servos();
       for (const auto& w : walls_) ledger_.wall_work += -w.force.dot(w.vel) * dt;
     }  // (implicit barrier: servo velocities and the work terms use this step's loads)
 
+    // Integration, with the work of gravity and of applied loads over this step (velocities of
+    // the step, before the update) and the damping dissipation, summed per fixed chunk.
 #pragma omp for schedule(static) reduction(&& : finite)
-    for (std::size_t i = 0; i < n; ++i) {
-      damp_[i] = integrate_particle(p_, i, cfg_.gravity, cfg_.damping, dt);
-      finite = finite && std::isfinite(p_.pos[i].squaredNorm()) &&
-               std::isfinite(p_.vel[i].squaredNorm());
+    for (std::size_t c = 0; c < chunks; ++c) {
+      double fr = 0, ro = 0, grav = 0, ext = 0, damp = 0;
+      for (std::size_t i = c * kChunk; i < std::min(n, (c + 1) * kChunk); ++i) {
+        fr += particle_dissipation_[2 * i];
+        ro += particle_dissipation_[2 * i + 1];
+        if (!p_.fixed[i]) {
+          grav += p_.mass[i] * cfg_.gravity.dot(p_.vel[i]);
+          ext += p_.external_force[i].dot(p_.vel[i]);
+        }
+        damp += integrate_particle(p_, i, cfg_.gravity, cfg_.damping, dt);
+        finite = finite && std::isfinite(p_.pos[i].squaredNorm()) &&
+                 std::isfinite(p_.vel[i].squaredNorm());
+      }
+      chunk_sums_[kSums * c] = fr;
+      chunk_sums_[kSums * c + 1] = ro;
+      chunk_sums_[kSums * c + 2] = grav;
+      chunk_sums_[kSums * c + 3] = ext;
+      chunk_sums_[kSums * c + 4] = damp;
     }
+  }
+  for (std::size_t c = 0; c < chunks; ++c) {
+    ledger_.friction_dissipation += chunk_sums_[kSums * c];
+    ledger_.rolling_dissipation += chunk_sums_[kSums * c + 1];
+    ledger_.gravity_work += chunk_sums_[kSums * c + 2] * dt;
+    ledger_.external_work += chunk_sums_[kSums * c + 3] * dt;
+    ledger_.damping_dissipation += chunk_sums_[kSums * c + 4];
   }
   if (!(max_overlap_ratio <= cfg_.max_overlap_ratio))
     throw BlowUp("step " + std::to_string(step_) + ": overlap of " +
@@ -305,7 +325,6 @@ void Simulation::step() {
                  std::to_string(cfg_.max_overlap_ratio) +
                  " (time step too large or walls too fast?)");
   if (!finite) throw BlowUp("step " + std::to_string(step_) + ": non-finite particle state");
-  for (const double d : damp_) ledger_.damping_dissipation += d;
   for (auto& w : walls_) {
     w.pos += w.vel * dt;
     const double om = w.spec.angular_velocity.norm();
@@ -496,7 +515,7 @@ Frame Simulation::frame() const {
 // ------------------------------------------------------------------ checkpoints
 
 namespace {
-constexpr char kMagic[8] = {'G', 'S', 'C', 'K', 'P', 'T', '0', '2'};
+constexpr char kMagic[8] = {'G', 'S', 'C', 'K', 'P', 'T', '0', '3'};
 
 template <class T>
 void put(std::ostream& o, const T& v) {
@@ -549,6 +568,7 @@ void Simulation::save_checkpoint(const std::filesystem::path& path,
     put(o, static_cast<std::uint64_t>(walls_.size()));
     for (const auto& w : walls_) {
       put(o, w.pos);
+      put(o, w.spec.half_extents);  // a test may size its walls when loading starts (clamps)
       put(o, w.normal);
       put(o, w.vel);
       put(o, static_cast<std::uint8_t>(w.active));
@@ -602,6 +622,7 @@ std::string Simulation::load_checkpoint(const std::filesystem::path& path) {
     throw InputError(file, "checkpoint does not match the scene (walls)", std::to_string(nw));
   for (auto& w : walls_) {
     get(in, w.pos, file);
+    get(in, w.spec.half_extents, file);
     get(in, w.normal, file);
     get(in, w.vel, file);
     std::uint8_t active = 1;

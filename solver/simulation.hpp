@@ -118,7 +118,7 @@ class Simulation {
   bool pair_geometry(std::size_t k, ContactGeometry& g, BodyMotion& m1, BodyMotion& m2) const;
   void update_servos();
   /// Wall loads, dissipation and work terms of this step, summed in pair / particle order.
-  void accumulate_walls_and_ledger(std::size_t np);
+  void accumulate_walls();
 
   SimulationConfig cfg_;
   ParticleState p_;
@@ -128,7 +128,9 @@ class Simulation {
   std::vector<ContactParams> params_;
   std::vector<ContactLoads> loads_;
   std::vector<std::uint8_t> active_;
-  std::vector<double> damp_;         // per-particle damping dissipation of the step
+  static constexpr std::size_t kChunk = 256, kSums = 5;
+  std::vector<double> chunk_sums_;  // per chunk: friction, rolling, gravity, external, damping
+  std::vector<double> particle_dissipation_;  // friction and rolling of the step, per body 1
   std::vector<double> dissipation_;  // friction and rolling dissipation of each pair this step
   // Pairs of each particle, in pair order (CSR), and the wall pairs: loads are gathered per
   // particle in parallel with the sums in the order of a serial pass over the pairs.

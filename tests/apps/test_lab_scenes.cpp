@@ -127,17 +127,49 @@ TEST(LabScenes, PlaneStrainMembraneCarriesTheConfiningPressure) {
     EXPECT_EQ(f.walls[1].force.norm(), 0.0);
     EXPECT_GT(f.walls[5].force.norm(), 0.0);  // top cap loaded
   }
-  // The membrane is clamped to the caps: the clamp walls (6-9) stay at the x of the specimen's
-  // faces, the top ones follow the top cap down.
-  const auto& w0 = t.frames.front().walls, &w1 = t.frames.back().walls;
+  // The membrane is clamped to the caps: the bottom clamp walls (6, 7) stay where they were,
+  // the top ones (8, 9) follow the top cap down and ride on its sledge along x, together, by the
+  // shift the curve reports.
+  const auto &w0 = t.frames.front().walls, &w1 = t.frames.back().walls;
   ASSERT_EQ(w0.size(), 10u);
-  for (std::size_t k = 6; k < 10; ++k) EXPECT_EQ(w1[k].a.x(), w0[k].a.x());
-  EXPECT_EQ(w1[6].a.z(), w0[6].a.z());
-  EXPECT_NEAR(w1[8].a.z() - w0[8].a.z(), w1[5].a.z() - w0[5].a.z(), 1e-15);
-  EXPECT_NEAR(w1[9].a.z() - w0[9].a.z(), w1[5].a.z() - w0[5].a.z(), 1e-15);
+  EXPECT_EQ(w1[6].a, w0[6].a);
+  EXPECT_EQ(w1[7].a, w0[7].a);
+  const double shift = c.at(c.rows.size() - 1, "top_shift_m");
+  EXPECT_NE(shift, 0.0);
+  for (std::size_t k : {8u, 9u}) {
+    EXPECT_NEAR(w1[k].a.x() - w0[k].a.x(), shift, 1e-8 * std::abs(shift));  // CSV: 9 digits
+    EXPECT_NEAR(w1[k].a.z() - w0[k].a.z(), w1[5].a.z() - w0[5].a.z(), 1e-15);
+  }
+  // The sledge's servo holds the lateral force of the grains on the top clamps near zero: the
+  // net force is a small part of what the two clamps carry.
+  for (std::size_t f = 1; f < t.frames.size(); ++f) {
+    const auto& w = t.frames[f].walls;
+    const double net = std::abs(w[8].force.x() + w[9].force.x());
+    EXPECT_LT(net, 0.2 * (std::abs(w[8].force.x()) + std::abs(w[9].force.x())) + 1e-12)
+        << "frame " << f;
+  }
   // External work of the membrane appears in the energy ledger.
   const Csv h = read_csv(dir / "history.csv");
   EXPECT_NE(h.at(h.rows.size() - 1, "external_work_J"), 0.0);
+}
+
+TEST(LabScenes, PlaneStrainWithAFixedTopCapHoldsBothEnds) {
+  gs::test::ScratchDir dir("lab_plane_strain_fixed");
+  std::string text = slurp(scene("plane_strain_tiny"));
+  const std::string key = "[plane_strain]\n";
+  text.replace(text.find(key), key.size(), key + "top_cap = \"fixed\"\n");
+  const fs::path toml = dir / "plane_strain_fixed.toml";
+  std::ofstream(toml) << text;
+  const auto r = run_cli("simulate " + toml.string() + " -q -o " + dir.path.string(), dir.path);
+  ASSERT_EQ(r.rc, 0) << r.err;
+  const auto t = gs::read_hdf5_trajectory(dir / "plane_strain.h5");
+  ASSERT_GE(t.frames.size(), 3u);
+  const auto &w0 = t.frames.front().walls, &w1 = t.frames.back().walls;
+  for (std::size_t k = 6; k < 10; ++k) EXPECT_EQ(w1[k].a.x(), w0[k].a.x());
+  const Csv c = read_csv(dir / "curve.csv");
+  EXPECT_EQ(c.at(c.rows.size() - 1, "top_shift_m"), 0.0);
+  // Without the sledge the clamps take a lateral force.
+  EXPECT_GT(std::abs(w1[8].force.x() + w1[9].force.x()), 0.0);
 }
 
 TEST(LabScenes, DirectShearBoxAndCurve) {
@@ -179,8 +211,9 @@ TEST(LabScenes, DirectShearBoxAndCurve) {
 
 // Kill a run once its checkpoint index passes `kill_after` steps, resume it, and compare every
 // output with an uninterrupted run.
-void expect_resume_identical(const std::string& name, std::int64_t kill_after) {
-  gs::test::ScratchDir dir("lab_resume_" + std::to_string(kill_after));
+void expect_resume_identical(const std::string& name, std::int64_t kill_after,
+                             const std::string& trajectory) {
+  gs::test::ScratchDir dir("lab_resume_" + name + std::to_string(kill_after));
   ASSERT_EQ(
       run_cli("simulate " + scene(name) + " -q -o " + (dir / "straight").string(), dir.path).rc, 0);
   const fs::path killed = dir / "killed";
@@ -211,8 +244,8 @@ void expect_resume_identical(const std::string& name, std::int64_t kill_after) {
   ASSERT_EQ(r.rc, 0) << r.err;
   for (const char* f : {"history.csv", "curve.csv", "preparation.csv"})
     EXPECT_EQ(slurp(dir / "straight" / f), slurp(killed / f)) << f;
-  const auto a = gs::read_hdf5_trajectory(dir / "straight" / "triaxial.h5");
-  const auto b = gs::read_hdf5_trajectory(killed / "triaxial.h5");
+  const auto a = gs::read_hdf5_trajectory(dir / "straight" / trajectory);
+  const auto b = gs::read_hdf5_trajectory(killed / trajectory);
   ASSERT_EQ(a.frames.size(), b.frames.size());
   for (std::size_t i = 0; i < a.frames.size(); ++i)
     gs::test::expect_same_frame(a.frames[i], b.frames[i]);
@@ -222,11 +255,17 @@ void expect_resume_identical(const std::string& name, std::int64_t kill_after) {
 }
 
 TEST(LabScenes, ResumeDuringPreparationIsBitForBitIdentical) {
-  expect_resume_identical("triaxial_tiny", 2000);
+  expect_resume_identical("triaxial_tiny", 2000, "triaxial.h5");
 }
 
 TEST(LabScenes, ResumeDuringLoadingIsBitForBitIdentical) {
-  expect_resume_identical("triaxial_tiny", 10500);
+  expect_resume_identical("triaxial_tiny", 10500, "triaxial.h5");
+}
+
+// The plane strain's sledge and membrane are driven by the wall forces and loads of the last
+// step: a resume during loading must restore them exactly.
+TEST(LabScenes, PlaneStrainResumeDuringLoadingIsBitForBitIdentical) {
+  expect_resume_identical("plane_strain_tiny", 8500, "plane_strain.h5");
 }
 
 TEST(LabScenes, BadScenesExitTwoWithOneLine) {
