@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Solver speed against YADE 2023.02a and LIGGGHTS 3.8 (Debian packages), same cases, same machine,
 # same script. Prints particle-steps/s and ratios, and granoscope's memory per particle.
-#   bench/solver/run_solver_bench.sh [BUILD_DIR]     (needs: apt-get install yade liggghts)
+#   bench/solver/run_solver_bench.sh [BUILD_DIR]     (needs: apt-get install --no-install-recommends yade liggghts)
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
 root=$(cd "$here/../.." && pwd)

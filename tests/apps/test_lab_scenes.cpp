@@ -268,6 +268,12 @@ TEST(LabScenes, PlaneStrainResumeDuringLoadingIsBitForBitIdentical) {
   expect_resume_identical("plane_strain_tiny", 8500, "plane_strain.h5");
 }
 
+// Direct shear: the frames, the platen's servo and the gap closers switched off at the start of
+// shearing.
+TEST(LabScenes, DirectShearResumeDuringShearingIsBitForBitIdentical) {
+  expect_resume_identical("direct_shear_tiny", 30000, "direct_shear.h5");
+}
+
 TEST(LabScenes, BadScenesExitTwoWithOneLine) {
   gs::test::ScratchDir dir("lab_bad");
   const std::string base = slurp(kScenes / "triaxial_tiny.toml");
