@@ -3,14 +3,16 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cmath>
+
+#include "scalar_vec3.hpp"
 
 namespace gs::solver {
 
 /// Geometry of one pair at the current positions. Body 1 is the wall for wall contacts (YADE
 /// orders box–sphere interactions box first); the normal points from body 1 to body 2.
 struct ContactGeometry {
-  Eigen::Vector3d normal = Eigen::Vector3d::Zero();
-  Eigen::Vector3d point = Eigen::Vector3d::Zero();
+  V3 normal, point;
   double penetration = 0;  // > 0 when overlapping
   double radius1 = 0, radius2 = 0;
   /// YADE's avoidGranularRatcheting: relative velocity from the radii (true) or from the
@@ -20,20 +22,69 @@ struct ContactGeometry {
 
 /// Sphere–sphere: normal = (x2 − x1)/|x2 − x1|, penetration = r1 + r2 − |x2 − x1|, contact
 /// point x1 + (r1 − pen/2)·n. Returns false when the centres coincide.
-bool sphere_sphere_geometry(const Eigen::Vector3d& x1, double r1, const Eigen::Vector3d& x2,
-                            double r2, ContactGeometry& g);
+[[gnu::always_inline]] inline bool sphere_sphere_geometry(const V3& x1, double r1, const V3& x2, double r2,
+                                   ContactGeometry& g) {
+  V3 n = x2 - x1;
+  const double d = std::sqrt(squared_norm(n));
+  if (!(d > 0)) return false;
+  n = n / d;
+  g.normal = n;
+  g.penetration = r1 + r2 - d;
+  g.point = x1 + (r1 - 0.5 * g.penetration) * n;
+  g.radius1 = r1;
+  g.radius2 = r2;
+  g.ratchet_free = true;
+  return true;
+}
 
 /// Axis-aligned box (centre c, half-extents h) and a sphere. Sphere centre outside the box:
 /// normal from the closest box point to the centre, penetration r − distance, contact point
 /// half-way between the box point and the sphere surface. Centre inside: normal along the
 /// nearest face's outward normal. Both radii are the sphere radius (YADE's convention).
-void box_sphere_geometry(const Eigen::Vector3d& c, const Eigen::Vector3d& h,
-                         const Eigen::Vector3d& x, double r, ContactGeometry& g);
+void box_sphere_geometry_inside(const V3& h, const V3& x, const V3& on_box, double r,
+                                ContactGeometry& g);
+[[gnu::always_inline]] inline void box_sphere_geometry(const V3& c, const V3& h, const V3& x,
+                                                       double r, ContactGeometry& g) {
+  const V3 rel = x - c;
+  V3 on_box = rel;
+  bool inside = true;
+  auto clamp = [&](double& v, double half) {
+    if (v < -half) {
+      v = -half;
+      inside = false;
+    }
+    if (v > half) {
+      v = half;
+      inside = false;
+    }
+  };
+  clamp(on_box.x, h.x);
+  clamp(on_box.y, h.y);
+  clamp(on_box.z, h.z);
+  g.radius1 = g.radius2 = r;
+  if (inside) return box_sphere_geometry_inside(h, x, on_box, r, g);
+  V3 to_box = on_box - rel;  // from the sphere centre to the closest box point
+  const double len2 = squared_norm(to_box);
+  g.penetration = r - std::sqrt(len2);
+  const V3 pt1 = on_box + c;
+  if (len2 > 0) to_box = to_box / std::sqrt(len2);
+  const V3 pt2 = x + to_box * r;
+  g.point = 0.5 * (pt1 + pt2);
+  g.normal = -to_box;
+  g.ratchet_free = false;
+}
 
 /// Infinite plane (point p, unit normal m into the domain) and a sphere: normal m,
 /// penetration r − (x − p)·m, contact point x − (r − pen/2)·m. Both radii = r.
-void plane_sphere_geometry(const Eigen::Vector3d& p, const Eigen::Vector3d& m,
-                           const Eigen::Vector3d& x, double r, ContactGeometry& g);
+[[gnu::always_inline]] inline void plane_sphere_geometry(const V3& p, const V3& m, const V3& x, double r,
+                                  ContactGeometry& g) {
+  const double dist = dot(x - p, m);
+  g.normal = m;
+  g.penetration = r - dist;
+  g.point = x - (r - 0.5 * g.penetration) * m;
+  g.radius1 = g.radius2 = r;
+  g.ratchet_free = false;
+}
 
 /// Distance from a point to an axis-aligned box (0 inside).
 double box_distance(const Eigen::Vector3d& c, const Eigen::Vector3d& h, const Eigen::Vector3d& x);

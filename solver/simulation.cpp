@@ -147,23 +147,24 @@ void Simulation::set_wall_active(std::size_t w, bool active) {
   invalidate_neighbors();
 }
 
-bool Simulation::pair_geometry(std::size_t k, ContactGeometry& g, BodyMotion& m1,
+[[gnu::always_inline]] inline bool Simulation::pair_geometry(std::size_t k, ContactGeometry& g, BodyMotion& m1,
                                BodyMotion& m2) const {
   const auto [a, b] = nl_.pairs[k];
   if (b >= kWallBase) {
     const WallState& w = walls_[b - kWallBase];
-    if (w.spec.shape == WallShape::Box)
-      box_sphere_geometry(w.pos, w.spec.half_extents, p_.pos[a], p_.radius[a], g);
-    else
-      plane_sphere_geometry(w.pos, w.normal, p_.pos[a], p_.radius[a], g);
-    m1 = {w.pos, w.vel,
-          w.spec.shape == WallShape::Plane ? w.spec.angular_velocity : Eigen::Vector3d::Zero()};
-    m2 = {p_.pos[a], p_.vel[a], p_.angvel[a]};
+    m2 = {V3(p_.pos[a]), V3(p_.vel[a]), V3(p_.angvel[a])};
+    if (w.spec.shape == WallShape::Box) {
+      box_sphere_geometry(V3(w.pos), V3(w.spec.half_extents), m2.pos, p_.radius[a], g);
+      m1 = {V3(w.pos), V3(w.vel), V3()};
+    } else {
+      plane_sphere_geometry(V3(w.pos), V3(w.normal), m2.pos, p_.radius[a], g);
+      m1 = {V3(w.pos), V3(w.vel), V3(w.spec.angular_velocity)};
+    }
     return true;
   }
-  m1 = {p_.pos[a], p_.vel[a], p_.angvel[a]};
-  m2 = {p_.pos[b], p_.vel[b], p_.angvel[b]};
-  return sphere_sphere_geometry(p_.pos[a], p_.radius[a], p_.pos[b], p_.radius[b], g);
+  m1 = {V3(p_.pos[a]), V3(p_.vel[a]), V3(p_.angvel[a])};
+  m2 = {V3(p_.pos[b]), V3(p_.vel[b]), V3(p_.angvel[b])};
+  return sphere_sphere_geometry(m1.pos, p_.radius[a], m2.pos, p_.radius[b], g);
 }
 
 void Simulation::update_servos() {
@@ -190,12 +191,39 @@ void Simulation::accumulate_walls() {
     if (!active_[k]) continue;
     const ContactLoads& L = loads_[k];
     WallState& w = walls_[nl_.pairs[k].second - kWallBase];
-    w.force += L.force1;
+    add_to(w.force, L.force1);
     w.contact_stiffness += params_[k].kn;
     ++w.contacts;
-    w.torque += L.arm1;
-    w.torque += -L.moment;
+    add_to(w.torque, L.arm1);
+    add_to(w.torque, -L.moment);
   }
+}
+
+[[gnu::always_inline]] inline bool Simulation::pair_step(std::size_t k, double dt, ContactLoads& L, double& max_overlap_ratio) {
+  ContactHistory& h = hist_[k];
+  const auto [a, b] = nl_.pairs[k];
+  if (b < kWallBase) {  // sphere pair out of reach: no geometry needed
+    const double reach = p_.radius[a] + p_.radius[b];
+    if ((p_.pos[b] - p_.pos[a]).squaredNorm() > reach * reach) {
+      h.real = false;
+      return false;
+    }
+  }
+  ContactGeometry g;
+  BodyMotion m1, m2;
+  if (!pair_geometry(k, g, m1, m2) || g.penetration < 0) {
+    // Coincident centres, or not touching (YADE erases the interaction).
+    h.real = false;
+    return false;
+  }
+  const bool fresh = !h.real;
+  L = cohesive_frictional_step(h, fresh, g, params_[k], m1, m2, dt);
+  h.real = true;
+  active_[k] = 1;
+  const double rmin = b >= kWallBase ? p_.radius[a] : std::min(p_.radius[a], p_.radius[b]);
+  if (!(h.overlap <= cfg_.max_overlap_ratio * rmin))  // (the ratio only when it is too large)
+    max_overlap_ratio = std::max(max_overlap_ratio, h.overlap / rmin);
+  return true;
 }
 
 void Simulation::step() {
@@ -219,67 +247,73 @@ void Simulation::step() {
   // them, and waking it costs more than the loops on small systems).
 #pragma omp parallel num_threads(threads)
   {
+    if (threads == 1) {
+      // One thread: the loads go straight onto the particles, in pair order, which is the
+      // order the gather below sums them in, so the results are the same as with more threads.
+      for (std::size_t i = 0; i < n; ++i) {
+        p_.force[i] = p_.external_force[i];
+        p_.torque[i].setZero();
+        particle_dissipation_[2 * i] = particle_dissipation_[2 * i + 1] = 0;
+      }
+      for (std::size_t k = 0; k < np; ++k) {
+        ContactLoads L;
+        if (!pair_step(k, dt, L, max_overlap_ratio)) continue;
+        const auto [a, b] = nl_.pairs[k];
+        particle_dissipation_[2 * a] += L.friction_dissipation;
+        particle_dissipation_[2 * a + 1] += L.rolling_dissipation;
+        if (b < kWallBase) {
+          add_to(p_.force[a], L.force1);
+          add_to(p_.torque[a], L.arm1);
+          add_to(p_.torque[a], -L.moment);
+          add_to(p_.force[b], -L.force1);
+          add_to(p_.torque[b], L.arm2);
+          add_to(p_.torque[b], L.moment);
+        } else {
+          add_to(p_.force[a], -L.force1);
+          add_to(p_.torque[a], L.arm2);
+          add_to(p_.torque[a], L.moment);
+          loads_[k] = L;  // for the wall's resultant
+        }
+      }
+    } else {
 #pragma omp for schedule(static) reduction(max : max_overlap_ratio)
-    for (std::size_t k = 0; k < np; ++k) {
-      ContactHistory& h = hist_[k];
-      const auto [a, b] = nl_.pairs[k];
-      if (b < kWallBase) {  // sphere pair out of reach: no geometry needed
-        const double reach = p_.radius[a] + p_.radius[b];
-        if ((p_.pos[b] - p_.pos[a]).squaredNorm() > reach * reach) {
-          h.real = false;
-          continue;
-        }
+      for (std::size_t k = 0; k < np; ++k) {
+        ContactLoads& L = loads_[k];
+        if (!pair_step(k, dt, L, max_overlap_ratio)) continue;
+        dissipation_[2 * k] = L.friction_dissipation;
+        dissipation_[2 * k + 1] = L.rolling_dissipation;
       }
-      ContactGeometry g;
-      BodyMotion m1, m2;
-      if (!pair_geometry(k, g, m1, m2)) {  // coincident centres
-        h.real = false;
-        continue;
-      }
-      if (g.penetration < 0) {  // not touching (YADE erases the interaction)
-        h.real = false;
-        continue;
-      }
-      const bool fresh = !h.real;
-      const ContactLoads& L = loads_[k] =
-          cohesive_frictional_step(h, fresh, g, params_[k], m1, m2, dt);
-      dissipation_[2 * k] = L.friction_dissipation;
-      dissipation_[2 * k + 1] = L.rolling_dissipation;
-      h.real = true;
-      active_[k] = 1;
-      const double rmin = b >= kWallBase ? p_.radius[a] : std::min(p_.radius[a], p_.radius[b]);
-      max_overlap_ratio = std::max(max_overlap_ratio, h.overlap / rmin);
-    }
 
-    // Loads gathered per particle in pair order (the pairs of each particle are listed in that
-    // order), so the sums are the same for any number of threads.
+      // Loads gathered per particle in pair order (the pairs of each particle are listed in
+      // that order), so the sums are the same for any number of threads.
 #pragma omp for schedule(static)
-    for (std::size_t i = 0; i < n; ++i) {
-      Eigen::Vector3d f = p_.external_force[i], t = Eigen::Vector3d::Zero();
-      double fr = 0, ro = 0;  // dissipation of the pairs whose body 1 this particle is
-      for (std::uint32_t e = pair_start_[i]; e < pair_start_[i + 1]; ++e) {
-        const std::uint32_t k = pair_of_[e] >> 1;
-        if (!active_[k]) continue;
-        const ContactLoads& L = loads_[k];
-        if ((pair_of_[e] & 1u) == 0) {
-          fr += dissipation_[2 * k];
-          ro += dissipation_[2 * k + 1];
+      for (std::size_t i = 0; i < n; ++i) {
+        V3 f(p_.external_force[i]), t;
+        double fr = 0, ro = 0;  // dissipation of the pairs whose body 1 this particle is
+        for (std::uint32_t e = pair_start_[i]; e < pair_start_[i + 1]; ++e) {
+          const std::uint32_t k = pair_of_[e] >> 1;
+          if (!active_[k]) continue;
+          const ContactLoads& L = loads_[k];
+          if ((pair_of_[e] & 1u) == 0) {
+            fr += dissipation_[2 * k];
+            ro += dissipation_[2 * k + 1];
+          }
+          const bool first = (pair_of_[e] & 1u) == 0 && nl_.pairs[k].second < kWallBase;
+          if (first) {  // body 1 of a sphere pair
+            f += L.force1;
+            t += L.arm1;
+            t += -L.moment;
+          } else {  // body 2: the second sphere, or the sphere of a wall pair
+            f += -L.force1;
+            t += L.arm2;
+            t += L.moment;
+          }
         }
-        const bool first = (pair_of_[e] & 1u) == 0 && nl_.pairs[k].second < kWallBase;
-        if (first) {  // body 1 of a sphere pair
-          f += L.force1;
-          t += L.arm1;
-          t += -L.moment;
-        } else {  // body 2: the second sphere, or the sphere of a wall pair
-          f += -L.force1;
-          t += L.arm2;
-          t += L.moment;
-        }
+        f.store(p_.force[i]);
+        t.store(p_.torque[i]);
+        particle_dissipation_[2 * i] = fr;
+        particle_dissipation_[2 * i + 1] = ro;
       }
-      p_.force[i] = f;
-      p_.torque[i] = t;
-      particle_dissipation_[2 * i] = fr;
-      particle_dissipation_[2 * i + 1] = ro;
     }
 
 #pragma omp single
@@ -293,23 +327,20 @@ void Simulation::step() {
     // the step, before the update) and the damping dissipation, summed per fixed chunk.
 #pragma omp for schedule(static) reduction(&& : finite)
     for (std::size_t c = 0; c < chunks; ++c) {
-      double fr = 0, ro = 0, grav = 0, ext = 0, damp = 0;
-      for (std::size_t i = c * kChunk; i < std::min(n, (c + 1) * kChunk); ++i) {
+      double fr = 0, ro = 0;
+      const std::size_t begin = c * kChunk, end = std::min(n, (c + 1) * kChunk);
+      for (std::size_t i = begin; i < end; ++i) {
         fr += particle_dissipation_[2 * i];
         ro += particle_dissipation_[2 * i + 1];
-        if (!p_.fixed[i]) {
-          grav += p_.mass[i] * cfg_.gravity.dot(p_.vel[i]);
-          ext += p_.external_force[i].dot(p_.vel[i]);
-        }
-        damp += integrate_particle(p_, i, cfg_.gravity, cfg_.damping, dt);
-        finite = finite && std::isfinite(p_.pos[i].squaredNorm()) &&
-                 std::isfinite(p_.vel[i].squaredNorm());
       }
+      const IntegrationSums sums =
+          integrate_particles(p_, begin, end, cfg_.gravity, cfg_.damping, dt);
+      finite = finite && sums.finite;
       chunk_sums_[kSums * c] = fr;
       chunk_sums_[kSums * c + 1] = ro;
-      chunk_sums_[kSums * c + 2] = grav;
-      chunk_sums_[kSums * c + 3] = ext;
-      chunk_sums_[kSums * c + 4] = damp;
+      chunk_sums_[kSums * c + 2] = sums.gravity_power;
+      chunk_sums_[kSums * c + 3] = sums.external_power;
+      chunk_sums_[kSums * c + 4] = sums.damping;
     }
   }
   for (std::size_t c = 0; c < chunks; ++c) {

@@ -116,6 +116,9 @@ class Simulation {
   void attach_histories(const std::vector<ContactHistory>& old);
   /// Geometry and body motions of candidate pair k; false when the centres coincide.
   bool pair_geometry(std::size_t k, ContactGeometry& g, BodyMotion& m1, BodyMotion& m2) const;
+  /// Contact law on candidate pair k this step: false when the pair is not touching. Sets the
+  /// pair's history and active flag, and raises max_overlap_ratio past the blow-up limit.
+  bool pair_step(std::size_t k, double dt, ContactLoads& L, double& max_overlap_ratio);
   void update_servos();
   /// Wall loads, dissipation and work terms of this step, summed in pair / particle order.
   void accumulate_walls();
