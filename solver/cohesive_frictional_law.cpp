@@ -13,10 +13,135 @@ ContactParams contact_params(const Material& m, double r1, double r2, double twi
   p.ks = k.ks;
   p.kr = k.kr;
   p.ktw = twist_beta * k.ks * r1 * r2;
+  p.inv_ks = 1.0 / p.ks;
+  p.inv_kr = 1.0 / p.kr;
   p.tan_friction = std::tan(m.friction_deg * M_PI / 180.0);
   p.max_roll = m.rolling_eta >= 0 ? m.rolling_eta * k.rolling_radius_m : -1;
   p.max_twist = twist_eta >= 0 ? twist_eta * k.rolling_radius_m : -1;
   return p;
+}
+
+namespace {
+using Batch = ContactBatch;
+
+inline double zero_max(double x) { return 0.0 < x ? x : 0.0; }  // std::max(0.0, x)
+
+template <bool kTwist>
+[[gnu::always_inline]] inline void law_lanes(ContactBatch& batch, int count, double dt) {
+  auto in3 = [&](Batch::Field f, int j) {
+    return V3{batch.v[f][j], batch.v[f + 1][j], batch.v[f + 2][j]};
+  };
+  auto out3 = [&](Batch::Field f, int j, V3 x) {
+    batch.v[f][j] = x.x;
+    batch.v[f + 1][j] = x.y;
+    batch.v[f + 2][j] = x.z;
+  };
+  const double* const pen_ = batch[Batch::PEN];
+  const double* const r1_ = batch[Batch::R1];
+  const double* const r2_ = batch[Batch::R2];
+  const double* const ratchet_ = batch[Batch::RATCHET];
+  const double* const fresh_ = batch[Batch::FRESH];
+  const double* const kn_ = batch[Batch::KN];
+  const double* const ks_ = batch[Batch::KS];
+  const double* const kr_ = batch[Batch::KR];
+  const double* const ktw_ = batch[Batch::KTW];
+  const double* const inv_ks_ = batch[Batch::INV_KS];
+  const double* const inv_kr_ = batch[Batch::INV_KR];
+  const double* const tan_ = batch[Batch::TAN_FRICTION];
+  const double* const max_roll_ = batch[Batch::MAX_ROLL];
+  const double* const max_twist_ = batch[Batch::MAX_TWIST];
+  double* const fn_ = batch[Batch::FN];
+  double* const fr_ = batch[Batch::FRICTION_DISSIPATION];
+  double* const ro_ = batch[Batch::ROLLING_DISSIPATION];
+  for (int j = 0; j < count; ++j) {
+    const V3 n = in3(Batch::NX, j);
+    const V3 c1 = in3(Batch::C1X, j), c2 = in3(Batch::C2X, j);
+    const double pen = pen_[j], r1 = r1_[j], r2 = r2_[j];
+    const V3 w1 = in3(Batch::W1X, j), w2 = in3(Batch::W2X, j);
+    const V3 v1 = in3(Batch::V1X, j), v2 = in3(Batch::V2X, j);
+    const double kn = kn_[j], ks = ks_[j], kr = kr_[j], ktw = ktw_[j];
+    const bool fresh = fresh_[j] != 0;
+    // ScGeom::precompute: rotation of the tangent plane since the last step (normal change and
+    // the mean spin about the old normal), applied to the stored shear force and moments. A
+    // fresh contact starts from zero history and no rotation.
+    const V3 zero{0, 0, 0};
+    const V3 old_n = in3(Batch::ONX, j);
+    V3 shear = select(fresh, zero, in3(Batch::SX, j));
+    V3 bending = select(fresh, zero, in3(Batch::BX, j));
+    V3 twist = select(fresh, zero, in3(Batch::TX, j));
+    const V3 orth = select(fresh, zero, cross(old_n, n));
+    const double angle = dt * 0.5 * dot(old_n, w1 + w2);
+    const V3 twist_axis = select(fresh, zero, angle * old_n);
+    // Relative velocity of body 2 with respect to body 1 at the contact (seed 004 eq 3.5).
+    const double alpha = (r1 + r2) / (r1 + r2 - pen);
+    const V3 rel_radii = (v2 - v1) * alpha + cross(w2, -r2 * n) - cross(w1, r1 * n);
+    const V3 rel_point = (v2 + cross(w2, c2)) - (v1 + cross(w1, c1));
+    V3 rel = select(ratchet_[j] != 0, rel_radii, rel_point);
+    rel = rel - dot(n, rel) * n;
+    const V3 shear_inc = rel * dt;
+    auto rotate = [&](V3 x) {
+      x = x - cross(x, orth);
+      return x - cross(x, twist_axis);
+    };
+    shear = rotate(shear);
+    bending = rotate(bending);  // (discarded below without a rolling stiffness)
+    if constexpr (kTwist) twist = rotate(twist);
+    // Elastic trial values (seed 000 eq 1-6).
+    const double fn = kn * pen;
+    shear = shear - ks * shear_inc;
+    const V3 rel_ang = w2 - w1;
+    const V3 bend = rel_ang - dot(n, rel_ang) * n;
+    bending = select(kr > 0, bending - kr * bend * dt, zero);
+    if constexpr (kTwist)
+      twist = select(ktw > 0, twist - ktw * (dot(n, rel_ang) * n) * dt, zero);
+    else
+      twist = zero;
+    // Coulomb limit on the shear force (seed 000 eq 4), compared on squared norms as YADE does.
+    double max_fs = zero_max(fn * tan_[j]);
+    max_fs *= max_fs;
+    const double fs2 = dot(shear, shear);
+    const bool sliding = fs2 > max_fs;
+    const V3 capped = shear * std::sqrt(max_fs / fs2);
+    const double d_fs = dot(inv_ks_[j] * (shear - capped), capped);
+    fr_[j] = (sliding & (d_fs > 0)) ? d_fs : 0.0;
+    shear = select(sliding, capped, shear);
+    // Rolling and twisting limits (seed 000 eq 7).
+    double max_roll = zero_max(max_roll_[j] * fn);
+    max_roll *= max_roll;
+    const double m2 = dot(bending, bending);
+    const bool rolling = (kr > 0) & (max_roll_[j] >= 0) & (m2 > max_roll);
+    const V3 bending_capped = bending * std::sqrt(max_roll / m2);
+    const double d_roll = dot(inv_kr_[j] * (bending - bending_capped), bending_capped);
+    ro_[j] = (rolling & (d_roll > 0)) ? d_roll : 0.0;
+    bending = select(rolling, bending_capped, bending);
+    if constexpr (kTwist) {
+      double max_tw = zero_max(max_twist_[j] * fn);
+      max_tw *= max_tw;
+      const double t2 = dot(twist, twist);
+      const bool twisting = (ktw > 0) & (max_twist_[j] >= 0) & (t2 > max_tw);
+      twist = select(twisting, twist * std::sqrt(max_tw / t2), twist);
+    }
+    // Loads: body 2 receives Fn·n + Fs at the contact point (YADE applyForceAtContactPoint).
+    const V3 f1 = -(fn * n) - shear;
+    out3(Batch::SX, j, shear);
+    out3(Batch::BX, j, bending);
+    out3(Batch::TX, j, twist);
+    out3(Batch::F1X, j, f1);
+    out3(Batch::A1X, j, cross(c1, f1));
+    out3(Batch::A2X, j, -cross(c2, f1));
+    out3(Batch::MX, j, twist + bending);
+    fn_[j] = fn;
+  }
+}
+
+}  // namespace
+
+__attribute__((target_clones("avx2", "default"))) void cohesive_frictional_batch(
+    ContactBatch& batch, int count, double dt, bool twist) {
+  if (twist)
+    law_lanes<true>(batch, count, dt);
+  else
+    law_lanes<false>(batch, count, dt);
 }
 
 }  // namespace gs::solver

@@ -16,11 +16,6 @@ inline double cundall_factor(double damping, double dt, double vel, double accel
   // cost more than the arithmetic.
   return 1 - damping * static_cast<double>(static_cast<int>(s > 0) - static_cast<int>(s < 0));
 }
-inline void cundall_damp(double damping, double dt, const V3& vel, V3& accel) {
-  accel.x *= cundall_factor(damping, dt, vel.x, accel.x);
-  accel.y *= cundall_factor(damping, dt, vel.y, accel.y);
-  accel.z *= cundall_factor(damping, dt, vel.z, accel.z);
-}
 
 /// Sums over the particles one call integrated, in particle order (J/s and J).
 struct IntegrationSums {

@@ -28,6 +28,10 @@ inline V3 operator*(const V3& a, double s) { return {a.x * s, a.y * s, a.z * s};
 inline V3 operator/(const V3& a, double s) { return {a.x / s, a.y / s, a.z / s}; }
 inline V3& operator+=(V3& a, const V3& b) { return a = a + b; }
 inline V3& operator-=(V3& a, const V3& b) { return a = a - b; }
+/// Component-wise c ? a : b (branch-free in vectorised loops).
+inline V3 select(bool c, const V3& a, const V3& b) {
+  return {c ? a.x : b.x, c ? a.y : b.y, c ? a.z : b.z};
+}
 inline V3 abs(const V3& a) { return {std::abs(a.x), std::abs(a.y), std::abs(a.z)}; }
 /// dst += v, component by component (as Eigen's +=).
 inline void add_to(Eigen::Vector3d& dst, const V3& v) {

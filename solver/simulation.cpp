@@ -199,16 +199,11 @@ void Simulation::accumulate_walls() {
   }
 }
 
-[[gnu::always_inline]] inline bool Simulation::pair_step(std::size_t k, double dt, ContactLoads& L, double& max_overlap_ratio) {
+[[gnu::always_inline]] inline bool Simulation::prepare_pair(std::size_t k, ContactBatch& B,
+                                                           int j, double& max_overlap_ratio) {
+  using F = ContactBatch::Field;
   ContactHistory& h = hist_[k];
   const auto [a, b] = nl_.pairs[k];
-  if (b < kWallBase) {  // sphere pair out of reach: no geometry needed
-    const double reach = p_.radius[a] + p_.radius[b];
-    if ((p_.pos[b] - p_.pos[a]).squaredNorm() > reach * reach) {
-      h.real = false;
-      return false;
-    }
-  }
   ContactGeometry g;
   BodyMotion m1, m2;
   if (!pair_geometry(k, g, m1, m2) || g.penetration < 0) {
@@ -216,14 +211,90 @@ void Simulation::accumulate_walls() {
     h.real = false;
     return false;
   }
-  const bool fresh = !h.real;
-  L = cohesive_frictional_step(h, fresh, g, params_[k], m1, m2, dt);
+  auto put = [&](F f, const V3& x) {
+    B.v[f][j] = x.x;
+    B.v[f + 1][j] = x.y;
+    B.v[f + 2][j] = x.z;
+  };
+  put(F::NX, g.normal);
+  B.v[F::PEN][j] = g.penetration;
+  B.v[F::R1][j] = g.radius1;
+  B.v[F::R2][j] = g.radius2;
+  B.v[F::RATCHET][j] = g.ratchet_free ? 1 : 0;
+  put(F::V1X, m1.vel);
+  put(F::V2X, m2.vel);
+  put(F::W1X, m1.angvel);
+  put(F::W2X, m2.angvel);
+  put(F::C1X, g.point - m1.pos);
+  put(F::C2X, g.point - m2.pos);
+  B.v[F::FRESH][j] = h.real ? 0 : 1;
+  put(F::ONX, V3(h.normal));
+  put(F::SX, V3(h.shear_force));
+  put(F::BX, V3(h.bending));
+  put(F::TX, V3(h.twist));
+  const ContactParams& p = params_[k];
+  B.v[F::KN][j] = p.kn;
+  B.v[F::KS][j] = p.ks;
+  B.v[F::KR][j] = p.kr;
+  B.v[F::KTW][j] = p.ktw;
+  B.v[F::INV_KS][j] = p.inv_ks;
+  B.v[F::INV_KR][j] = p.inv_kr;
+  B.v[F::TAN_FRICTION][j] = p.tan_friction;
+  B.v[F::MAX_ROLL][j] = p.max_roll;
+  B.v[F::MAX_TWIST][j] = p.max_twist;
+  // The history's geometry of this step.
+  g.normal.store(h.normal);
+  g.point.store(h.point);
+  h.overlap = g.penetration;
   h.real = true;
   active_[k] = 1;
   const double rmin = b >= kWallBase ? p_.radius[a] : std::min(p_.radius[a], p_.radius[b]);
   if (!(h.overlap <= cfg_.max_overlap_ratio * rmin))  // (the ratio only when it is too large)
     max_overlap_ratio = std::max(max_overlap_ratio, h.overlap / rmin);
   return true;
+}
+
+int Simulation::fill_batch(std::size_t& k, std::size_t end, ContactBatch& batch,
+                           std::uint32_t* lane_pair, double& max_overlap_ratio) {
+  // Pass 1 without branches (whether a candidate is within reach is a coin flip that the
+  // branch predictor loses): candidates within reach are compacted, the others lose their
+  // contact (YADE erases the interaction).
+  std::uint32_t near[ContactBatch::kLanes];
+  int m = 0;
+  for (; k < end && m < ContactBatch::kLanes; ++k) {
+    const auto [a, b] = nl_.pairs[k];
+    const bool wall = b >= kWallBase;
+    const std::uint32_t other = wall ? a : b;
+    const double reach = p_.radius[a] + p_.radius[other];
+    const bool in_reach = wall | !((p_.pos[other] - p_.pos[a]).squaredNorm() > reach * reach);
+    hist_[k].real = hist_[k].real & in_reach;
+    near[m] = static_cast<std::uint32_t>(k);
+    m += in_reach;
+  }
+  // Pass 2: geometry, and the lanes of the pairs that touch.
+  int lanes = 0;
+  for (int i = 0; i < m; ++i) {
+    lane_pair[lanes] = near[i];
+    lanes += prepare_pair(near[i], batch, lanes, max_overlap_ratio);
+  }
+  return lanes;
+}
+
+[[gnu::always_inline]] inline void Simulation::finish_pair(std::size_t k, const ContactBatch& B,
+                                                          int j, ContactLoads& L) {
+  using F = ContactBatch::Field;
+  auto get = [&](F f) { return V3(B.v[f][j], B.v[f + 1][j], B.v[f + 2][j]); };
+  ContactHistory& h = hist_[k];
+  get(F::SX).store(h.shear_force);
+  get(F::BX).store(h.bending);
+  get(F::TX).store(h.twist);
+  h.fn = B.v[F::FN][j];
+  L.force1 = get(F::F1X);
+  L.arm1 = get(F::A1X);
+  L.arm2 = get(F::A2X);
+  L.moment = get(F::MX);
+  L.friction_dissipation = B.v[F::FRICTION_DISSIPATION][j];
+  L.rolling_dissipation = B.v[F::ROLLING_DISSIPATION][j];
 }
 
 void Simulation::step() {
@@ -255,34 +326,55 @@ void Simulation::step() {
         p_.torque[i].setZero();
         particle_dissipation_[2 * i] = particle_dissipation_[2 * i + 1] = 0;
       }
-      for (std::size_t k = 0; k < np; ++k) {
-        ContactLoads L;
-        if (!pair_step(k, dt, L, max_overlap_ratio)) continue;
-        const auto [a, b] = nl_.pairs[k];
-        particle_dissipation_[2 * a] += L.friction_dissipation;
-        particle_dissipation_[2 * a + 1] += L.rolling_dissipation;
-        if (b < kWallBase) {
-          add_to(p_.force[a], L.force1);
-          add_to(p_.torque[a], L.arm1);
-          add_to(p_.torque[a], -L.moment);
-          add_to(p_.force[b], -L.force1);
-          add_to(p_.torque[b], L.arm2);
-          add_to(p_.torque[b], L.moment);
-        } else {
-          add_to(p_.force[a], -L.force1);
-          add_to(p_.torque[a], L.arm2);
-          add_to(p_.torque[a], L.moment);
-          loads_[k] = L;  // for the wall's resultant
+      ContactBatch batch;
+      std::uint32_t lane_pair[ContactBatch::kLanes];
+      for (std::size_t k = 0; k < np;) {
+        const int m = fill_batch(k, np, batch, lane_pair, max_overlap_ratio);
+        cohesive_frictional_batch(batch, m, dt, cfg_.twist_beta > 0);
+        for (int j = 0; j < m; ++j) {
+          const std::uint32_t kk = lane_pair[j];
+          ContactLoads L;
+          finish_pair(kk, batch, j, L);
+          const auto [a, b] = nl_.pairs[kk];
+          particle_dissipation_[2 * a] += L.friction_dissipation;
+          particle_dissipation_[2 * a + 1] += L.rolling_dissipation;
+          if (b < kWallBase) {
+            add_to(p_.force[a], L.force1);
+            add_to(p_.torque[a], L.arm1);
+            add_to(p_.torque[a], -L.moment);
+            add_to(p_.force[b], -L.force1);
+            add_to(p_.torque[b], L.arm2);
+            add_to(p_.torque[b], L.moment);
+          } else {
+            add_to(p_.force[a], -L.force1);
+            add_to(p_.torque[a], L.arm2);
+            add_to(p_.torque[a], L.moment);
+            loads_[kk] = L;  // for the wall's resultant
+          }
         }
       }
     } else {
-#pragma omp for schedule(static) reduction(max : max_overlap_ratio)
-      for (std::size_t k = 0; k < np; ++k) {
-        ContactLoads& L = loads_[k];
-        if (!pair_step(k, dt, L, max_overlap_ratio)) continue;
-        dissipation_[2 * k] = L.friction_dissipation;
-        dissipation_[2 * k + 1] = L.rolling_dissipation;
+      // Each thread takes a contiguous share of the pairs, in batches.
+      const std::size_t t = static_cast<std::size_t>(omp_get_thread_num());
+      const std::size_t nt = static_cast<std::size_t>(omp_get_num_threads());
+      const std::size_t k_end = np * (t + 1) / nt;
+      double my_max_overlap = 0;
+      ContactBatch batch;
+      std::uint32_t lane_pair[ContactBatch::kLanes];
+      for (std::size_t k = np * t / nt; k < k_end;) {
+        const int m = fill_batch(k, k_end, batch, lane_pair, my_max_overlap);
+        cohesive_frictional_batch(batch, m, dt, cfg_.twist_beta > 0);
+        for (int j = 0; j < m; ++j) {
+          const std::uint32_t kk = lane_pair[j];
+          ContactLoads& L = loads_[kk];
+          finish_pair(kk, batch, j, L);
+          dissipation_[2 * kk] = L.friction_dissipation;
+          dissipation_[2 * kk + 1] = L.rolling_dissipation;
+        }
       }
+#pragma omp critical(gs_max_overlap)
+      max_overlap_ratio = std::max(max_overlap_ratio, my_max_overlap);
+#pragma omp barrier
 
       // Loads gathered per particle in pair order (the pairs of each particle are listed in
       // that order), so the sums are the same for any number of threads.

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "cohesive_frictional_law.hpp"
+#include "contact_geometry.hpp"
 #include "dem_types.hpp"
 #include "neighbor_list.hpp"
 #include "snapshot.hpp"
@@ -116,9 +117,16 @@ class Simulation {
   void attach_histories(const std::vector<ContactHistory>& old);
   /// Geometry and body motions of candidate pair k; false when the centres coincide.
   bool pair_geometry(std::size_t k, ContactGeometry& g, BodyMotion& m1, BodyMotion& m2) const;
-  /// Contact law on candidate pair k this step: false when the pair is not touching. Sets the
-  /// pair's history and active flag, and raises max_overlap_ratio past the blow-up limit.
-  bool pair_step(std::size_t k, double dt, ContactLoads& L, double& max_overlap_ratio);
+  /// Geometry, motions, history and parameters of candidate pair k into lane j of a batch;
+  /// false when the pair does not touch (its history is then marked not real). Raises
+  /// max_overlap_ratio past the blow-up limit.
+  bool prepare_pair(std::size_t k, ContactBatch& batch, int j, double& max_overlap_ratio);
+  /// Fills a batch with the next touching pairs from k (advanced) up to end; returns the
+  /// number of lanes, lane_pair[j] the pair of lane j.
+  int fill_batch(std::size_t& k, std::size_t end, ContactBatch& batch, std::uint32_t* lane_pair,
+                 double& max_overlap_ratio);
+  /// The law's results in lane j back into pair k's history, and its loads.
+  void finish_pair(std::size_t k, const ContactBatch& batch, int j, ContactLoads& loads);
   void update_servos();
   /// Wall loads, dissipation and work terms of this step, summed in pair / particle order.
   void accumulate_walls();
