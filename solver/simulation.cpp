@@ -328,6 +328,19 @@ void Simulation::step() {
       }
       ContactBatch batch;
       std::uint32_t lane_pair[ContactBatch::kLanes];
+      // The loads of body 1 stay in registers while its pairs follow each other (pairs are
+      // sorted by body 1, and a particle's pairs as body 2 all come before those as body 1):
+      // the same additions in the same order.
+      std::uint32_t cur = kWallBase;
+      V3 f_cur, t_cur;
+      double fr_cur = 0, ro_cur = 0;
+      auto flush = [&] {
+        if (cur == kWallBase) return;
+        f_cur.store(p_.force[cur]);
+        t_cur.store(p_.torque[cur]);
+        particle_dissipation_[2 * cur] = fr_cur;
+        particle_dissipation_[2 * cur + 1] = ro_cur;
+      };
       for (std::size_t k = 0; k < np;) {
         const int m = fill_batch(k, np, batch, lane_pair, max_overlap_ratio);
         cohesive_frictional_batch(batch, m, dt, cfg_.twist_beta > 0);
@@ -336,23 +349,32 @@ void Simulation::step() {
           ContactLoads L;
           finish_pair(kk, batch, j, L);
           const auto [a, b] = nl_.pairs[kk];
-          particle_dissipation_[2 * a] += L.friction_dissipation;
-          particle_dissipation_[2 * a + 1] += L.rolling_dissipation;
+          if (a != cur) {
+            flush();
+            cur = a;
+            f_cur = V3(p_.force[a]);
+            t_cur = V3(p_.torque[a]);
+            fr_cur = particle_dissipation_[2 * a];
+            ro_cur = particle_dissipation_[2 * a + 1];
+          }
+          fr_cur += L.friction_dissipation;
+          ro_cur += L.rolling_dissipation;
           if (b < kWallBase) {
-            add_to(p_.force[a], L.force1);
-            add_to(p_.torque[a], L.arm1);
-            add_to(p_.torque[a], -L.moment);
+            f_cur += L.force1;
+            t_cur += L.arm1;
+            t_cur += -L.moment;
             add_to(p_.force[b], -L.force1);
             add_to(p_.torque[b], L.arm2);
             add_to(p_.torque[b], L.moment);
           } else {
-            add_to(p_.force[a], -L.force1);
-            add_to(p_.torque[a], L.arm2);
-            add_to(p_.torque[a], L.moment);
+            f_cur += -L.force1;
+            t_cur += L.arm2;
+            t_cur += L.moment;
             loads_[kk] = L;  // for the wall's resultant
           }
         }
       }
+      flush();
     } else {
       // Each thread takes a contiguous share of the pairs, in batches.
       const std::size_t t = static_cast<std::size_t>(omp_get_thread_num());
