@@ -195,6 +195,53 @@ TEST(Physics, MomentRotationSlopePlateauUnloading) {
   }
 }
 
+// Twisting moment (off unless enabled): incremental, slope Ktw = βtw·Ks·RA·RB, plateau at
+// ηtw·R_roll·|Fn|, elastic unloading; the bending moment stays zero under a pure twist.
+TEST(Physics, TwistMomentSlopePlateauUnloadingAndOffByDefault) {
+  const double ra = 1e-3, rb = 2e-3, beta_tw = 0.5, eta_tw = 0.3;
+  for (bool enabled : {true, false}) {
+    SimulationConfig c;
+    c.material = material(1e8, 30, 0.7, 0.4);
+    c.dt = 1e-7;
+    if (enabled) {
+      c.twist_beta = beta_tw;
+      c.twist_eta = eta_tw;
+    }
+    const double overlap = 1e-6;
+    Simulation sim(c, {sphere(0, {0, 0, 0}, ra), sphere(1, {0, 0, ra + rb - overlap}, rb)}, {});
+    auto& p = sim.particles();
+    p.fixed[0] = p.fixed[1] = 1;
+    const double omega = 0.5;  // rad/s about the contact normal
+    p.angvel[1] = Eigen::Vector3d(0, 0, omega);
+    const auto k = contact_stiffness(c.material.young_ec, 0.3, 0.7, ra, rb, RollingRadius::Min);
+    const double ktw = beta_tw * k.ks * ra * rb;
+    const double plateau = eta_tw * k.rolling_radius_m * k.kn * overlap;
+    const int load_steps = static_cast<int>(1.5 * plateau / ktw / (omega * c.dt));
+    for (int s = 1; s <= load_steps; ++s) {
+      sim.step();
+      const auto contact = sim.frame().contacts.at(0);
+      EXPECT_EQ(contact.bending_moment.norm(), 0.0) << "step " << s;
+      const double m = std::abs(contact.twisting_moment.z());
+      if (!enabled) {
+        ASSERT_EQ(contact.twisting_moment.norm(), 0.0) << "step " << s;
+        continue;
+      }
+      const double elastic = ktw * omega * c.dt * s;
+      if (elastic < plateau * (1 - 1e-9))
+        EXPECT_NEAR(m, elastic, 1e-9 * elastic) << "step " << s;
+      else
+        EXPECT_NEAR(m, plateau, 1e-12 * plateau) << "step " << s;
+    }
+    if (!enabled) continue;
+    p.angvel[1] = Eigen::Vector3d(0, 0, -omega);  // unload
+    for (int s = 1; s <= 100; ++s) {
+      sim.step();
+      const double m = std::abs(sim.frame().contacts.at(0).twisting_moment.z());
+      EXPECT_NEAR(m, plateau - ktw * omega * c.dt * s, 1e-9 * plateau) << "unloading step " << s;
+    }
+  }
+}
+
 namespace {
 std::vector<Particle> random_packing(int n, unsigned seed) {
   std::mt19937 rng(seed);
