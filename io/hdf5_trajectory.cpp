@@ -71,7 +71,11 @@ hid_t t_i8() {
   return H5T_NATIVE_INT8;
 }
 
-constexpr hsize_t kRowChunk = 4096;
+// Rows per chunk of the per-particle and per-contact datasets. The chunk that a frame ends in is
+// compressed and written again when the next frame is appended: with 4096 rows the 883-sphere
+// oedometer (a frame every 1000 steps) ran 6 % slower and its file was 1.7x larger than with
+// 1024. 1024 rows of three doubles (24 KiB) still fill most of deflate's 32 KiB window.
+constexpr hsize_t kRowChunk = 1024;
 constexpr hsize_t kFrameChunk = 64;
 
 // Column order matters for the writer: /frames/end must stay last (commit marker).
