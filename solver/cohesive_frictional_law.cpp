@@ -24,7 +24,9 @@ ContactParams contact_params(const Material& m, double r1, double r2, double twi
 namespace {
 using Batch = ContactBatch;
 
-inline double zero_max(double x) { return 0.0 < x ? x : 0.0; }  // std::max(0.0, x)
+inline double zero_max(double x) {
+  return 0.0 < x ? x : 0.0;
+}  // std::max(0.0, x)
 
 template <bool kTwist>
 [[gnu::always_inline]] inline void law_lanes(ContactBatch& batch, int count, double dt) {
@@ -136,7 +138,7 @@ template <bool kTwist>
 
 }  // namespace
 
-__attribute__((target_clones("avx2", "default"))) void cohesive_frictional_batch(
+__attribute__((target_clones("avx512f", "avx2", "default"))) void cohesive_frictional_batch(
     ContactBatch& batch, int count, double dt, bool twist) {
   if (twist)
     law_lanes<true>(batch, count, dt);

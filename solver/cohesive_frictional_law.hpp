@@ -37,34 +37,37 @@ struct ContactLoads {
 /// Body 1 is the wall for wall contacts; the normal points from body 1 to body 2.
 struct ContactBatch {
   static constexpr int kLanes = 32;
+  // clang-format off
   enum Field : int {
     // inputs
-    NX, NY, NZ,        // unit normal
-    PEN,               // penetration (≥ 0), m
-    R1, R2,            // radii (both the sphere's for wall contacts)
-    RATCHET,           // 1: relative velocity from the radii (YADE avoidGranularRatcheting)
-    V1X, V1Y, V1Z,     // velocities
+    NX, NY, NZ,     // unit normal
+    PEN,            // penetration (≥ 0), m
+    R1, R2,         // radii (both the sphere's for wall contacts)
+    RATCHET,        // 1: relative velocity from the radii (YADE avoidGranularRatcheting)
+    V1X, V1Y, V1Z,  // velocities
     V2X, V2Y, V2Z,
-    W1X, W1Y, W1Z,     // angular velocities
+    W1X, W1Y, W1Z,  // angular velocities
     W2X, W2Y, W2Z,
-    C1X, C1Y, C1Z,     // contact point − centre of body 1 (torque arm)
-    C2X, C2Y, C2Z,     // contact point − centre of body 2
-    FRESH,             // 1: the contact is new this step (history starts at zero)
-    ONX, ONY, ONZ,     // last step's normal
+    C1X, C1Y, C1Z,  // contact point − centre of body 1 (torque arm)
+    C2X, C2Y, C2Z,  // contact point − centre of body 2
+    FRESH,          // 1: the contact is new this step (history starts at zero)
+    ONX, ONY, ONZ,  // last step's normal
     KN, KS, KR, KTW, INV_KS, INV_KR, TAN_FRICTION, MAX_ROLL, MAX_TWIST,
     // history: read, and written back with this step's values
-    SX, SY, SZ,        // shear force
-    BX, BY, BZ,        // bending moment
-    TX, TY, TZ,        // twisting moment
+    SX, SY, SZ,     // shear force
+    BX, BY, BZ,     // bending moment
+    TX, TY, TZ,     // twisting moment
     // outputs
-    F1X, F1Y, F1Z,        // force on body 1
-    A1X, A1Y, A1Z,        // torque on body 1 from the force (arm1)
-    A2X, A2Y, A2Z,        // torque on body 2 from the force (arm2)
-    MX, MY, MZ,           // contact moment (body 1 receives −M, body 2 +M)
-    FN,                   // |normal force|
+    F1X, F1Y, F1Z,  // force on body 1
+    A1X, A1Y, A1Z,  // torque on body 1 from the force (arm1)
+    A2X, A2Y, A2Z,  // torque on body 2 from the force (arm2)
+    MX, MY, MZ,     // contact moment (body 1 receives −M, body 2 +M)
+    FN,             // |normal force|
     FRICTION_DISSIPATION, ROLLING_DISSIPATION,
     kFields
   };
+  // clang-format on
+
   alignas(64) double v[kFields][kLanes];
   double* operator[](Field f) { return v[f]; }
 };
@@ -73,7 +76,8 @@ struct ContactBatch {
 /// stored shear force and moments into the current tangent plane, elastic increments, Coulomb
 /// and rolling limits, and the loads. Every lane computes both sides of each condition and
 /// selects, with the operations of each lane in the order of the scalar law, so results do not
-/// depend on the batching. Vectorised for AVX2 where the CPU has it (chosen at load time).
+/// depend on the batching. Vectorised with AVX-512 or AVX2 where the CPU has them (chosen at
+/// load time); every variant gives the same bits.
 /// `twist`: some lane has a twisting stiffness (otherwise the twisting moments are zero and
 /// their limit is not computed).
 void cohesive_frictional_batch(ContactBatch& batch, int count, double dt, bool twist);

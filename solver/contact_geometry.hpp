@@ -22,8 +22,8 @@ struct ContactGeometry {
 
 /// Sphere–sphere: normal = (x2 − x1)/|x2 − x1|, penetration = r1 + r2 − |x2 − x1|, contact
 /// point x1 + (r1 − pen/2)·n. Returns false when the centres coincide.
-[[gnu::always_inline]] inline bool sphere_sphere_geometry(const V3& x1, double r1, const V3& x2, double r2,
-                                   ContactGeometry& g) {
+[[gnu::always_inline]] inline bool sphere_sphere_geometry(const V3& x1, double r1, const V3& x2,
+                                                          double r2, ContactGeometry& g) {
   V3 n = x2 - x1;
   const double d = std::sqrt(squared_norm(n));
   if (!(d > 0)) return false;
@@ -76,8 +76,8 @@ void box_sphere_geometry_inside(const V3& h, const V3& x, const V3& on_box, doub
 
 /// Infinite plane (point p, unit normal m into the domain) and a sphere: normal m,
 /// penetration r − (x − p)·m, contact point x − (r − pen/2)·m. Both radii = r.
-[[gnu::always_inline]] inline void plane_sphere_geometry(const V3& p, const V3& m, const V3& x, double r,
-                                  ContactGeometry& g) {
+[[gnu::always_inline]] inline void plane_sphere_geometry(const V3& p, const V3& m, const V3& x,
+                                                         double r, ContactGeometry& g) {
   const double dist = dot(x - p, m);
   g.normal = m;
   g.penetration = r - dist;

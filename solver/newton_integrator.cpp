@@ -14,24 +14,30 @@ namespace {
 /// update then run four at a time.
 struct ParticleBatch {
   static constexpr int kLanes = 32;
+  // clang-format off
   enum Field : int {
     // inputs (velocities, position, orientation and rotation are updated in place)
-    VX, VY, VZ, WX, WY, WZ, FX, FY, FZ, TX, TY, TZ, EX, EY, EZ,  // external force
+    VX, VY, VZ, WX, WY, WZ, FX, FY, FZ, TX, TY, TZ,
+    EX, EY, EZ,  // external force
     PX, PY, PZ, QW, QX, QY, QZ, RX, RY, RZ,
     MASS, INERTIA, FIXED, ROT_BLOCKED,
     // outputs: this particle's terms of the step's sums, the finite check, and 1 where the
-    // rotation angle is too large for the series (done again in scalar code with sincos)
+    // orientation is updated again in scalar code (a rotation too large for the series, or a
+    // quaternion that was not a unit one)
     GRAVITY_POWER, EXTERNAL_POWER, DAMPING, FINITE, LARGE_ANGLE,
     kFields
   };
+  // clang-format on
+
   alignas(64) double v[kFields][kLanes];
 };
 
-
 // YADE's NewtonIntegrator on lanes [0, count): Cundall damping per component, leapfrog, and
 // the rotation of the orientation by |ω|·dt about ω from the half-angle series.
-__attribute__((target_clones("avx2", "default"))) void integrate_batch(
-    ParticleBatch& b, int count, V3 g, double damping, double dt) {
+__attribute__((target_clones("avx512f", "avx2", "default"))) void integrate_batch(ParticleBatch& b,
+                                                                                  int count, V3 g,
+                                                                                  double damping,
+                                                                                  double dt) {
   using F = ParticleBatch::Field;
   auto in3 = [&](F f, int j) { return V3(b.v[f][j], b.v[f + 1][j], b.v[f + 2][j]); };
   auto out3 = [&](F f, int j, const V3& x) {
@@ -63,8 +69,7 @@ __attribute__((target_clones("avx2", "default"))) void integrate_batch(
     out3(F::VX, j, vel);
     out3(F::WX, j, angvel);
     out3(F::PX, j, pos);
-    b.v[F::FINITE][j] =
-        (squared_norm(pos) < HUGE_VAL) & (squared_norm(vel) < HUGE_VAL) ? 1.0 : 0.0;
+    b.v[F::FINITE][j] = (squared_norm(pos) < HUGE_VAL) & (squared_norm(vel) < HUGE_VAL) ? 1.0 : 0.0;
     // Orientation: q ← (cos h, sin h·ω/|ω|)·q with h = |ω|·dt/2 (YADE's
     // leapfrogSphericalRotate). Below h = 1e-3 rad the series is exact to double precision.
     const double a2 = squared_norm(angvel);

@@ -19,28 +19,52 @@ struct V3 {
   Eigen::Vector3d eigen() const { return {x, y, z}; }
 };
 
-inline V3 load3(const Eigen::Vector3d& v) { return V3(v); }
-inline V3 operator+(const V3& a, const V3& b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
-inline V3 operator-(const V3& a, const V3& b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
-inline V3 operator-(const V3& a) { return {-a.x, -a.y, -a.z}; }
-inline V3 operator*(double s, const V3& a) { return {s * a.x, s * a.y, s * a.z}; }
-inline V3 operator*(const V3& a, double s) { return {a.x * s, a.y * s, a.z * s}; }
-inline V3 operator/(const V3& a, double s) { return {a.x / s, a.y / s, a.z / s}; }
-inline V3& operator+=(V3& a, const V3& b) { return a = a + b; }
-inline V3& operator-=(V3& a, const V3& b) { return a = a - b; }
+inline V3 load3(const Eigen::Vector3d& v) {
+  return V3(v);
+}
+inline V3 operator+(const V3& a, const V3& b) {
+  return {a.x + b.x, a.y + b.y, a.z + b.z};
+}
+inline V3 operator-(const V3& a, const V3& b) {
+  return {a.x - b.x, a.y - b.y, a.z - b.z};
+}
+inline V3 operator-(const V3& a) {
+  return {-a.x, -a.y, -a.z};
+}
+inline V3 operator*(double s, const V3& a) {
+  return {s * a.x, s * a.y, s * a.z};
+}
+inline V3 operator*(const V3& a, double s) {
+  return {a.x * s, a.y * s, a.z * s};
+}
+inline V3 operator/(const V3& a, double s) {
+  return {a.x / s, a.y / s, a.z / s};
+}
+inline V3& operator+=(V3& a, const V3& b) {
+  return a = a + b;
+}
+inline V3& operator-=(V3& a, const V3& b) {
+  return a = a - b;
+}
 /// Component-wise c ? a : b (branch-free in vectorised loops).
 inline V3 select(bool c, const V3& a, const V3& b) {
   return {c ? a.x : b.x, c ? a.y : b.y, c ? a.z : b.z};
 }
-inline V3 abs(const V3& a) { return {std::abs(a.x), std::abs(a.y), std::abs(a.z)}; }
+inline V3 abs(const V3& a) {
+  return {std::abs(a.x), std::abs(a.y), std::abs(a.z)};
+}
 /// dst += v, component by component (as Eigen's +=).
 inline void add_to(Eigen::Vector3d& dst, const V3& v) {
   dst[0] += v.x;
   dst[1] += v.y;
   dst[2] += v.z;
 }
-inline double dot(const V3& a, const V3& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-inline double squared_norm(const V3& a) { return dot(a, a); }
+inline double dot(const V3& a, const V3& b) {
+  return a.x * b.x + a.y * b.y + a.z * b.z;
+}
+inline double squared_norm(const V3& a) {
+  return dot(a, a);
+}
 inline V3 cross(const V3& a, const V3& b) {
   return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
 }

@@ -147,8 +147,8 @@ void Simulation::set_wall_active(std::size_t w, bool active) {
   invalidate_neighbors();
 }
 
-[[gnu::always_inline]] inline bool Simulation::pair_geometry(std::size_t k, ContactGeometry& g, BodyMotion& m1,
-                               BodyMotion& m2) const {
+[[gnu::always_inline]] inline bool Simulation::pair_geometry(std::size_t k, ContactGeometry& g,
+                                                             BodyMotion& m1, BodyMotion& m2) const {
   const auto [a, b] = nl_.pairs[k];
   if (b >= kWallBase) {
     const WallState& w = walls_[b - kWallBase];
@@ -199,8 +199,8 @@ void Simulation::accumulate_walls() {
   }
 }
 
-[[gnu::always_inline]] inline bool Simulation::prepare_pair(std::size_t k, ContactBatch& B,
-                                                           int j, double& max_overlap_ratio) {
+[[gnu::always_inline]] inline bool Simulation::prepare_pair(std::size_t k, ContactBatch& B, int j,
+                                                            double& max_overlap_ratio) {
   using F = ContactBatch::Field;
   ContactHistory& h = hist_[k];
   const auto [a, b] = nl_.pairs[k];
@@ -281,7 +281,7 @@ int Simulation::fill_batch(std::size_t& k, std::size_t end, ContactBatch& batch,
 }
 
 [[gnu::always_inline]] inline void Simulation::finish_pair(std::size_t k, const ContactBatch& B,
-                                                          int j, ContactLoads& L) {
+                                                           int j, ContactLoads& L) {
   using F = ContactBatch::Field;
   auto get = [&](F f) { return V3(B.v[f][j], B.v[f + 1][j], B.v[f + 2][j]); };
   ContactHistory& h = hist_[k];
