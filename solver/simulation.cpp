@@ -231,17 +231,20 @@ void Simulation::accumulate_walls() {
   put(F::ONX, V3(h.normal));
   put(F::SX, V3(h.shear_force));
   put(F::BX, V3(h.bending));
-  put(F::TX, V3(h.twist));
+  const bool twist = cfg_.twist_beta > 0;  // (off: the twisting moments stay zero)
+  if (twist) put(F::TX, V3(h.twist));
   const ContactParams& p = params_[k];
   B.v[F::KN][j] = p.kn;
   B.v[F::KS][j] = p.ks;
   B.v[F::KR][j] = p.kr;
-  B.v[F::KTW][j] = p.ktw;
+  if (twist) {
+    B.v[F::KTW][j] = p.ktw;
+    B.v[F::MAX_TWIST][j] = p.max_twist;
+  }
   B.v[F::INV_KS][j] = p.inv_ks;
   B.v[F::INV_KR][j] = p.inv_kr;
   B.v[F::TAN_FRICTION][j] = p.tan_friction;
   B.v[F::MAX_ROLL][j] = p.max_roll;
-  B.v[F::MAX_TWIST][j] = p.max_twist;
   // The history's geometry of this step.
   g.normal.store(h.normal);
   g.point.store(h.point);
@@ -287,7 +290,7 @@ int Simulation::fill_batch(std::size_t& k, std::size_t end, ContactBatch& batch,
   ContactHistory& h = hist_[k];
   get(F::SX).store(h.shear_force);
   get(F::BX).store(h.bending);
-  get(F::TX).store(h.twist);
+  if (cfg_.twist_beta > 0) get(F::TX).store(h.twist);
   h.fn = B.v[F::FN][j];
   L.force1 = get(F::F1X);
   L.arm1 = get(F::A1X);
