@@ -13,8 +13,6 @@ ContactParams contact_params(const Material& m, double r1, double r2, double twi
   p.ks = k.ks;
   p.kr = k.kr;
   p.ktw = twist_beta * k.ks * r1 * r2;
-  p.inv_ks = 1.0 / p.ks;
-  p.inv_kr = 1.0 / p.kr;
   p.tan_friction = std::tan(m.friction_deg * M_PI / 180.0);
   p.max_roll = m.rolling_eta >= 0 ? m.rolling_eta * k.rolling_radius_m : -1;
   p.max_twist = twist_eta >= 0 ? twist_eta * k.rolling_radius_m : -1;
@@ -47,8 +45,6 @@ template <bool kTwist>
   const double* const ks_ = batch[Batch::KS];
   const double* const kr_ = batch[Batch::KR];
   const double* const ktw_ = batch[Batch::KTW];
-  const double* const inv_ks_ = batch[Batch::INV_KS];
-  const double* const inv_kr_ = batch[Batch::INV_KR];
   const double* const tan_ = batch[Batch::TAN_FRICTION];
   const double* const max_roll_ = batch[Batch::MAX_ROLL];
   const double* const max_twist_ = batch[Batch::MAX_TWIST];
@@ -61,7 +57,8 @@ template <bool kTwist>
     const double pen = pen_[j], r1 = r1_[j], r2 = r2_[j];
     const V3 w1 = in3(Batch::W1X, j), w2 = in3(Batch::W2X, j);
     const V3 v1 = in3(Batch::V1X, j), v2 = in3(Batch::V2X, j);
-    const double kn = kn_[j], ks = ks_[j], kr = kr_[j], ktw = ktw_[j];
+    const double kn = kn_[j], ks = ks_[j], kr = kr_[j];
+    const double ktw = kTwist ? ktw_[j] : 0.0;  // (not filled in without twisting)
     const bool fresh = fresh_[j] != 0;
     // ScGeom::precompute: rotation of the tangent plane since the last step (normal change and
     // the mean spin about the old normal), applied to the stored shear force and moments. A
@@ -70,7 +67,7 @@ template <bool kTwist>
     const V3 old_n = in3(Batch::ONX, j);
     V3 shear = select(fresh, zero, in3(Batch::SX, j));
     V3 bending = select(fresh, zero, in3(Batch::BX, j));
-    V3 twist = select(fresh, zero, in3(Batch::TX, j));
+    V3 twist = kTwist ? select(fresh, zero, in3(Batch::TX, j)) : zero;
     const V3 orth = select(fresh, zero, cross(old_n, n));
     const double angle = dt * 0.5 * dot(old_n, w1 + w2);
     const V3 twist_axis = select(fresh, zero, angle * old_n);
@@ -104,7 +101,7 @@ template <bool kTwist>
     const double fs2 = dot(shear, shear);
     const bool sliding = fs2 > max_fs;
     const V3 capped = shear * std::sqrt(max_fs / fs2);
-    const double d_fs = dot(inv_ks_[j] * (shear - capped), capped);
+    const double d_fs = dot((1.0 / ks) * (shear - capped), capped);
     fr_[j] = (sliding & (d_fs > 0)) ? d_fs : 0.0;
     shear = select(sliding, capped, shear);
     // Rolling and twisting limits (seed 000 eq 7).
@@ -113,7 +110,7 @@ template <bool kTwist>
     const double m2 = dot(bending, bending);
     const bool rolling = (kr > 0) & (max_roll_[j] >= 0) & (m2 > max_roll);
     const V3 bending_capped = bending * std::sqrt(max_roll / m2);
-    const double d_roll = dot(inv_kr_[j] * (bending - bending_capped), bending_capped);
+    const double d_roll = dot((1.0 / kr) * (bending - bending_capped), bending_capped);
     ro_[j] = (rolling & (d_roll > 0)) ? d_roll : 0.0;
     bending = select(rolling, bending_capped, bending);
     if constexpr (kTwist) {

@@ -10,7 +10,6 @@ namespace gs::solver {
 /// Constant contact parameters, set when the contact is created.
 struct ContactParams {
   double kn = 0, ks = 0, kr = 0, ktw = 0;
-  double inv_ks = 0, inv_kr = 0;  // 1/ks and 1/kr, for the dissipation of the limits
   double tan_friction = 0;
   double max_roll = -1;   // η·R_roll (m); negative: rolling moment unbounded
   double max_twist = -1;  // likewise for twisting
@@ -52,11 +51,11 @@ struct ContactBatch {
     C2X, C2Y, C2Z,  // contact point − centre of body 2
     FRESH,          // 1: the contact is new this step (history starts at zero)
     ONX, ONY, ONZ,  // last step's normal
-    KN, KS, KR, KTW, INV_KS, INV_KR, TAN_FRICTION, MAX_ROLL, MAX_TWIST,
+    KN, KS, KR, KTW, TAN_FRICTION, MAX_ROLL, MAX_TWIST,  // KTW, MAX_TWIST: only with `twist`
     // history: read, and written back with this step's values
     SX, SY, SZ,     // shear force
     BX, BY, BZ,     // bending moment
-    TX, TY, TZ,     // twisting moment
+    TX, TY, TZ,     // twisting moment (only with `twist`)
     // outputs
     F1X, F1Y, F1Z,  // force on body 1
     A1X, A1Y, A1Z,  // torque on body 1 from the force (arm1)
@@ -78,8 +77,8 @@ struct ContactBatch {
 /// selects, with the operations of each lane in the order of the scalar law, so results do not
 /// depend on the batching. Vectorised with AVX-512 or AVX2 where the CPU has them (chosen at
 /// load time); every variant gives the same bits.
-/// `twist`: some lane has a twisting stiffness (otherwise the twisting moments are zero and
-/// their limit is not computed).
+/// `twist`: twisting moments are enabled. Without it KTW, MAX_TWIST and TX..TZ are not read
+/// (the caller need not fill them) and the twisting moments come out zero.
 void cohesive_frictional_batch(ContactBatch& batch, int count, double dt, bool twist);
 
 }  // namespace gs::solver

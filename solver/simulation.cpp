@@ -241,8 +241,6 @@ void Simulation::accumulate_walls() {
     B.v[F::KTW][j] = p.ktw;
     B.v[F::MAX_TWIST][j] = p.max_twist;
   }
-  B.v[F::INV_KS][j] = p.inv_ks;
-  B.v[F::INV_KR][j] = p.inv_kr;
   B.v[F::TAN_FRICTION][j] = p.tan_friction;
   B.v[F::MAX_ROLL][j] = p.max_roll;
   // The history's geometry of this step.
