@@ -16,14 +16,15 @@ struct ParticleBatch {
   static constexpr int kLanes = 32;
   // clang-format off
   enum Field : int {
-    // inputs (velocities, position, orientation and rotation are updated in place)
+    // inputs (velocities and orientation are updated in place; positions and rotation
+    // vectors are advanced by the caller from the new velocities)
     VX, VY, VZ, WX, WY, WZ, FX, FY, FZ, TX, TY, TZ,
     EX, EY, EZ,  // external force
-    PX, PY, PZ, QW, QX, QY, QZ, RX, RY, RZ,
+    QW, QX, QY, QZ,
     MASS, INERTIA, FIXED, ROT_BLOCKED,
-    // outputs: this particle's terms of the step's sums, the finite check, and 1 where the
-    // orientation is updated again in scalar code (a rotation too large for the series, or a
-    // quaternion that was not a unit one)
+    // outputs: this particle's terms of the step's sums, the finite check of the velocity,
+    // and 1 where the orientation is updated again in scalar code (a rotation too large for
+    // the series, or a quaternion that was not a unit one)
     GRAVITY_POWER, EXTERNAL_POWER, DAMPING, FINITE, LARGE_ANGLE,
     kFields
   };
@@ -65,11 +66,9 @@ __attribute__((target_clones("avx512f", "avx2", "default"))) void integrate_batc
            ang.y * cundall_factor(damping, dt, angvel0.y, ang.y),
            ang.z * cundall_factor(damping, dt, angvel0.z, ang.z)};
     const V3 angvel = select(free_lane & spin, angvel0 + dt * ang, angvel0);
-    const V3 pos = in3(F::PX, j) + vel * dt;
     out3(F::VX, j, vel);
     out3(F::WX, j, angvel);
-    out3(F::PX, j, pos);
-    b.v[F::FINITE][j] = (squared_norm(pos) < HUGE_VAL) & (squared_norm(vel) < HUGE_VAL) ? 1.0 : 0.0;
+    b.v[F::FINITE][j] = squared_norm(vel) < HUGE_VAL ? 1.0 : 0.0;
     // Orientation: q ← (cos h, sin h·ω/|ω|)·q with h = |ω|·dt/2 (YADE's
     // leapfrogSphericalRotate). Below h = 1e-3 rad the series is exact to double precision.
     const double a2 = squared_norm(angvel);
@@ -93,7 +92,6 @@ __attribute__((target_clones("avx512f", "avx2", "default"))) void integrate_batc
     b.v[F::QY][j] = ny * scale;
     b.v[F::QZ][j] = nz * scale;
     if (!(std::abs(q2 - 1) < 1e-8)) b.v[F::LARGE_ANGLE][j] = 1.0;
-    out3(F::RX, j, in3(F::RX, j) + angvel * dt);
   }
 }
 
@@ -118,8 +116,6 @@ IntegrationSums integrate_particles(ParticleState& p, std::size_t begin, std::si
       put(F::FX, j, p.force[i]);
       put(F::TX, j, p.torque[i]);
       put(F::EX, j, p.external_force[i]);
-      put(F::PX, j, p.pos[i]);
-      put(F::RX, j, p.rot[i]);
       b.v[F::QW][j] = p.ori[i].w();
       b.v[F::QX][j] = p.ori[i].x();
       b.v[F::QY][j] = p.ori[i].y();
@@ -130,17 +126,20 @@ IntegrationSums integrate_particles(ParticleState& p, std::size_t begin, std::si
       b.v[F::ROT_BLOCKED][j] = p.rot_blocked[i];
     }
     integrate_batch(b, count, V3(gravity), damping, dt);
-    auto get = [&](F f, int j) { return Eigen::Vector3d(b.v[f][j], b.v[f + 1][j], b.v[f + 2][j]); };
+    auto get = [&](F f, int j) { return V3(b.v[f][j], b.v[f + 1][j], b.v[f + 2][j]); };
     for (int j = 0; j < count; ++j) {
       const std::size_t i = i0 + static_cast<std::size_t>(j);
       sums.gravity_power += b.v[F::GRAVITY_POWER][j];
       sums.external_power += b.v[F::EXTERNAL_POWER][j];
       sums.damping += b.v[F::DAMPING][j];
-      sums.finite = sums.finite && b.v[F::FINITE][j] != 0;
-      p.vel[i] = get(F::VX, j);
-      p.angvel[i] = get(F::WX, j);
-      p.pos[i] = get(F::PX, j);
-      p.rot[i] = get(F::RX, j);
+      const V3 vel = get(F::VX, j), angvel = get(F::WX, j);
+      vel.store(p.vel[i]);
+      angvel.store(p.angvel[i]);
+      // Position and rotation vector here rather than through the batch (fewer copies).
+      const V3 pos = V3(p.pos[i]) + vel * dt;
+      pos.store(p.pos[i]);
+      add_to(p.rot[i], angvel * dt);
+      sums.finite = sums.finite && b.v[F::FINITE][j] != 0 && squared_norm(pos) < HUGE_VAL;
       if (b.v[F::LARGE_ANGLE][j] == 0) {
         p.ori[i] = Eigen::Quaterniond(b.v[F::QW][j], b.v[F::QX][j], b.v[F::QY][j], b.v[F::QZ][j]);
         continue;
