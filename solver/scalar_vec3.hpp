@@ -19,9 +19,6 @@ struct V3 {
   Eigen::Vector3d eigen() const { return {x, y, z}; }
 };
 
-inline V3 load3(const Eigen::Vector3d& v) {
-  return V3(v);
-}
 inline V3 operator+(const V3& a, const V3& b) {
   return {a.x + b.x, a.y + b.y, a.z + b.z};
 }
