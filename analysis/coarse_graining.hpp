@@ -10,7 +10,7 @@
 // stresses are positive in a compressed, agitated packing). The line integral over the branch
 // uses Gauss–Legendre points along it (2 + ceil(2 |l| / w), at most 16).
 //
-// Discretisation: fields are given on the points of a RevGrid (cell size 0). On each axis the
+// Discretisation: fields are given on the points of a RevGrid (make_point_grid). On each axis the
 // kernel weight of grid point k is the Gaussian's integral over the grid interval
 // [x_k - s/2, x_k + s/2] divided by s (erf differences), renormalised to the cut-off stencil, so
 // every particle (and every quadrature point of a branch) deposits exactly its mass (branch
@@ -43,7 +43,7 @@ struct CoarseOptions {
   double particle_density = 2650.0;  // kg/m^3, for particles of unknown mass (mass = 0)
 };
 
-/// Fields on the points of `grid` (made with cell = 0). Parallel over blocks of grid planes;
+/// Fields on the points of `grid` (make_point_grid). Parallel over blocks of grid planes;
 /// results do not depend on the number of threads. Throws std::invalid_argument for w <= 0.
 CoarseFields coarse_grain(const Frame& frame, const ContactBranches& branches, const RevGrid& grid,
                           const CoarseOptions& options);

@@ -231,9 +231,17 @@ Eigen::Vector3d RevGrid::centre(std::size_t c) const {
   return global(u);
 }
 
-RevGrid make_rev_grid(const Frame& frame, const RevGridSpec& spec) {
-  if (!(spec.cell >= 0.0) || !std::isfinite(spec.cell))
+namespace {
+
+/// Grid of cells of side spec.cell (> 0), or of points (spec.cell = 0, `points`).
+RevGrid make_grid(const Frame& frame, const RevGridSpec& spec, bool points) {
+  if (points) {
+    if (spec.cell != 0.0)
+      throw std::invalid_argument("a grid of points has cell size 0 (" + std::to_string(spec.cell) +
+                                  ")");
+  } else if (!(spec.cell > 0.0) || !std::isfinite(spec.cell)) {
     throw std::invalid_argument("REV cell size must be > 0 (" + std::to_string(spec.cell) + ")");
+  }
   if (!(spec.step > 0.0) || !std::isfinite(spec.step))
     throw std::invalid_argument("REV step must be > 0 (" + std::to_string(spec.step) + ")");
   if (frame.particles.empty()) throw std::invalid_argument("the frame has no particles");
@@ -299,10 +307,29 @@ RevGrid make_rev_grid(const Frame& frame, const RevGridSpec& spec) {
   return g;
 }
 
+/// REV averages divide by the cell measure: a grid of points has none.
+void check_cells(const RevGrid& g) {
+  if (!(g.measure() > 0.0))
+    throw std::invalid_argument(
+        "REV averages need cells of size > 0 (a grid of points is for "
+        "coarse-graining)");
+}
+
+}  // namespace
+
+RevGrid make_rev_grid(const Frame& frame, const RevGridSpec& spec) {
+  return make_grid(frame, spec, false);
+}
+
+RevGrid make_point_grid(const Frame& frame, const RevGridSpec& spec) {
+  return make_grid(frame, spec, true);
+}
+
 // ---- averages -------------------------------------------------------------------------------
 
 RevFields rev_average(const Frame& frame, const ContactBranches& branches, const RevGrid& g,
                       const ParticleMotion& motion) {
+  check_cells(g);
   check_motion(frame, motion);
   const bool with_motion = !motion.matched.empty();
   const std::vector<double> z = contact_counts(frame, branches);
@@ -504,6 +531,7 @@ RevFields rev_average(const Frame& frame, const ContactBranches& branches, const
 RevFields rev_average_brute_force(const Frame& frame, const ContactBranches& branches,
                                   const RevGrid& g, const ParticleMotion& motion,
                                   const std::vector<std::size_t>& cells) {
+  check_cells(g);
   check_motion(frame, motion);
   const bool with_motion = !motion.matched.empty();
   RevFields f = empty_fields(g.count(), with_motion);

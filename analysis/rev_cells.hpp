@@ -34,7 +34,7 @@
 namespace gs::analysis {
 
 struct RevGridSpec {
-  double cell = 0.0;         // L, m (> 0); 0 makes a grid of points (kernel coarse-graining)
+  double cell = 0.0;         // L, m (> 0); 0 for a grid of points (make_point_grid)
   double step = 0.0;         // s, m (> 0)
   std::optional<Slab> slab;  // 2D grid in the slab (3D frames only)
   /// Box the cells must fit in (default: the extent of the spheres): 3D grid: global box; slab:
@@ -85,6 +85,10 @@ struct RevGrid {
 /// particle in the slab.
 RevGrid make_rev_grid(const Frame& frame, const RevGridSpec& spec);
 
+/// Grid of points (cells of size 0) for kernel coarse-graining (coarse_graining.hpp), laid out
+/// as make_rev_grid lays out cells; spec.cell must be 0. Same errors otherwise.
+RevGrid make_point_grid(const Frame& frame, const RevGridSpec& spec);
+
 struct RevFields {
   std::vector<double> solid_volume;           // m^3 (m^2 in 2D)
   std::vector<double> solid_fraction;         // V_s / V_cell
@@ -102,7 +106,8 @@ struct ParticleMotion {
   std::vector<std::uint8_t> matched;
 };
 
-/// REV averages on the grid (binned, parallel over cells, deterministic).
+/// REV averages on the grid (binned, parallel over cells, deterministic). Throws
+/// std::invalid_argument for a grid of points (no cell volume).
 RevFields rev_average(const Frame& frame, const ContactBranches& branches, const RevGrid& grid,
                       const ParticleMotion& motion = {});
 

@@ -221,7 +221,7 @@ void run_rev(const RevArgs& a) {
   MapFields out;
   const auto branches = ga::contact_branches(f);
   try {
-    g = ga::make_rev_grid(f, spec);
+    g = gauss ? ga::make_point_grid(f, spec) : ga::make_rev_grid(f, spec);
     if (!gauss) {
       const auto r = ga::rev_average(f, branches, g, motion);
       out.scalar = {{"void_ratio", r.void_ratio},

@@ -157,7 +157,7 @@ int main(int argc, char** argv) {
   cg.cell = 0.0;
   cg.step = d50;
   t0 = Clock::now();
-  const auto gg = gs::analysis::make_rev_grid(f, cg);
+  const auto gg = gs::analysis::make_point_grid(f, cg);
   const auto fields = gs::analysis::coarse_grain(f, branches, gg, {d50, 2650.0});
   std::printf("Gaussian coarse-graining (w = d50, 3D, %zu points): %.3f s\n", gg.count(),
               seconds_since(t0));

@@ -24,7 +24,7 @@ TEST(CoarseGraining, ConservesMassVolumeAndContactTensor) {
   spec.step = 0.45 * sp;
   const double w = 0.6 * sp, margin = 4 * w + 2 * sp;  // the grid covers every stencil
   spec.region = {Eigen::Vector3d::Constant(-margin), Eigen::Vector3d::Constant(8 * sp + margin)};
-  const auto g = ga::make_rev_grid(f, spec);
+  const auto g = ga::make_point_grid(f, spec);
   const auto cf = ga::coarse_grain(f, b, g, {w, 2650.0});
   double mass = 0.0, vol = 0.0;
   Eigen::Matrix3d lf = Eigen::Matrix3d::Zero();
@@ -71,7 +71,7 @@ TEST(CoarseGraining, UniformLatticeGivesUniformFields) {
   spec.step = 0.7 * a;
   const double w = a;
   spec.region = {Eigen::Vector3d::Constant(7.1 * a), Eigen::Vector3d::Constant(11.9 * a)};
-  const auto g = ga::make_rev_grid(f, spec);
+  const auto g = ga::make_point_grid(f, spec);
   const auto cf = ga::coarse_grain(f, b, g, {w, 2650.0});
   const double rho = 1e-6 / (a * a * a), p = force / (a * a);
   double worst = 0.0;
@@ -105,7 +105,7 @@ TEST(CoarseGraining, KineticStressOfRandomVelocities) {
   spec.cell = 0.0;
   spec.step = 1e-3;
   spec.region = {Eigen::Vector3d::Zero(), Eigen::Vector3d::Constant(10e-3)};
-  const auto g = ga::make_rev_grid(f, spec);
+  const auto g = ga::make_point_grid(f, spec);
   const auto cf = ga::coarse_grain(f, ga::contact_branches(f), g, {1e-3, 2650.0});
   const Eigen::Vector3d u(0.3, 0.1, -0.2);
   for (std::size_t q = 0; q < g.count(); ++q) {
@@ -128,7 +128,7 @@ TEST(CoarseGraining, TwoDFrameAndSlabConserve) {
   spec.slab = ga::Slab{Eigen::Vector3d(4, 4, 4) * sp, Eigen::Vector3d::UnitY(),
                        Eigen::Vector3d::UnitX(), t};
   spec.region = {Eigen::Vector3d::Constant(-7 * sp), Eigen::Vector3d::Constant(7 * sp)};
-  const auto g = ga::make_rev_grid(f, spec);
+  const auto g = ga::make_point_grid(f, spec);
   const auto cf = ga::coarse_grain(f, b, g, {w, 2650.0});
   double m = 0.0, expect = 0.0;
   for (std::size_t q = 0; q < g.count(); ++q) m += cf.density[q] * g.step * g.step * t;
@@ -144,7 +144,7 @@ TEST(CoarseGraining, TwoDFrameAndSlabConserve) {
   for (auto& p : f.particles) p.position.z() = 0.0;
   spec.slab.reset();
   spec.region = {Eigen::Vector3d::Constant(-3 * sp), Eigen::Vector3d::Constant(11 * sp)};
-  const auto g2 = ga::make_rev_grid(f, spec);
+  const auto g2 = ga::make_point_grid(f, spec);
   const auto c2 = ga::coarse_grain(f, ga::contact_branches(f), g2, {w, 2650.0});
   double m2 = 0.0, mass = 0.0;
   for (std::size_t q = 0; q < g2.count(); ++q) m2 += c2.density[q] * g2.step * g2.step;
@@ -158,7 +158,7 @@ TEST(CoarseGraining, ThreadCountIndependentAndRejectsBadWidth) {
   ga::RevGridSpec spec;
   spec.cell = 0.0;
   spec.step = 0.3e-3;
-  const auto g = ga::make_rev_grid(f, spec);
+  const auto g = ga::make_point_grid(f, spec);
   const int threads = omp_get_max_threads();
   omp_set_num_threads(1);
   const auto one = ga::coarse_grain(f, b, g, {0.5e-3, 2650.0});

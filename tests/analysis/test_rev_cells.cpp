@@ -4,7 +4,10 @@
 #include <omp.h>
 
 #include <cmath>
+#include <limits>
 #include <numbers>
+#include <stdexcept>
+#include <string>
 
 #include "love_weber_stress.hpp"
 #include "packing_util.hpp"
@@ -15,6 +18,7 @@ namespace ga = gs::analysis;
 namespace {
 
 constexpr double kPi = std::numbers::pi;
+constexpr double kInf = std::numeric_limits<double>::infinity();
 
 bool inside(const ga::RevGrid& g, std::size_t c, const Eigen::Vector3d& lo,
             const Eigen::Vector3d& hi) {
@@ -197,16 +201,40 @@ TEST(RevCells, ResultsDoNotDependOnThreadCount) {
   }
 }
 
+/// The message of the std::invalid_argument that `f` throws ("" when it throws none).
+template <class F>
+std::string invalid_argument_of(F&& f) {
+  try {
+    f();
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  return "";
+}
+
 TEST(RevCells, RejectsBadGrids) {
+  // Cell sizes L = 0 (no volume to divide by), negative, NaN and infinite are refused with the
+  // message "REV cell size must be > 0 (L)"; a grid of points (L = 0) is for coarse-graining
+  // only, and REV averages refuse it.
   const gs::Frame f = gs::test::cubic_lattice(4, 0.5e-3, 1.0, false);
   ga::RevGridSpec spec;
-  spec.cell = 0.0;
   spec.step = 1e-3;
-  spec.cell = -1.0;
-  EXPECT_THROW(ga::make_rev_grid(f, spec), std::invalid_argument);
-  spec.cell = std::nan("");
-  EXPECT_THROW(ga::make_rev_grid(f, spec), std::invalid_argument);
-  spec.cell = 1e-3;
+  for (const double bad : {0.0, -0.0, -1.0, std::nan(""), kInf, -kInf}) {
+    spec.cell = bad;
+    const std::string what = invalid_argument_of([&] { ga::make_rev_grid(f, spec); });
+    EXPECT_EQ(what.rfind("REV cell size must be > 0 (", 0), 0u) << bad << ": " << what;
+  }
+  spec.cell = 0.0;
+  const auto points = ga::make_point_grid(f, spec);
+  EXPECT_EQ(points.measure(), 0.0);
+  const auto b = ga::contact_branches(f);
+  EXPECT_NE(invalid_argument_of([&] { ga::rev_average(f, b, points); }).find("size > 0"),
+            std::string::npos);
+  EXPECT_NE(
+      invalid_argument_of([&] { ga::rev_average_brute_force(f, b, points); }).find("size > 0"),
+      std::string::npos);
+  spec.cell = 1e-3;  // a grid of points has no cell size
+  EXPECT_THROW(ga::make_point_grid(f, spec), std::invalid_argument);
   spec.step = 0.0;
   EXPECT_THROW(ga::make_rev_grid(f, spec), std::invalid_argument);
   spec.step = 1e-3;
