@@ -91,7 +91,7 @@ struct Trajectory {
 std::pair<Eigen::Vector3d, Eigen::Vector3d> particle_bounds(const Frame& frame);
 
 /// Throws InputError naming `source` and the first invalid field: non-finite numbers, radius
-/// <= 0, negative mass, non-unit contact normals, duplicate particle ids.
+/// <= 0, negative mass, non-unit contact and plane-wall normals, duplicate particle ids.
 void validate_frame(const Frame& frame, const std::string& source);
 
 /// The project version string, e.g. "granoscope 0.1.0".

@@ -15,6 +15,7 @@
 #include <vtkXMLUnstructuredGridReader.h>
 
 #include <cmath>
+#include <limits>
 #include <regex>
 
 #include "errors.hpp"
@@ -79,6 +80,14 @@ double field_scalar(vtkFieldData* fd, const char* name, int k, double fallback) 
   return a->GetComponent(0, k);
 }
 
+// An id stored as a floating-point array value (YADE writes Float64 ids): integral and exact.
+std::int64_t id_value(vtkDataArray* a, vtkIdType i, const std::string& file, const char* what) {
+  const double v = a->GetComponent(i, 0);
+  if (!(std::abs(v) <= 9e15) || v != std::round(v))
+    throw InputError(file, std::string(what) + " is not an integer", value_str(v));
+  return static_cast<std::int64_t>(v);
+}
+
 Eigen::Vector3d tuple3(vtkDataArray* a, vtkIdType i) {
   double v[3];
   a->GetTuple(i, v);
@@ -112,7 +121,7 @@ Frame read_vtu_particles(const std::filesystem::path& path) {
     g->GetPoints()->GetPoint(i, x);
     p.position = {x[0], x[1], x[2]};
     p.radius = rad->GetComponent(i, 0);
-    p.id = id ? static_cast<std::int64_t>(std::llround(id->GetComponent(i, 0))) : i;
+    p.id = id ? id_value(id, i, name, "particle id") : i;
     if (vel) p.velocity = tuple3(vel, i);
     if (av) p.angular_velocity = tuple3(av, i);
     if (ori) {
@@ -123,8 +132,14 @@ Frame read_vtu_particles(const std::filesystem::path& path) {
     if (rot) p.rotation = tuple3(rot, i);
     if (mass) p.mass = mass->GetComponent(i, 0);
     // YADE writes clumpId = -1 for standalone bodies, as we do.
-    if (clump) p.clump_id = static_cast<std::int64_t>(std::llround(clump->GetComponent(i, 0)));
-    if (mat) p.material_id = static_cast<std::int32_t>(std::llround(mat->GetComponent(i, 0)));
+    if (clump) p.clump_id = id_value(clump, i, name, "clump id");
+    if (mat) {
+      const std::int64_t m = id_value(mat, i, name, "material id");
+      if (m < std::numeric_limits<std::int32_t>::min() ||
+          m > std::numeric_limits<std::int32_t>::max())
+        throw InputError(name, "material id out of range", value_str(m));
+      p.material_id = static_cast<std::int32_t>(m);
+    }
   }
   vtkFieldData* fd = g->GetFieldData();
   f.time = field_scalar(fd, "TimeValue", 0, 0.0);
@@ -166,8 +181,8 @@ void read_vtp_contacts(const std::filesystem::path& path, Frame& f) {
   f.contacts.resize(static_cast<std::size_t>(n));
   for (vtkIdType i = 0; i < n; ++i) {
     auto& c = f.contacts[static_cast<std::size_t>(i)];
-    c.id1 = static_cast<std::int64_t>(std::llround(id1->GetComponent(i, 0)));
-    c.id2 = static_cast<std::int64_t>(std::llround(id2->GetComponent(i, 0)));
+    c.id1 = id_value(id1, i, name, "contact id1");
+    c.id2 = id_value(id2, i, name, "contact id2");
     c.point = tuple3(pt, i);
     c.normal = tuple3(nn, i);
     c.normal_force = tuple3(fn, i);
@@ -195,8 +210,11 @@ Trajectory read_pvd_series(const std::filesystem::path& pvd_path) {
       if (!std::regex_search(attrs, mf, fl))
         throw InputError(p.string(), "DataSet without file attribute");
       double t = 0;
-      if (std::regex_search(attrs, mt, ts))
+      if (std::regex_search(attrs, mt, ts)) {
         t = text::to_double(mt[1].str(), p.string(), 0, "timestep");
+        if (!std::isfinite(t))
+          throw InputError(p.string(), "DataSet timestep is not finite", mt[1]);
+      }
       out.emplace_back(t, p.parent_path() / mf[1].str());
     }
     if (out.empty()) throw InputError(p.string(), "collection lists no DataSet");

@@ -24,6 +24,13 @@ const LegacyPolyData::Array* find(const std::map<std::string, LegacyPolyData::Ar
   return nullptr;
 }
 
+// Ids are written as floating-point values: integral and exact, or the file is rejected.
+std::int64_t id_value(double v, const std::string& file, const char* what) {
+  if (!(std::abs(v) <= 9e15) || v != std::round(v))
+    throw InputError(file, std::string(what) + " is not an integer", value_str(v));
+  return static_cast<std::int64_t>(v);
+}
+
 Eigen::Vector3d v3(const LegacyPolyData::Array& a, std::size_t i) {
   return {a.values[3 * i], a.values[3 * i + 1], a.values[3 * i + 2]};
 }
@@ -47,8 +54,7 @@ Frame read_yade_legacy(const std::filesystem::path& spheres,
     auto& p = f.particles[i];
     p.position = {s.points[3 * i], s.points[3 * i + 1], s.points[3 * i + 2]};
     p.radius = rad->values[i];
-    p.id =
-        id ? static_cast<std::int64_t>(std::llround(id->values[i])) : static_cast<std::int64_t>(i);
+    p.id = id ? id_value(id->values[i], name, "particle id") : static_cast<std::int64_t>(i);
     if (vel) p.velocity = v3(*vel, i);
     if (av) p.angular_velocity = v3(*av, i);
     if (mass) p.mass = mass->values[i];
@@ -90,8 +96,8 @@ Frame read_yade_legacy(const std::filesystem::path& spheres,
   f.contacts.resize(m);
   for (std::size_t i = 0; i < m; ++i) {
     auto& c = f.contacts[i];
-    c.id1 = static_cast<std::int64_t>(std::llround(id1->values[i]));
-    c.id2 = static_cast<std::int64_t>(std::llround(id2->values[i]));
+    c.id1 = id_value(id1->values[i], iname, "interaction id1");
+    c.id2 = id_value(id2->values[i], iname, "interaction id2");
     if (d.lines[i].size() != 2)
       throw InputError(iname, "interaction line without 2 points", std::to_string(i));
     const auto a = static_cast<std::size_t>(d.lines[i][0]),
