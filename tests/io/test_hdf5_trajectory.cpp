@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <fstream>
 
+#include "../apps/cli_util.hpp"
 #include "errors.hpp"
 #include "hdf5_trajectory.hpp"
 #include "test_util.hpp"
@@ -263,4 +264,172 @@ TEST(Hdf5Trajectory, ReadableByH5py) {
   EXPECT_EQ(cend, 7);
   EXPECT_EQ(std::stod(y), t.frames[1].particles[1].position.y());
   EXPECT_EQ(std::stod(r), t.frames[1].particles[8].radius);
+}
+
+namespace {
+
+// The datasets docs/format.md lists, group by group.
+const std::vector<std::pair<std::string, std::vector<std::string>>> kDocumentedDatasets = {
+    {"particles",
+     {"id", "position", "radius", "velocity", "angular_velocity", "orientation", "rotation", "mass",
+      "clump_id", "material_id"}},
+    {"contacts",
+     {"id1", "id2", "point", "normal", "normal_force", "shear_force", "bending_moment",
+      "twisting_moment", "overlap"}},
+    {"walls", {"id", "kind", "a", "b", "force", "torque"}},
+    {"frames",
+     {"time", "step", "dt", "two_d", "domain_lo", "domain_hi", "periodic", "cell", "end"}},
+};
+
+}  // namespace
+
+// docs/format.md: every array is chunked, shuffled, deflate-compressed and Fletcher-32
+// checksummed. Exact answer: each documented dataset's creation property list holds exactly the
+// pipeline shuffle -> deflate (level 1, the writer's default) -> Fletcher-32, in that order, on
+// a chunked layout; and each group holds exactly the documented datasets.
+TEST(Hdf5Trajectory, EveryDatasetIsChunkedShuffledDeflatedAndChecksummed) {
+  ScratchDir dir("h5filters");
+  const auto path = dir / "run.h5";
+  Trajectory t;
+  t.metadata = meta();
+  t.frames = {random_frame(40, 30, 1), random_frame(41, 20, 2)};
+  write_hdf5_trajectory(path, t);
+  hid_t f = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  ASSERT_GE(f, 0);
+  int checked = 0;
+  for (const auto& [group, names] : kDocumentedDatasets) {
+    hid_t g = H5Gopen2(f, group.c_str(), H5P_DEFAULT);
+    ASSERT_GE(g, 0) << group;
+    H5G_info_t gi;
+    ASSERT_GE(H5Gget_info(g, &gi), 0);
+    EXPECT_EQ(gi.nlinks, names.size()) << group << ": undocumented or missing datasets";
+    H5Gclose(g);
+    for (const auto& n : names) {
+      const std::string ds = "/" + group + "/" + n;
+      hid_t d = H5Dopen2(f, ds.c_str(), H5P_DEFAULT);
+      ASSERT_GE(d, 0) << ds;
+      hid_t dcpl = H5Dget_create_plist(d);
+      EXPECT_EQ(H5Pget_layout(dcpl), H5D_CHUNKED) << ds;
+      ASSERT_EQ(H5Pget_nfilters(dcpl), 3) << ds;
+      const H5Z_filter_t want[3] = {H5Z_FILTER_SHUFFLE, H5Z_FILTER_DEFLATE, H5Z_FILTER_FLETCHER32};
+      for (unsigned k = 0; k < 3; ++k) {
+        unsigned flags = 0, cd[8] = {};
+        size_t ncd = 8;
+        char name[64] = {};
+        const H5Z_filter_t id =
+            H5Pget_filter2(dcpl, k, &flags, &ncd, cd, sizeof name, name, nullptr);
+        EXPECT_EQ(id, want[k]) << ds << " filter " << k << " (" << name << ")";
+        if (id == H5Z_FILTER_DEFLATE) {
+          ASSERT_GE(ncd, 1u);
+          EXPECT_EQ(cd[0], 1u) << ds << ": deflate level";
+        }
+      }
+      H5Pclose(dcpl);
+      H5Dclose(d);
+      ++checked;
+    }
+  }
+  EXPECT_EQ(checked, 34);
+  H5Fclose(f);
+}
+
+namespace {
+
+// File address and stored size of chunk `index` of a dataset.
+std::pair<haddr_t, hsize_t> chunk_location(const std::filesystem::path& path, const char* ds,
+                                           hsize_t index) {
+  hid_t f = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  hid_t d = H5Dopen2(f, ds, H5P_DEFAULT);
+  hsize_t offset[2] = {};
+  unsigned mask = 0;
+  haddr_t addr = HADDR_UNDEF;
+  hsize_t size = 0;
+  hid_t sp = H5Dget_space(d);
+  const herr_t rc = H5Dget_chunk_info(d, sp, index, offset, &mask, &addr, &size);
+  H5Sclose(sp);
+  H5Dclose(d);
+  H5Fclose(f);
+  if (rc < 0) return {HADDR_UNDEF, 0};
+  return {addr, size};
+}
+
+void flip_byte(const std::filesystem::path& path, std::uint64_t at) {
+  std::fstream io(path, std::ios::in | std::ios::out | std::ios::binary);
+  io.seekg(static_cast<std::streamoff>(at));
+  char c = 0;
+  io.read(&c, 1);
+  c = static_cast<char>(c ^ 0x5a);
+  io.seekp(static_cast<std::streamoff>(at));
+  io.write(&c, 1);
+}
+
+// Reads the whole /particles/position dataset; `edc` false disables checksum verification.
+bool read_positions(const std::filesystem::path& path, bool edc, std::vector<double>& out) {
+  hid_t f = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  hid_t d = H5Dopen2(f, "/particles/position", H5P_DEFAULT);
+  hid_t sp = H5Dget_space(d);
+  out.assign(static_cast<std::size_t>(H5Sget_simple_extent_npoints(sp)), 0.0);
+  H5Sclose(sp);
+  hid_t dxpl = H5Pcreate(H5P_DATASET_XFER);
+  H5Pset_edc_check(dxpl, edc ? H5Z_ENABLE_EDC : H5Z_DISABLE_EDC);
+  const herr_t rc = H5Dread(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, dxpl, out.data());
+  H5Pclose(dxpl);
+  H5Dclose(d);
+  H5Fclose(f);
+  return rc >= 0;
+}
+
+}  // namespace
+
+// A flipped byte inside a chunk is caught by the Fletcher-32 checksum, never read silently:
+// the reader throws one line naming the file and the dataset, `granoscope info` prints it as
+// `error: ...` with exit code 2. Flipping a byte of the stored checksum itself (the chunk's
+// last 4 bytes) leaves the data intact: with checksum verification disabled the read returns
+// the written values bit for bit, with it enabled (the default) the read fails, so it is the
+// checksum, not deflate, that detects the damage.
+TEST(Hdf5Trajectory, FlippedChunkByteIsDetectedByTheChecksum) {
+  ScratchDir dir("h5flip");
+  const auto good = dir / "good.h5";
+  Trajectory t;
+  t.metadata = meta();
+  t.frames = {random_frame(300, 50, 1)};
+  write_hdf5_trajectory(good, t);
+  const auto [addr, size] = chunk_location(good, "/particles/position", 0);
+  ASSERT_NE(addr, HADDR_UNDEF);
+  ASSERT_GT(size, 64u);
+  std::vector<double> ref;
+  ASSERT_TRUE(read_positions(good, true, ref));
+  ASSERT_EQ(ref.size(), 900u);
+
+  // Inside the compressed data.
+  const auto data = dir / "data.h5";
+  std::filesystem::copy_file(good, data);
+  flip_byte(data, addr + size / 2);
+  TrajectoryReader r(data);  // metadata and frame table are intact
+  ASSERT_EQ(r.frame_count(), 1u);
+  const std::string msg =
+      data.string() + ": cannot read dataset (corrupt or truncated) (/particles/position)";
+  EXPECT_EQ(error_of([&] { (void)r.frame(0); }), msg);
+  gs::test::ScratchDir log("h5flip_log");
+  const auto info = gs::test::run_cli("info " + data.string(), log.path);
+  EXPECT_EQ(info.rc, 2);
+  EXPECT_EQ(info.err, "error: " + msg + "\n");
+  EXPECT_EQ(info.out, "");
+  const auto conv =
+      gs::test::run_cli("convert " + data.string() + " " + (dir / "out.vtu").string(), log.path);
+  EXPECT_EQ(conv.rc, 2);
+  EXPECT_EQ(conv.err, "error: " + msg + "\n");
+  EXPECT_FALSE(std::filesystem::exists(dir / "out.vtu"));
+  EXPECT_FALSE(std::filesystem::exists(dir / "out.vtp"));
+
+  // In the stored checksum.
+  const auto sum = dir / "sum.h5";
+  std::filesystem::copy_file(good, sum);
+  flip_byte(sum, addr + size - 2);
+  std::vector<double> back;
+  EXPECT_FALSE(read_positions(sum, true, back));
+  ASSERT_TRUE(read_positions(sum, false, back));
+  EXPECT_EQ(back, ref);
+  EXPECT_EQ(error_of([&] { (void)TrajectoryReader(sum).frame(0); }),
+            sum.string() + ": cannot read dataset (corrupt or truncated) (/particles/position)");
 }
