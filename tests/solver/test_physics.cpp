@@ -5,8 +5,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <random>
 
+#include "cuboid_walls.hpp"
+#include "scene_file.hpp"
 #include "simulation.hpp"
 
 using namespace gs;
@@ -341,7 +344,16 @@ TEST(Physics, ServoWallReachesTargetStress) {
   const double force = sim.walls()[1].force.dot(Eigen::Vector3d(0, 0, 1));
   EXPECT_NEAR(force, 1e-3, 1e-5);                      // stress within 1 %
   EXPECT_NEAR(sim.walls()[0].force.z(), -1e-3, 1e-5);  // transmitted to the floor
-  EXPECT_NEAR(sim.frame().contacts.at(0).overlap, 1e-3 / (1e8 * r), 1e-9);  // Fn = Kn·u
+  // Fn = Kn·u on both contacts (floor and servo plane) of the same frame: the overlap equals
+  // |Fn|/Kn with Kn = Ec·2·r·r/(r + r), a sphere–wall contact taking both radii the sphere's
+  // (docs/physics.md), to round-off.
+  const double kn = c.material.young_ec * 2 * r * r / (r + r);
+  const auto f = sim.frame();
+  ASSERT_EQ(f.contacts.size(), 2u);
+  for (const auto& k : f.contacts) {
+    const double u = k.normal_force.norm() / kn;
+    EXPECT_NEAR(k.overlap, u, 1e-12 * u);
+  }
 }
 
 TEST(Physics, EnergyLedgerCatchesAnUnstableRun) {
@@ -394,4 +406,374 @@ TEST(Physics, InertialNumberOfAShearedLattice) {
   const double p = 54 * kn * delta * (2 * r - delta) / 3 / volume;
   const double expected = rate * 2 * r / std::sqrt(p / c.material.density);
   EXPECT_NEAR(sim.inertial_number() / expected, 1.0, 1e-6);
+}
+
+// A sphere spinning at a constant ω with no contacts, no gravity and no damping: after n steps
+// its orientation is the rotation by |ω|·t about ω (t = n·dt) and its rotation vector is ω·t,
+// to round-off; its spin stays ω bit for bit. Two time steps: a half-angle per step below 1e-3
+// rad (the integrator's series) and above it (sincos).
+TEST(Physics, FreeSpinOrientationIsTheRotationByOmegaT) {
+  const Eigen::Vector3d w(3, -2, 6);  // |ω| = 7 rad/s
+  for (double dt : {1e-4, 1e-3}) {
+    SimulationConfig c;
+    c.material = material();
+    c.dt = dt;
+    Particle p = sphere(0, {0, 0, 0}, 1e-3);
+    p.angular_velocity = w;
+    Simulation sim(c, {p}, {});
+    const int n = 2000;
+    sim.run(n);
+    const double t = n * dt;
+    const Eigen::Quaterniond expect(Eigen::AngleAxisd(w.norm() * t, w.normalized()));
+    const auto& q = sim.particles().ori[0];
+    EXPECT_LT(q.angularDistance(expect), 1e-12) << "dt " << dt;
+    EXPECT_NEAR(q.norm(), 1.0, 1e-15);
+    EXPECT_LT((sim.particles().rot[0] - w * t).norm(), 1e-12 * (w * t).norm()) << "dt " << dt;
+    EXPECT_EQ(sim.particles().angvel[0], w);
+  }
+}
+
+// A sphere sliding without rotation on a horizontal plane, Coulomb friction μ, no damping. Exact
+// binary radius and overlap (r = 2⁻¹⁰ m, δ = 2⁻³⁰ m) make Fn = Kn·δ exact, and gravity is set to
+// g = Fn/m so that the normal direction is in equilibrium bit for bit: the sphere stays at
+// overlap δ and decelerates at exactly μ·g. The ledger's friction dissipation is μ·Fn times the
+// plastic slip: the tangential displacement s = Σ vₖ·dt (the velocities the law sees, vₖ = v0 −
+// k·μg·dt) less the elastic stretch μ·Fn/Ks of the shear spring. The kinetic energy lost is that
+// plus the stored ½(μFn)²/Ks, less the leapfrog's n·m·(μg·dt)²/2: the ledger residual is
+// n·m·(μg·dt)²/2 − ½(μFn)²/Ks. All to round-off.
+TEST(Physics, SlidingSphereFrictionWorkIsMuFnTimesSlip) {
+  const double r = std::ldexp(1.0, -10), delta = std::ldexp(1.0, -30), v0 = 0.1;
+  SimulationConfig c;
+  c.material = material(1e8, 20);
+  c.dt = 2e-7;
+  Simulation sim(c, {sphere(0, {0, 0, r - delta}, r, {v0, 0, 0})}, {plane({0, 0, 0}, {0, 0, 1})});
+  sim.particles().rot_blocked[0] = 1;
+  const double m = sim.particles().mass[0];
+  const double kn = c.material.young_ec * 2 * r * r / (r + r), ks = 0.3 * kn;
+  const double fn = kn * delta, g = fn / m, tan_mu = std::tan(20 * M_PI / 180);
+  sim.set_gravity({0, 0, -g});
+  const double e0 = sim.energy().initial;
+  const int n = 20000;  // 4 ms; it would stop after 0.03 s
+  sim.run(n);
+  const double a = tan_mu * g, dt = c.dt;
+  const double vn = v0 - n * a * dt;
+  const double s = n * v0 * dt - a * dt * dt * n * (n - 1) / 2.0;
+  const auto& e = sim.energy();
+  EXPECT_EQ(sim.particles().pos[0].z(), r - delta);
+  const double vx = sim.particles().vel[0].x();
+  // Deceleration μ·g: v carries the round-off of n additions, at most n·ε·v0.
+  const double eps = std::numeric_limits<double>::epsilon();
+  EXPECT_NEAR(vx, vn, n * eps * v0);
+  const double dissipation = tan_mu * fn * (s - tan_mu * fn / ks);
+  EXPECT_NEAR(e.friction_dissipation, dissipation, 1e-12 * dissipation);
+  const double shear = sim.frame().contacts.at(0).shear_force.norm();
+  EXPECT_NEAR(shear, tan_mu * fn, 1e-14 * tan_mu * fn);  // the Coulomb limit
+  const double residual = n * m * (a * dt) * (a * dt) / 2 - 0.5 * tan_mu * fn * tan_mu * fn / ks;
+  // Round-off: the velocity's n·ε·v0 carried into ½·m·v² (2·n·ε·E0).
+  EXPECT_NEAR(e.residual(), residual, 2 * n * eps * e0);
+}
+
+// Cundall's local damping λ on a free body under gravity alone: the acceleration is g·(1 − λ)
+// while it falls from rest (a·v > 0) and g·(1 + λ) while it is thrown up (a·v < 0). The ledger's
+// damping term is λ·m·g·Σ|vₖ|·dt over the velocities at the start of each step, in closed form
+// (sums of arithmetic series), and the ledger residual is the leapfrog's n·m·(a·dt)²/2. All to
+// round-off.
+TEST(Physics, LocalDampingOfAFreeBodyInClosedForm) {
+  const double g = 9.81, lambda = 0.3, dt = 1e-5;
+  const int n = 1000;
+  for (double v0 : {0.0, 1.0}) {  // from rest (down), thrown up (stays rising: v0 > n·a·dt)
+    SimulationConfig c;
+    c.material = material();
+    c.dt = dt;
+    c.damping = lambda;
+    c.gravity = Eigen::Vector3d(0, 0, -g);
+    Simulation sim(c, {sphere(0, {0, 0, 0}, 1e-3, {0, 0, v0})}, {});
+    const double m = sim.particles().mass[0];
+    const double e0 = sim.energy().initial;
+    sim.run(n);
+    const double a = v0 > 0 ? g * (1 + lambda) : g * (1 - lambda);  // deceleration / acceleration
+    const double sign = v0 > 0 ? 1 : -1;                            // direction of motion
+    // Speeds at the start of step k: down from rest k·a·dt; up v0 − k·a·dt.
+    const double sum_v = v0 > 0 ? n * v0 - a * dt * n * (n - 1) / 2.0 : a * dt * n * (n - 1) / 2.0;
+    const double vn = v0 > 0 ? v0 - n * a * dt : -n * a * dt;
+    const auto& e = sim.energy();
+    EXPECT_NEAR(sim.particles().vel[0].z(), vn, 1e-12 * std::abs(vn));
+    const double damping = lambda * m * g * sum_v * dt;
+    EXPECT_NEAR(e.damping_dissipation, damping, 1e-12 * damping);
+    EXPECT_NEAR(e.gravity_work, -sign * m * g * sum_v * dt, 1e-12 * m * g * sum_v * dt);
+    EXPECT_NEAR(e.residual(), n * m * (a * dt) * (a * dt) / 2,
+                1e-12 * (e0 + std::abs(e.gravity_work)));
+  }
+}
+
+// A damped linear oscillator: a sphere on a floor under gravity, released at rest from 1.5 times
+// its static overlap δ = m·g/Kn (the contact stays closed: a linear spring about δ), with
+// Cundall's local damping λ, 3 periods. (1) The ledger's damping term equals Σ λ·|F + m·g|·|v|·dt
+// summed by hand over the recorded steps (F the contact force, v the velocity at the start of the
+// step), to round-off. (2) It equals the loss of KE + PE (½m·v² + ½Kn·(u − δ)²) to the
+// integration's first order: relative difference below ω·dt (the ledger takes each step's
+// power at the velocity of its start; measured 2.7e-5 for ω·dt = 3.1e-3). (3) The amplitude
+// ratio of successive half-cycles is the analytic sqrt((1 − λ)/(1 + λ)) of local damping (a
+// quarter cycle accelerating with force × (1 − λ), the next decelerating with × (1 + λ)), to
+// (ω·dt)² (extrema sampled at steps).
+TEST(Physics, DampedOscillatorLedgerAndAmplitudeDecay) {
+  const double r = 1e-3, g = 9.81, lambda = 0.1;
+  const int per_period = 2000;
+  SimulationConfig c;
+  c.material = material();
+  c.damping = lambda;
+  c.gravity = Eigen::Vector3d(0, 0, -g);
+  const double m = (4.0 / 3.0) * M_PI * r * r * r * c.material.density;
+  const double kn = c.material.young_ec * r;
+  const double omega = std::sqrt(kn / m);
+  c.dt = 2 * M_PI / omega / per_period;
+  const double deq = m * g / kn;
+  Simulation sim(c, {sphere(0, {0, 0, r - 1.5 * deq}, r)}, {plane({0, 0, 0}, {0, 0, 1})});
+  auto energy = [&] {  // KE + elastic + gravity potential, about the static equilibrium
+    const double x = r - sim.particles().pos[0].z() - deq, v = sim.particles().vel[0].z();
+    return 0.5 * m * v * v + 0.5 * kn * x * x;
+  };
+  const double e0 = energy();
+  sim.energy();  // the ledger starts here
+  double hand = 0, last_u = 1.5 * deq, last_du = 0;
+  std::vector<double> amplitudes;
+  for (int s = 0; s < 3 * per_period; ++s) {
+    const double v = sim.particles().vel[0].z();
+    sim.step();
+    const auto& k = sim.frame().contacts.at(0);
+    hand += lambda * std::abs(k.normal_force.z() - m * g) * std::abs(v) * c.dt;
+    const double du = k.overlap - last_u;
+    if (s > 0 && du * last_du < 0) amplitudes.push_back(std::abs(last_u - deq));
+    last_u = k.overlap;
+    last_du = du;
+  }
+  const double damping = sim.energy().damping_dissipation;
+  EXPECT_NEAR(damping, hand, 1e-12 * hand);
+  EXPECT_NEAR(damping, e0 - energy(), omega * c.dt * damping);
+  ASSERT_GE(amplitudes.size(), 5u);
+  const double ratio = std::sqrt((1 - lambda) / (1 + lambda));
+  for (std::size_t i = 1; i < amplitudes.size(); ++i) {
+    EXPECT_NEAR(amplitudes[i] / amplitudes[i - 1], ratio, (omega * c.dt) * (omega * c.dt)) << i;
+  }
+}
+
+// A plane wall turning at a prescribed ω about its point: after n steps its normal is the
+// initial one rotated by |ω|·t about ω (t = n·dt), to round-off; its point does not move, and
+// the frame reports the same normal.
+TEST(Physics, RotatingPlaneNormalIsTheAnalyticRotation) {
+  SimulationConfig c;
+  c.material = material();
+  c.dt = 1e-4;
+  const Eigen::Vector3d n0(0, 0, 1), w(0.5, -1.0, 2.0);
+  WallSpec spec = plane({0, 0, 0}, n0);
+  spec.angular_velocity = w;
+  // A sphere on the rotation axis keeps its distance from the plane (n·ω̂ is constant): no
+  // contact.
+  Simulation sim(c, {sphere(0, 0.1 * w.normalized(), 1e-3)}, {spec});
+  const int n = 5000;  // 0.5 s, 1.15 rad
+  sim.run(n);
+  const Eigen::Vector3d expect = Eigen::AngleAxisd(w.norm() * n * c.dt, w.normalized()) * n0;
+  EXPECT_LT((sim.walls()[0].normal - expect).norm(), 1e-12);
+  EXPECT_EQ(sim.walls()[0].pos, Eigen::Vector3d::Zero());
+  EXPECT_EQ(sim.frame().walls.at(0).b, sim.walls()[0].normal);
+  EXPECT_EQ(sim.contact_count(), 0u);
+}
+
+// Per-wall friction: a sphere slides without rotation along x between two pairs of parallel
+// planes, each pressed by the same exact overlap δ = 2⁻³⁰ m (r = 2⁻¹⁰ m: Fn = Kn·δ exact; the
+// normal forces cancel bit for bit, so the sphere stays on the x axis). The walls have friction
+// 10°, 35°, the material's 25° (friction_deg unset) and 0°. On each wall the tangential force is
+// the Coulomb limit tan μ_w·Fn against the motion (zero on the frictionless one) and the wall
+// feels it along +x; the sphere decelerates at Σ tan μ_w·Fn/m; the ledger's friction
+// dissipation is Σ tan μ_w·Fn·(s − tan μ_w·Fn/Ks) (s = Σ vₖ·dt, less each spring's elastic
+// stretch). All to round-off.
+TEST(Physics, PerWallFrictionLimitsAndDeceleration) {
+  const double r = std::ldexp(1.0, -10), delta = std::ldexp(1.0, -30), v0 = 0.1;
+  SimulationConfig c;
+  c.material = material(1e8, 25);
+  c.dt = 2e-7;
+  const double d = r - delta;
+  std::vector<WallSpec> walls = {plane({0, -d, 0}, {0, 1, 0}), plane({0, d, 0}, {0, -1, 0}),
+                                 plane({0, 0, -d}, {0, 0, 1}), plane({0, 0, d}, {0, 0, -1})};
+  const double mu_deg[4] = {10, 35, 25, 0};
+  walls[0].friction_deg = 10;
+  walls[1].friction_deg = 35;  // walls[2]: the material's 25°
+  walls[3].friction_deg = 0;
+  Simulation sim(c, {sphere(0, {0, 0, 0}, r, {v0, 0, 0})}, walls);
+  sim.particles().rot_blocked[0] = 1;
+  const double m = sim.particles().mass[0];
+  const double kn = c.material.young_ec * 2 * r * r / (r + r), ks = 0.3 * kn, fn = kn * delta;
+  double tan_sum = 0;
+  for (double mu : mu_deg) tan_sum += std::tan(mu * M_PI / 180);
+  const int n = 5000;
+  sim.run(n);
+  const double dt = c.dt, a = tan_sum * fn / m;
+  const double s = n * v0 * dt - a * dt * dt * n * (n - 1) / 2.0;
+  const auto& p = sim.particles();
+  EXPECT_EQ(p.pos[0].y(), 0.0);
+  EXPECT_EQ(p.pos[0].z(), 0.0);
+  const double eps = std::numeric_limits<double>::epsilon();
+  EXPECT_NEAR(p.vel[0].x(), v0 - n * a * dt, n * eps * v0);  // n additions' round-off
+  const auto f = sim.frame();
+  ASSERT_EQ(f.contacts.size(), 4u);
+  double dissipation = 0;
+  for (std::size_t w = 0; w < 4; ++w) {
+    const double limit = std::tan(mu_deg[w] * M_PI / 180) * fn;
+    dissipation += limit * (s - limit / ks);
+    const auto k = std::find_if(f.contacts.begin(), f.contacts.end(),
+                                [&](const Contact& x) { return x.id1 == sim.wall_id(w); });
+    ASSERT_NE(k, f.contacts.end()) << w;
+    EXPECT_EQ(k->normal_force.norm(), fn) << w;
+    if (mu_deg[w] == 0) {
+      EXPECT_EQ(k->shear_force.norm(), 0.0);
+      EXPECT_EQ(sim.walls()[w].force.x(), 0.0);
+      continue;
+    }
+    // Shear force on the sphere: −tan μ_w·Fn along x; the wall gets +tan μ_w·Fn.
+    EXPECT_NEAR(k->shear_force.x(), -limit, 1e-14 * limit) << w;
+    EXPECT_EQ(k->shear_force.y(), 0.0) << w;
+    EXPECT_EQ(k->shear_force.z(), 0.0) << w;
+    EXPECT_NEAR(sim.walls()[w].force.x(), limit, 1e-14 * limit) << w;
+  }
+  const double got = sim.energy().friction_dissipation;
+  EXPECT_NEAR(got, dissipation, 1e-12 * dissipation);
+}
+
+// Rolling resistance of a sphere–wall contact (Kr = β·Ks·R², |M| ≤ η·R·|Fn|) on an incline θ,
+// with friction high enough that the sphere does not slip. At rest the friction force
+// m·g·sinθ has the moment R·m·g·sinθ about the centre, which the rolling moment must balance:
+// the sphere holds while R·m·g·sinθ ≤ η·R·m·g·cosθ, i.e. tanθ ≤ η, and rolls above. Rolling
+// with M at its plateau η·R·Fn: m·a = m·g·sinθ − Fs and (2/5)·m·R²·a/R = Fs·R − η·R·m·g·cosθ give
+// a = (5/7)·g·(sinθ − η·cosθ). The plane is horizontal and gravity is tilted by θ.
+namespace {
+struct RollingRun {
+  double accel = 0, roll_rate = 0;  // down-slope; least-squares slopes over the second half
+  double travel = 0;                // largest down-slope displacement over the second half
+  double plateau_error = 0;  // max | |M| − η·R·|Fn| | / (η·R·|Fn|) over the second half
+  double moment_ratio = 0;   // |M| / (η·R·|Fn|) at the end
+};
+RollingRun rolling_incline(double theta_deg, double eta, double damping) {
+  const double r = 1e-3, g = 9.81, beta = 0.7;
+  SimulationConfig c;
+  c.material = material(1e8, 30, beta, eta);
+  c.dt = 2e-7;
+  c.damping = damping;
+  const double m = (4.0 / 3.0) * M_PI * r * r * r * c.material.density;
+  auto gravity = [&](double th) {
+    return Eigen::Vector3d(-g * std::sin(th), 0, -g * std::cos(th));  // down-slope: −x
+  };
+  c.gravity = gravity(0);
+  const double th = theta_deg * M_PI / 180;
+  // At rest at the static overlap; gravity turned quasi-statically to θ over 4 ms (a sudden tilt
+  // would set the elastic tangential and rolling springs oscillating).
+  Simulation sim(c, {sphere(0, {0, 0, r - m * g / (c.material.young_ec * r)}, r)},
+                 {plane({0, 0, 0}, {0, 0, 1})});
+  const int ramp = 20000;
+  for (int s = 1; s <= ramp; ++s) {
+    sim.set_gravity(gravity(th * s / ramp));
+    sim.step();
+  }
+  const int steps = 50000;  // 10 ms at θ
+  sim.run(steps / 2);
+  RollingRun out;
+  const double x0 = sim.particles().pos[0].x();
+  double st = 0, sv = 0, sw = 0, stt = 0, stv = 0, stw = 0;
+  for (int s = 1; s <= steps / 2; ++s) {
+    sim.step();
+    const double t = s * c.dt, v = -sim.particles().vel[0].x(), w = sim.particles().angvel[0].y();
+    st += t;
+    sv += v;
+    sw += w;
+    stt += t * t;
+    stv += t * v;
+    stw += t * w;
+    out.travel = std::max(out.travel, std::abs(sim.particles().pos[0].x() - x0));
+    const auto& k = sim.frame().contacts.at(0);
+    const double limit = eta * r * k.normal_force.norm();
+    out.moment_ratio = k.bending_moment.norm() / limit;
+    out.plateau_error = std::max(out.plateau_error, std::abs(out.moment_ratio - 1));
+  }
+  const double n = steps / 2, den = n * stt - st * st;
+  out.accel = (n * stv - st * sv) / den;
+  out.roll_rate = (n * stw - st * sw) / den;
+  return out;
+}
+}  // namespace
+
+TEST(Physics, RollingResistanceHoldsBelowTanThetaEqualsEtaAndRollsAbove) {
+  const double eta = 0.3, r = 1e-3, kn = 1e8 * r;  // threshold θc = atan 0.3 = 16.70°
+  {
+    // 16.5°: tanθ = 0.296, 1.3 % below η. With local damping (it leaves the statics unchanged)
+    // the sphere settles: it does not move (rolling at even 0.01·g would travel 1.2e-7 m in the
+    // 5 ms), and the rolling moment balances the friction force's moment, M = (R − δ/2)·m·g·sinθ
+    // (the contact point lies δ/2 inside the sphere, δ = |Fn|/Kn), i.e.
+    // |M|/(η·R·|Fn|) = (tanθ/η)·(1 − δ/(2R)), to the settling residual.
+    const double th = 16.5 * M_PI / 180;
+    const auto hold = rolling_incline(16.5, eta, 0.2);
+    const double m = (4.0 / 3.0) * M_PI * r * r * r * 2600;
+    const double delta = m * 9.81 * std::cos(th) / kn;
+    const double expected = std::tan(th) / eta * (1 - delta / (2 * r));
+    EXPECT_LT(hold.travel, 1e-9);
+    EXPECT_NEAR(hold.moment_ratio, expected, 1e-8);
+  }
+  for (double deg : {17.0, 20.0}) {
+    // Above (tanθ = 0.306 at 17°, 1.9 % over η): rolling without slip (v = −ω_y·R) at the
+    // analytic acceleration, the rolling moment at its plateau η·R·|Fn| at every step, to
+    // round-off. The acceleration and spin rate are least-squares slopes; the residual elastic
+    // oscillation of the quasi-static tilt is below 1e-4 of them.
+    const double th = deg * M_PI / 180;
+    const auto roll = rolling_incline(deg, eta, 0.0);
+    const double expected = 5.0 / 7.0 * 9.81 * (std::sin(th) - eta * std::cos(th));
+    EXPECT_NEAR(roll.accel, expected, 1e-4 * expected) << deg;
+    EXPECT_NEAR(-roll.roll_rate * r, roll.accel, 1e-4 * roll.accel) << deg;
+    EXPECT_LT(roll.plateau_error, 1e-14) << deg;
+  }
+}
+
+// The membrane of a plane-strain test (the shipped tiny scene, prepared by its own programme,
+// then loaded): at every refresh the loads on the x− face add up to +σc × (projected area) along
+// x and those on the x+ face to −σc × (projected area), the area being the span between the
+// plane-strain walls (y) times the height between the clamps (z), read from the walls; to
+// round-off.
+TEST(Membrane, PlaneStrainLoadsSumToSigmaCTimesProjectedArea) {
+  Scene s =
+      load_scene(std::filesystem::path(GS_TEST_DATA_DIR) / "scenes" / "plane_strain_tiny.toml");
+  auto programmes = scene_programmes(s);
+  ASSERT_EQ(programmes.size(), 2u);
+  Simulation sim(s.config, s.particles, s.walls);
+  auto& prep = *programmes[0];
+  prep.start(sim);
+  while (!prep.finished(sim)) {
+    prep.control(sim);
+    if (prep.finished(sim)) break;
+    sim.step();
+  }
+  auto& test = *programmes[1];
+  test.start(sim);
+  const double sigma = s.plane_strain.confining_Pa;
+  const std::int64_t refresh = s.plane_strain.refresh_steps;
+  int checked = 0;
+  for (std::int64_t k = 0; k < 5 * refresh; ++k) {
+    test.control(sim);
+    if (k % refresh == 0) {
+      const auto& w = sim.walls();
+      const double y_span = w[kYmax].pos.y() - w[kYmin].pos.y();
+      const double z_lo = w[6].pos.z() + w[6].spec.half_extents.z();  // top of the bottom clamp
+      const double z_hi = w[8].pos.z() - w[8].spec.half_extents.z();  // bottom of the top clamp
+      const double area = y_span * (z_hi - z_lo);
+      Eigen::Vector3d minus = Eigen::Vector3d::Zero(), plus = Eigen::Vector3d::Zero();
+      std::size_t loaded = 0;
+      for (const auto& f : sim.particles().external_force) {
+        if (f.x() > 0) minus += f;
+        if (f.x() < 0) plus += f;
+        loaded += f.x() != 0;
+      }
+      EXPECT_GT(loaded, 20u);
+      EXPECT_NEAR(minus.x(), sigma * area, 1e-12 * sigma * area) << "step " << k;
+      EXPECT_NEAR(plus.x(), -sigma * area, 1e-12 * sigma * area) << "step " << k;
+      ++checked;
+    }
+    sim.step();
+  }
+  EXPECT_EQ(checked, 5);
 }
