@@ -44,6 +44,7 @@ void NeighborList::build(const ParticleState& p, const std::vector<WallState>& w
     hi = hi.cwiseMax(p.pos[i]);
   }
   const double cell = 2 * rmax + skin;
+  const bool clumped = p.clump.size() == n;
   Eigen::Array3i dims;
   for (int k = 0; k < 3; ++k)
     dims[k] =
@@ -81,6 +82,7 @@ void NeighborList::build(const ParticleState& p, const std::vector<WallState>& w
           for (std::uint32_t k = start[ci]; k < start[ci + 1]; ++k) {
             const std::uint32_t j = order[k];
             if (j <= i) continue;
+            if (clumped && p.clump[i] >= 0 && p.clump[i] == p.clump[j]) continue;  // one clump
             const double reach = p.radius[i] + p.radius[j] + skin;
             if ((p.pos[j] - p.pos[i]).squaredNorm() < reach * reach)
               pairs.emplace_back(static_cast<std::uint32_t>(i), j);

@@ -13,7 +13,8 @@ namespace gs::solver {
 
 struct NeighborList {
   double skin = 0;
-  /// Candidate pairs sorted by (a, b); b ≥ kWallBase encodes a wall. Sphere pairs have a < b.
+  /// Candidate pairs sorted by (a, b); b ≥ kWallBase encodes a wall. Sphere pairs have a < b;
+  /// members of one clump are never paired.
   std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs;
   std::vector<Eigen::Vector3d> ref_pos;   // particle positions at the last build
   std::vector<Eigen::Vector3d> wall_ref;  // wall positions at the last build

@@ -45,6 +45,7 @@ Simulation::Simulation(SimulationConfig config, const std::vector<Particle>& par
   p_.fixed.assign(n, 0);
   p_.rot_blocked.assign(n, 0);
   p_.external_force.assign(n, Eigen::Vector3d::Zero());
+  p_.clump.assign(n, -1);
   std::int64_t max_id = -1;
   double rmin = std::numeric_limits<double>::infinity();
   for (std::size_t i = 0; i < n; ++i) {
@@ -76,6 +77,60 @@ Simulation::Simulation(SimulationConfig config, const std::vector<Particle>& par
     walls_.push_back(w);
   }
   nl_.skin = cfg_.skin > 0 ? cfg_.skin : (n > 0 ? 0.5 * rmin : 1e-3);
+}
+
+void Simulation::set_clumps(std::vector<ClumpBody> clumps) {
+  if (step_ != 0) throw std::logic_error("clumps must be set before the first step");
+  for (std::size_t i = 0; i < p_.size(); ++i)
+    if (p_.clump[i] >= 0) throw std::logic_error("clumps are already set");
+  for (std::size_t c = 0; c < clumps.size(); ++c) {
+    const ClumpBody& b = clumps[c];
+    if (b.members.empty() || b.local_pos.size() != b.members.size() ||
+        b.local_ori.size() != b.members.size())
+      throw std::invalid_argument("clump " + std::to_string(c) + " has no members");
+    if (!(b.mass > 0) || !(b.inertia.minCoeff() > 0))
+      throw std::invalid_argument("clump " + std::to_string(c) + " needs a positive mass and inertia");
+    for (const std::uint32_t i : b.members) {
+      if (i >= p_.size())
+        throw std::invalid_argument("clump " + std::to_string(c) + ": no particle " +
+                                    std::to_string(i));
+      if (p_.clump[i] >= 0)
+        throw std::invalid_argument("particle " + std::to_string(i) + " is in two clumps");
+      p_.clump[i] = static_cast<std::int32_t>(c);
+      p_.fixed[i] = 1;  // moved by its clump, not integrated as a sphere
+    }
+  }
+  clumps_ = std::move(clumps);
+  invalidate_neighbors();
+}
+
+bool Simulation::integrate_clumps() {
+  const double dt = cfg_.dt;
+  bool finite = true;
+  double gravity_power = 0, damping = 0;
+  for (ClumpBody& c : clumps_) {
+    // YADE's Clump::addForceTorqueFromMembers, in member order.
+    ClumpLoad load;
+    for (const std::uint32_t i : c.members) {
+      const Eigen::Vector3d& f = p_.force[i];
+      load.force += f;
+      load.torque += p_.torque[i] + (p_.pos[i] - c.pos).cross(f);
+    }
+    gravity_power += c.mass * cfg_.gravity.dot(c.vel);
+    damping += integrate_clump(c, load, cfg_.gravity, cfg_.damping, dt);
+    finite = finite && c.pos.allFinite() && c.vel.allFinite() && c.angmom.allFinite();
+    // YADE's Clump::moveMembers.
+    for (std::size_t k = 0; k < c.members.size(); ++k) {
+      const std::uint32_t i = c.members[k];
+      p_.pos[i] = c.pos + c.ori * c.local_pos[k];
+      p_.ori[i] = c.ori * c.local_ori[k];
+      p_.vel[i] = c.vel + c.angvel.cross(p_.pos[i] - c.pos);
+      p_.angvel[i] = c.angvel;
+    }
+  }
+  ledger_.gravity_work += gravity_power * dt;
+  ledger_.damping_dissipation += damping;
+  return finite;
 }
 
 void Simulation::rebuild_neighbors() {
@@ -465,6 +520,7 @@ void Simulation::step() {
     ledger_.external_work += chunk_sums_[kSums * c + 3] * dt;
     ledger_.damping_dissipation += chunk_sums_[kSums * c + 4];
   }
+  if (!clumps_.empty()) finite = integrate_clumps() && finite;
   if (!(max_overlap_ratio <= cfg_.max_overlap_ratio))
     throw BlowUp("step " + std::to_string(step_) + ": overlap of " +
                  std::to_string(max_overlap_ratio) + " radius exceeds " +
@@ -500,8 +556,10 @@ std::size_t Simulation::sphere_contact_count() const {
 double Simulation::kinetic_energy() const {
   double e = 0;
   for (std::size_t i = 0; i < p_.size(); ++i)
-    e += 0.5 * p_.mass[i] * p_.vel[i].squaredNorm() +
-         0.5 * p_.inertia[i] * p_.angvel[i].squaredNorm();
+    if (p_.clump[i] < 0)
+      e += 0.5 * p_.mass[i] * p_.vel[i].squaredNorm() +
+           0.5 * p_.inertia[i] * p_.angvel[i].squaredNorm();
+  for (const auto& c : clumps_) e += clump_kinetic_energy(c);  // (members skipped, as YADE)
   return e;
 }
 
@@ -550,6 +608,13 @@ double Simulation::unbalanced_force() const {
   for (std::size_t i = 0; i < p_.size(); ++i) {
     if (p_.fixed[i]) continue;
     sum_f += (p_.force[i] + p_.mass[i] * cfg_.gravity).norm();
+    ++nf;
+  }
+  // Clumps count as bodies (their members are fixed, so skipped above, as in YADE).
+  for (const auto& c : clumps_) {
+    Eigen::Vector3d f = c.mass * cfg_.gravity;
+    for (const std::uint32_t i : c.members) f += p_.force[i];
+    sum_f += f.norm();
     ++nf;
   }
   double sum_c = 0;
@@ -621,6 +686,7 @@ Frame Simulation::frame() const {
     q.orientation = p_.ori[i];
     q.rotation = p_.rot[i];
     q.mass = p_.mass[i];
+    q.clump_id = p_.clump[i] >= 0 ? clumps_[static_cast<std::size_t>(p_.clump[i])].id : -1;
   }
   for (const auto& h : hist_) {
     if (!h.real) continue;
@@ -661,7 +727,8 @@ Frame Simulation::frame() const {
 // ------------------------------------------------------------------ checkpoints
 
 namespace {
-constexpr char kMagic[8] = {'G', 'S', 'C', 'K', 'P', 'T', '0', '3'};
+constexpr char kMagic[8] = {'G', 'S', 'C', 'K', 'P', 'T', '0', '4'};
+constexpr char kMagicV03[8] = {'G', 'S', 'C', 'K', 'P', 'T', '0', '3'};  // (no clumps)
 
 template <class T>
 void put(std::ostream& o, const T& v) {
@@ -729,6 +796,14 @@ void Simulation::save_checkpoint(const std::filesystem::path& path,
       if (h.real) real.push_back(h);
     put(o, static_cast<std::uint64_t>(real.size()));
     for (const auto& h : real) put(o, h);
+    put(o, static_cast<std::uint64_t>(clumps_.size()));
+    for (const auto& c : clumps_) {
+      put(o, c.pos);
+      put(o, c.ori);
+      put(o, c.vel);
+      put(o, c.angvel);
+      put(o, c.angmom);
+    }
     put(o, static_cast<std::uint64_t>(extra.size()));
     o.write(extra.data(), static_cast<std::streamsize>(extra.size()));
     if (!o.flush()) throw InputError(path.string(), "cannot write checkpoint");
@@ -742,7 +817,8 @@ std::string Simulation::load_checkpoint(const std::filesystem::path& path) {
   if (!in) throw InputError(file, "cannot open checkpoint");
   char magic[8];
   in.read(magic, 8);
-  if (!in || std::memcmp(magic, kMagic, 8) != 0)
+  const bool v03 = in && std::memcmp(magic, kMagicV03, 8) == 0;
+  if (!in || (!v03 && std::memcmp(magic, kMagic, 8) != 0))
     throw InputError(file, "not a granoscope checkpoint");
   get(in, step_, file);
   get(in, time_, file);
@@ -787,6 +863,17 @@ std::string Simulation::load_checkpoint(const std::filesystem::path& path) {
     throw InputError(file, "corrupt checkpoint (contact count)", std::to_string(nc));
   std::vector<ContactHistory> real(nc);
   for (auto& h : real) get(in, h, file);
+  std::uint64_t ncl = 0;
+  if (!v03) get(in, ncl, file);
+  if (ncl != clumps_.size())
+    throw InputError(file, "checkpoint does not match the scene (clumps)", std::to_string(ncl));
+  for (auto& c : clumps_) {
+    get(in, c.pos, file);
+    get(in, c.ori, file);
+    get(in, c.vel, file);
+    get(in, c.angvel, file);
+    get(in, c.angmom, file);
+  }
   std::uint64_t extra_size = 0;
   get(in, extra_size, file);
   if (extra_size > (1ull << 30))

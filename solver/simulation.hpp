@@ -12,6 +12,7 @@
 #include "contact_geometry.hpp"
 #include "dem_types.hpp"
 #include "neighbor_list.hpp"
+#include "rigid_clump.hpp"
 #include "snapshot.hpp"
 
 namespace gs::solver {
@@ -103,6 +104,13 @@ class Simulation {
   void set_gravity(const Eigen::Vector3d& g) { cfg_.gravity = g; }
   /// Switches a wall on or off; contacts with an inactive wall are dropped.
   void set_wall_active(std::size_t w, bool active);
+  /// Makes rigid clumps of particles (before the first step): each member is then moved with
+  /// its clump (YADE's Clump::moveMembers) and never touches another member of it; the loads on
+  /// the members drive the clump (integrate_clump). Throws on a member index out of range or in
+  /// two clumps.
+  void set_clumps(std::vector<ClumpBody> clumps);
+  const std::vector<ClumpBody>& clumps() const { return clumps_; }
+
   /// Forces a neighbour-list rebuild before the next step.
   void invalidate_neighbors() { nl_.ref_pos.clear(); }
 
@@ -128,12 +136,16 @@ class Simulation {
   /// The law's results in lane j back into pair k's history, and its loads.
   void finish_pair(std::size_t k, const ContactBatch& batch, int j, ContactLoads& loads);
   void update_servos();
+  /// Clump loads from their members, the clumps' integration, and the members moved rigidly;
+  /// adds the clumps' gravity work and damping to the ledger. False on a non-finite state.
+  bool integrate_clumps();
   /// Wall loads, dissipation and work terms of this step, summed in pair / particle order.
   void accumulate_walls();
 
   SimulationConfig cfg_;
   ParticleState p_;
   std::vector<WallState> walls_;
+  std::vector<ClumpBody> clumps_;
   NeighborList nl_;
   std::vector<ContactHistory> hist_;  // parallel to nl_.pairs
   std::vector<ContactParams> params_;
