@@ -43,8 +43,10 @@ FrameMotion motion_between(const Frame& from, const Frame& to, const std::string
   m.kind = "displacement";
   std::unordered_map<std::int64_t, std::size_t> by_id;
   for (std::size_t i = 0; i < to.particles.size(); ++i) by_id.emplace(to.particles[i].id, i);
-  const bool periodic = from.domain.periodic;
-  const Eigen::Matrix3d cell = from.domain.cell;
+  // A particle that left the cell was wrapped back by the cell of the target frame (which may
+  // have deformed since `from`): its image shift is a whole multiple of that cell.
+  const bool periodic = from.domain.periodic || to.domain.periodic;
+  const Eigen::Matrix3d cell = to.domain.periodic ? to.domain.cell : from.domain.cell;
   const Eigen::Matrix3d inv = periodic ? Eigen::Matrix3d(cell.inverse()) : Eigen::Matrix3d::Zero();
   for (std::size_t i = 0; i < from.particles.size(); ++i) {
     const auto it = by_id.find(from.particles[i].id);

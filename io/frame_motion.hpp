@@ -26,7 +26,8 @@ Frame read_frame(const std::string& path, long i);
 std::size_t frame_count(const std::string& path);
 
 /// Without `to`: the velocities of frame `from`. With it: the displacement from `from` to `to`
-/// of every particle present in both (matched by id; periodic cells take the minimum image).
+/// of every particle present in both (matched by id; periodic cells take the minimum image
+/// with respect to the target frame's cell, the one wrapped positions were wrapped into).
 FrameMotion motion_between(const Frame& from, const Frame& to, const std::string& source);
 FrameMotion read_frame_motion(const std::string& path, long from, std::optional<long> to);
 

@@ -7,9 +7,11 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "../apps/cli_util.hpp"
@@ -75,6 +77,35 @@ inline std::string read_format(const std::filesystem::path& file) {
   H5Aclose(a);
   H5Fclose(f);
   return s.c_str();
+}
+
+/// Numeric attribute `name="..."` of an XML tag (the text of the tag); NaN when absent.
+inline double xml_number(const std::string& tag, const std::string& name) {
+  const auto at = tag.find(" " + name + "=\"");
+  if (at == std::string::npos) return std::nan("");
+  return std::stod(tag.substr(at + name.size() + 3));
+}
+
+/// The opening tag of the first element `element` of a VTK XML file (e.g. "Piece").
+inline std::string xml_tag(const std::filesystem::path& file, const std::string& element) {
+  const std::string s = slurp(file);
+  const auto at = s.find("<" + element + " ");
+  if (at == std::string::npos) return "";
+  return s.substr(at, s.find('>', at) - at + 1);
+}
+
+/// RangeMin and RangeMax that VTK's XML writers record for the DataArray `name` of a
+/// "PointData" or "CellData" section (for arrays of several components: of their magnitude).
+inline std::pair<double, double> vtk_range(const std::filesystem::path& file,
+                                           const std::string& section, const std::string& name) {
+  const std::string s = slurp(file);
+  const auto begin = s.find("<" + section + ">"), end = s.find("</" + section + ">");
+  const auto at = s.find("Name=\"" + name + "\"", begin);
+  EXPECT_TRUE(begin != std::string::npos && at < end) << file << ": no " << section << " " << name;
+  if (begin == std::string::npos || at >= end) return {std::nan(""), std::nan("")};
+  const auto open = s.rfind('<', at);
+  const std::string tag = s.substr(open, s.find('>', at) - open + 1);
+  return {xml_number(tag, "RangeMin"), xml_number(tag, "RangeMax")};
 }
 
 }  // namespace gs::test
