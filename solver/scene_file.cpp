@@ -251,6 +251,9 @@ Scene load_scene(const std::filesystem::path& path) {
   if (s.test.empty() || has_packing || !specimen) {
     const std::string packing = r.string(scene, "scene", "packing", true, "");
     const auto packing_path = path.parent_path() / packing;
+    std::error_code missing;
+    if (!std::filesystem::exists(packing_path, missing))
+      r.fail("scene.packing", "no such file", packing_path.string());
     const Trajectory t = read_snapshots(packing_path);
     if (t.frames.empty() || t.frames.back().particles.empty())
       throw InputError(packing_path.string(), "packing holds no particles");

@@ -9,8 +9,10 @@
 #include <algorithm>
 #include <chrono>
 #include <fstream>
+#include <limits>
 #include <sstream>
 #include <thread>
+#include <vector>
 
 #include "../io/test_util.hpp"
 #include "cli_util.hpp"
@@ -83,43 +85,135 @@ TEST(Simulate, ResumeAfterKillIsBitForBitIdentical) {
   EXPECT_FALSE(std::filesystem::exists(killed / "checkpoint.txt"));  // cleaned up at the end
 }
 
+// Bad scenes: exit code 2 and exactly one line "error: FILE: key: what (value)" naming the scene
+// file, the offending key and, where there is one, the offending value (docs/scenes.md; the
+// TOML syntax error names the line of the edit instead of a key).
 TEST(Simulate, BadScenesGiveOneLineAndExit2) {
   gs::test::ScratchDir dir("simulate_bad");
   const std::string good = slurp(kData / "scenes" / "drop.toml");
   std::filesystem::copy_file(kData / "scenes" / "drop_packing.csv", dir / "drop_packing.csv");
+  std::size_t line = 0;  // line of the last edit
   auto variant = [&](const std::string& name, const std::string& from, const std::string& to) {
     std::string s = good;
     const auto k = s.find(from);
     EXPECT_NE(k, std::string::npos) << from;
+    line = static_cast<std::size_t>(std::count(s.begin(), s.begin() + k, '\n')) + 1;
     s.replace(k, from.size(), to);
     std::ofstream(dir / name) << s;
     return (dir / name).string();
   };
-  const std::vector<std::pair<std::string, std::string>> cases = {
-      {(dir / "missing.toml").string(), "no such scene file"},
+  struct Case {
+    std::string file, message;  // the message after "error: FILE: "
+    bool prefix = false;        // the message continues (a parser's description)
+  };
+  const std::string missing = (dir / "missing.toml").string();
+  std::vector<Case> cases = {
+      {missing, "no such scene file"},
       {variant("young.toml", "young_Pa = 5.0e7", "young_Pa = -5.0e7"),
        "material.young_Pa: must be positive (-50000000)"},
-      {variant("syntax.toml", "[solver]", "[solver"), "TOML syntax error"},
       {variant("shape.toml", "shape = \"plane\"", "shape = \"sphere\""),
        "walls[0].shape: expected \"box\" or \"plane\" (sphere)"},
-      {variant("nopack.toml", "drop_packing.csv", "nope.csv"), "no such file"},
+      {variant("nopack.toml", "drop_packing.csv", "nope.csv"),
+       "scene.packing: no such file (" + (dir / "nope.csv").string() + ")"},
       {variant("damp.toml", "damping = 0.1", "damping = 1.5"),
        "solver.damping: outside [0, 1) (1.5)"},
       {variant("vec.toml", "normal = [0.0, 0.0, 1.0]", "normal = [0.0, 1.0]"),
        "walls[0].normal: expected an array of 3 numbers"},
+      {variant("unit.toml", "young_Pa = 5.0e7", "young_MPa = 50.0"),
+       "material.young_MPa: unknown key"},
+      {variant("steps.toml", "steps = 8000", "steps = -5"),
+       "solver.steps: must be at least 0 (-5)"},
   };
-  for (const auto& [file, what] : cases) {
+  const std::string syntax = variant("syntax.toml", "[solver]", "[solver");
+  cases.push_back({syntax, "TOML syntax error at line " + std::to_string(line) + " (", true});
+  for (const auto& [file, what, prefix] : cases) {
     std::string err;
     EXPECT_EQ(run("simulate " + file + " -q -o " + (dir / "out").string(), &err), 2) << file;
-    EXPECT_EQ(err.rfind("error: ", 0), 0u) << err;
-    EXPECT_NE(err.find(what), std::string::npos) << err;
+    const std::string expected = "error: " + file + ": " + what;
+    if (prefix)
+      EXPECT_EQ(err.rfind(expected, 0), 0u) << err;
+    else
+      EXPECT_EQ(err, expected + "\n");
     EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
   }
-  // Resume without a checkpoint.
+  // Resume without a checkpoint: the checkpoint index it looked for is named.
   std::string err;
   EXPECT_EQ(run("simulate " + (kData / "scenes" / "drop.toml").string() + " -q --resume -o " +
                     (dir / "empty").string(),
                 &err),
             2);
-  EXPECT_NE(err.find("no checkpoint to resume from"), std::string::npos) << err;
+  EXPECT_EQ(err, "error: " + (dir / "empty" / "checkpoint.txt").string() +
+                     ": no checkpoint to resume from\n");
+}
+
+namespace {
+std::vector<std::vector<std::string>> csv_rows(const std::string& text) {
+  std::vector<std::vector<std::string>> rows;
+  std::istringstream in(text);
+  std::string line;
+  while (std::getline(in, line)) {
+    std::vector<std::string> row;
+    std::istringstream l(line);
+    std::string field;
+    while (std::getline(l, field, ',')) row.push_back(field);
+    rows.push_back(row);
+  }
+  return rows;
+}
+}  // namespace
+
+// --steps N stops the drop scene (which asks for 8000 steps) after exactly N = 1234 steps: the
+// history has its rows at steps 0, 100, ..., 1200 and a last one at 1234; the trajectory its
+// frames at 0, 500, 1000 and 1234, the last at time 1234·dt; the report says 1234 steps.
+TEST(Simulate, StepsOptionRunsExactlyThatManySteps) {
+  gs::test::ScratchDir dir("simulate_steps");
+  const std::string scene = (kData / "scenes" / "drop.toml").string();
+  const auto r = gs::test::run_cli(
+      "simulate " + scene + " -q --steps 1234 -o " + (dir / "out").string(), dir.path);
+  ASSERT_EQ(r.rc, 0) << r.err;
+  EXPECT_NE(r.out.find("drop: 1234 steps of 150 particles"), std::string::npos) << r.out;
+  const auto h = csv_rows(slurp(dir / "out" / "history.csv"));
+  ASSERT_EQ(h.size(), 1u + 13u + 1u);  // header, steps 0..1200 every 100, step 1234
+  EXPECT_EQ(h[0].at(0), "step");
+  for (std::size_t i = 1; i + 1 < h.size(); ++i)
+    EXPECT_EQ(h[i].at(0), std::to_string(100 * (i - 1)));
+  EXPECT_EQ(h.back().at(0), "1234");
+  const auto t = gs::read_hdf5_trajectory(dir / "out" / "drop.h5");
+  ASSERT_EQ(t.frames.size(), 4u);
+  const std::int64_t steps[4] = {0, 500, 1000, 1234};
+  for (std::size_t i = 0; i < 4; ++i) EXPECT_EQ(t.frames[i].step, steps[i]);
+  const double dt = t.frames.back().dt;
+  EXPECT_NEAR(
+      t.frames.back().time, 1234 * dt,
+      1234 * std::numeric_limits<double>::epsilon() * (1234 * dt));  // a sum of 1234 steps dt
+}
+
+// --threads overrides the scene's thread count (the report says so), and the solver's results do
+// not depend on it (docs/physics.md): with 1 and 2 threads the history and every trajectory
+// frame (particles, contacts, walls) are identical bit for bit. The drop scene with gravity at
+// 3000 m/s², so that the spheres pile up (~150 contacts by step 2000, where the runs stop).
+TEST(Simulate, OneAndTwoThreadsWriteIdenticalOutputs) {
+  gs::test::ScratchDir dir("simulate_threads");
+  std::string text = slurp(kData / "scenes" / "drop.toml");
+  const std::string g = "gravity_m_s2 = [0.0, 0.0, -9.81]";
+  ASSERT_NE(text.find(g), std::string::npos);
+  text.replace(text.find(g), g.size(), "gravity_m_s2 = [0.0, 0.0, -3000.0]");
+  std::ofstream(dir / "pile.toml") << text;
+  std::filesystem::copy_file(kData / "scenes" / "drop_packing.csv", dir / "drop_packing.csv");
+  for (const char* n : {"1", "2"}) {
+    const auto r =
+        gs::test::run_cli("simulate " + (dir / "pile.toml").string() +
+                              " -q --steps 2000 --threads " + n + " -o " + (dir / n).string(),
+                          dir.path);
+    ASSERT_EQ(r.rc, 0) << r.err;
+    EXPECT_NE(r.out.find(std::string(n) + " thread(s))"), std::string::npos) << r.out;
+  }
+  EXPECT_EQ(slurp(dir / "1" / "history.csv"), slurp(dir / "2" / "history.csv"));
+  const auto a = gs::read_hdf5_trajectory(dir / "1" / "drop.h5");
+  const auto b = gs::read_hdf5_trajectory(dir / "2" / "drop.h5");
+  ASSERT_EQ(a.frames.size(), 5u);  // steps 0, 500, ..., 2000
+  ASSERT_EQ(a.frames.size(), b.frames.size());
+  for (std::size_t i = 0; i < a.frames.size(); ++i)
+    gs::test::expect_same_frame(a.frames[i], b.frames[i]);
+  EXPECT_GT(a.frames.back().contacts.size(), 100u);  // the loads split between the threads
 }
