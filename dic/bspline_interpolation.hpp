@@ -24,10 +24,16 @@ class BSplineImage {
  public:
   explicit BSplineImage(const cv::Mat& image);
 
+  /// How far (px) outside the pixel centres `inside` still accepts a point. Warps composed in
+  /// floating point put the border samples of a subset that did not move at -1e-17 px, not 0;
+  /// the mirror-padded coefficients make the interpolant well defined there.
+  static constexpr double kInsideTolerance = 1e-6;
+
   int rows() const { return rows_; }
   int cols() const { return cols_; }
   bool inside(double x, double y) const {
-    return x >= 0.0 && y >= 0.0 && x <= cols_ - 1.0 && y <= rows_ - 1.0;
+    constexpr double e = kInsideTolerance;
+    return x >= -e && y >= -e && x <= cols_ - 1.0 + e && y <= rows_ - 1.0 + e;
   }
   double value(double x, double y) const;
   Sample sample(double x, double y) const;

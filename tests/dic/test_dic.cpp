@@ -275,3 +275,31 @@ TEST(DicSequence, IncrementalAccumulatesLikeCumulative) {
   EXPECT_GT(checked, cum.grid.size());
   EXPECT_THROW(correlate_sequence({images[0]}, {}, opt), std::invalid_argument);
 }
+
+// An image correlated with itself: every POI of the grid is valid, the first and last rows and
+// columns included (their subsets touch the image border), with u = v = 0 to 1e-9 px and
+// ZNCC = 1 to 1e-12. Before the `inside` tolerance the border rows were lost: warps composed in
+// floating point put their samples at -1e-17 px.
+TEST(Dic, ZeroMotionKeepsThePoisWhoseSubsetsTouchTheBorder) {
+  const int n = 64;
+  const SpecklePattern pat(-10, -10, n + 10, n + 10, SpeckleParams{});
+  const cv::Mat img = render(pat, n, identity());
+  DicOptions opt;
+  opt.radius = 8;
+  const PoiGrid grid = make_grid(n, n, opt.radius, 4);
+  const DicField f = correlate(img, img, grid, opt);
+  ASSERT_EQ(grid.size(), 12 * 12);
+  for (int i = 0; i < grid.size(); ++i) {
+    const auto u = static_cast<std::size_t>(i);
+    EXPECT_TRUE(f.valid[u]) << grid.x(i) << "," << grid.y(i);
+    EXPECT_NEAR(f.p[u][0], 0.0, 1e-9);
+    EXPECT_NEAR(f.p[u][3], 0.0, 1e-9);
+    EXPECT_NEAR(f.zncc[u], 1.0, 1e-12);
+  }
+  const BSplineImage s(img);
+  EXPECT_TRUE(s.inside(-1e-17, 0.0));
+  EXPECT_TRUE(s.inside(n - 1.0 + 1e-12, n - 1.0));
+  EXPECT_FALSE(s.inside(-1e-3, 0.0));
+  EXPECT_FALSE(s.inside(0.0, n - 1.0 + 1e-3));
+  EXPECT_NEAR(s.value(-1e-7, 5.0), img.at<double>(5, 0), 1e-4);
+}
