@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "simd_level.hpp"
+
 namespace gs::solver {
 
 ContactParams contact_params(const Material& m, double r1, double r2, double twist_beta,
@@ -133,14 +135,46 @@ template <bool kTwist>
   }
 }
 
-}  // namespace
-
-__attribute__((target_clones("avx512f", "avx2", "default"))) void cohesive_frictional_batch(
-    ContactBatch& batch, int count, double dt, bool twist) {
+// The law compiled for each instruction set (docs/physics.md: the same bits from each).
+void law_generic(ContactBatch& batch, int count, double dt, bool twist) {
   if (twist)
     law_lanes<true>(batch, count, dt);
   else
     law_lanes<false>(batch, count, dt);
+}
+
+#if GS_SIMD_X86
+__attribute__((target("avx2"))) void law_avx2(ContactBatch& batch, int count, double dt,
+                                              bool twist) {
+  if (twist)
+    law_lanes<true>(batch, count, dt);
+  else
+    law_lanes<false>(batch, count, dt);
+}
+
+__attribute__((target("avx512f"))) void law_avx512(ContactBatch& batch, int count, double dt,
+                                                   bool twist) {
+  if (twist)
+    law_lanes<true>(batch, count, dt);
+  else
+    law_lanes<false>(batch, count, dt);
+}
+#endif
+
+}  // namespace
+
+void cohesive_frictional_batch(ContactBatch& batch, int count, double dt, bool twist) {
+#if GS_SIMD_X86
+  switch (simd_level()) {
+    case SimdLevel::Avx512:
+      return law_avx512(batch, count, dt, twist);
+    case SimdLevel::Avx2:
+      return law_avx2(batch, count, dt, twist);
+    case SimdLevel::Generic:
+      break;
+  }
+#endif
+  law_generic(batch, count, dt, twist);
 }
 
 }  // namespace gs::solver

@@ -75,8 +75,9 @@ struct ContactBatch {
 /// stored shear force and moments into the current tangent plane, elastic increments, Coulomb
 /// and rolling limits, and the loads. Every lane computes both sides of each condition and
 /// selects, with the operations of each lane in the order of the scalar law, so results do not
-/// depend on the batching. Vectorised with AVX-512 or AVX2 where the CPU has them (chosen at
-/// load time); every variant gives the same bits.
+/// depend on the batching. Compiled for AVX-512, AVX2 and plain x86-64; the variant is
+/// simd_level() (the best the CPU has unless GS_SIMD or set_simd_level says otherwise), and
+/// every variant gives the same bits.
 /// `twist`: twisting moments are enabled. Without it KTW, MAX_TWIST and TX..TZ are not read
 /// (the caller need not fill them) and the twisting moments come out zero.
 void cohesive_frictional_batch(ContactBatch& batch, int count, double dt, bool twist);

@@ -5,6 +5,8 @@
 
 #include <Eigen/Geometry>
 
+#include "simd_level.hpp"
+
 namespace gs::solver {
 
 namespace {
@@ -35,10 +37,8 @@ struct ParticleBatch {
 
 // YADE's NewtonIntegrator on lanes [0, count): Cundall damping per component, leapfrog, and
 // the rotation of the orientation by |ω|·dt about ω from the half-angle series.
-__attribute__((target_clones("avx512f", "avx2", "default"))) void integrate_batch(ParticleBatch& b,
-                                                                                  int count, V3 g,
-                                                                                  double damping,
-                                                                                  double dt) {
+[[gnu::always_inline]] inline void integrate_lanes(ParticleBatch& b, int count, V3 g,
+                                                   double damping, double dt) {
   using F = ParticleBatch::Field;
   auto in3 = [&](F f, int j) { return V3(b.v[f][j], b.v[f + 1][j], b.v[f + 2][j]); };
   auto out3 = [&](F f, int j, const V3& x) {
@@ -93,6 +93,37 @@ __attribute__((target_clones("avx512f", "avx2", "default"))) void integrate_batc
     b.v[F::QZ][j] = nz * scale;
     if (!(std::abs(q2 - 1) < 1e-8)) b.v[F::LARGE_ANGLE][j] = 1.0;
   }
+}
+
+// The integrator compiled for each instruction set (docs/physics.md: the same bits from each).
+void integrate_generic(ParticleBatch& b, int count, V3 g, double damping, double dt) {
+  integrate_lanes(b, count, g, damping, dt);
+}
+
+#if GS_SIMD_X86
+__attribute__((target("avx2"))) void integrate_avx2(ParticleBatch& b, int count, V3 g,
+                                                    double damping, double dt) {
+  integrate_lanes(b, count, g, damping, dt);
+}
+
+__attribute__((target("avx512f"))) void integrate_avx512(ParticleBatch& b, int count, V3 g,
+                                                         double damping, double dt) {
+  integrate_lanes(b, count, g, damping, dt);
+}
+#endif
+
+void integrate_batch(ParticleBatch& b, int count, V3 g, double damping, double dt) {
+#if GS_SIMD_X86
+  switch (simd_level()) {
+    case SimdLevel::Avx512:
+      return integrate_avx512(b, count, g, damping, dt);
+    case SimdLevel::Avx2:
+      return integrate_avx2(b, count, g, damping, dt);
+    case SimdLevel::Generic:
+      break;
+  }
+#endif
+  integrate_generic(b, count, g, damping, dt);
 }
 
 }  // namespace
