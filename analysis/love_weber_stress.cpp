@@ -5,6 +5,7 @@
 #include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 #include <unordered_map>
 
 namespace gs::analysis {
@@ -82,6 +83,16 @@ Eigen::Matrix3d love_weber_stress(const std::vector<ContactBranch>& branches,
     if (w > 0.0) s.noalias() += w * b.branch * b.force.transpose();
   }
   return s / (hi - lo).prod();
+}
+
+Eigen::Matrix3d periodic_cell_stress(const Frame& frame, const ContactBranches& b) {
+  if (!frame.domain.periodic) throw std::invalid_argument("the frame has no periodic cell");
+  const Eigen::Matrix3d& c = frame.domain.cell;
+  const double v = std::abs(frame.two_d ? c.topLeftCorner<2, 2>().determinant() : c.determinant());
+  if (!(v > 0.0) || !std::isfinite(v)) throw std::invalid_argument("degenerate periodic cell");
+  Eigen::Matrix3d s = Eigen::Matrix3d::Zero();
+  for (const auto& br : b.branches) s.noalias() += br.branch * br.force.transpose();
+  return s / v;
 }
 
 Eigen::Matrix3d boundary_stress(const Frame& frame, const ContactBranches& b, double volume) {

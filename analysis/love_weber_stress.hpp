@@ -52,6 +52,12 @@ double segment_box_fraction(const Eigen::Vector3d& start, const Eigen::Vector3d&
 Eigen::Matrix3d love_weber_stress(const std::vector<ContactBranch>& branches,
                                   const Eigen::Vector3d& lo, const Eigen::Vector3d& hi);
 
+/// Love–Weber stress (compression positive) of a whole periodic cell: every branch counts in
+/// full (with the minimum image each contact is one branch of the periodic volume), divided by
+/// the cell volume |det C| (2D frames: the area of the in-plane cell, N/m per unit depth).
+/// Throws std::invalid_argument for a frame without a periodic cell or a degenerate cell.
+Eigen::Matrix3d periodic_cell_stress(const Frame& frame, const ContactBranches& b);
+
 /// Seed 003 eq 14 without body forces: sigma_ij = -(1/v) sum_beta x_i^beta F_j^beta over the
 /// wall contacts, F the force of the wall on the specimen at the contact point x (compression
 /// positive). Equals the Love–Weber stress of all contacts when every particle is in equilibrium.

@@ -423,9 +423,15 @@ RevFields rev_average(const Frame& frame, const ContactBranches& branches, const
               const auto& p = ax[static_cast<std::size_t>(d)].p;
               blo[d] = p[static_cast<std::size_t>(e[d])];
               bhi[d] = p[static_cast<std::size_t>(e[d] + 1)];
+              // A plane that is not interior to the sphere by the index tests above (k0, k1)
+              // has no slot in the table: treat it as beyond the sphere. Deciding by the
+              // offset instead (p - c < r) can disagree by one rounding for a plane tangent to
+              // the sphere, and read a slot of the next table row.
+              const double lo_off = e[d] < q.k0[d] ? -kInf : blo[d] - c[d];
+              const double hi_off = e[d] + 1 >= q.k1[d] ? kInf : bhi[d] - c[d];
               bool fd = false;
-              nt[d] = cell_terms(blo[d] - c[d], bhi[d] - c[d], r, 1 + e[d] - q.k0[d],
-                                 2 + e[d] - q.k0[d], terms[d], fd);
+              nt[d] = cell_terms(lo_off, hi_off, r, 1 + e[d] - q.k0[d], 2 + e[d] - q.k0[d],
+                                 terms[d], fd);
               full = full && fd;
             }
             double v = 0.0;
