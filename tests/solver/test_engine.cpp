@@ -26,6 +26,12 @@
 using namespace gs;
 using namespace gs::solver;
 
+namespace gs::solver {
+void PrintTo(SimdLevel level, std::ostream* os) {
+  *os << simd_level_name(level);
+}  // (test names and messages show the level's name)
+}  // namespace gs::solver
+
 namespace {
 
 bool same_bits(double a, double b) {
