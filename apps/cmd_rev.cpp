@@ -454,10 +454,20 @@ void run_invariants(const InvArgs& a) {
     const auto b = ga::contact_branches(f);
     if (!has_sigma) {
       auto box = a.sel.make_region(a.in.input);
-      if (!box) box = particle_bounds(f);
-      if (f.two_d) box->first.z() = -0.5, box->second.z() = 0.5;  // per unit depth: N/m
-      volume = (box->second - box->first).prod();
-      sigma = ga::love_weber_stress(b.branches, box->first, box->second);
+      if (!box && f.domain.periodic) {  // the whole cell: every (minimum-image) branch in full
+        try {
+          sigma = ga::periodic_cell_stress(f, b);
+        } catch (const std::invalid_argument& e) {
+          throw InputError(a.in.input, e.what());
+        }
+        const Eigen::Matrix3d& c = f.domain.cell;
+        volume = std::abs(f.two_d ? c.topLeftCorner<2, 2>().determinant() : c.determinant());
+      } else {
+        if (!box) box = particle_bounds(f);
+        if (f.two_d) box->first.z() = -0.5, box->second.z() = 0.5;  // per unit depth: N/m
+        volume = (box->second - box->first).prod();
+        sigma = ga::love_weber_stress(b.branches, box->first, box->second);
+      }
       has_sigma = true;
       if (b.wall_contacts > 0) {
         boundary = ga::boundary_stress(f, b, volume);
@@ -590,7 +600,8 @@ void register_analyze_rev(CLI::App& app) {
         "eta, b, Lode angle, mobilised friction; with --to the deformation gradient and eps_v, "
         "eps_q, b_eps, Biot strain, F = Fv Fd");
     a->in.add_to(*s, true, false);
-    s->add_option("--region", a->sel.region, "box x0 y0 z0 x1 y1 z1 (default: the particles)")
+    s->add_option("--region", a->sel.region,
+                  "box x0 y0 z0 x1 y1 z1 (default: the particles; a periodic frame: its cell)")
         ->expected(6);
     s->add_option("-o,--output", a->output, "output HDF5 (format granoscope-invariants)")
         ->required();
