@@ -235,6 +235,21 @@ Eigen::Quaterniond add_scaled(const Eigen::Quaterniond& q, double s, const Eigen
   return Eigen::Quaterniond(q.coeffs() + p.coeffs() * s);
 }
 
+// YADE's Eigen reduces a 3-vector as x + (y + z) and a 4-vector as (x + y) + (z + w) (its
+// scalar unroller splits in halves); ours vectorises them in another order. The products and
+// the normalisation are written out so that the trajectories round as YADE's do.
+Eigen::Vector3d mat_vec(const Eigen::Matrix3d& a, const Eigen::Vector3d& v) {
+  Eigen::Vector3d r;
+  for (int i = 0; i < 3; ++i) r[i] = a(i, 0) * v[0] + (a(i, 1) * v[1] + a(i, 2) * v[2]);
+  return r;
+}
+
+void normalize(Eigen::Quaterniond& q) {
+  const double n2 = (q.x() * q.x() + q.y() * q.y()) + (q.z() * q.z() + q.w() * q.w());
+  const double n = std::sqrt(n2);
+  q = Eigen::Quaterniond(q.w() / n, q.x() / n, q.y() / n, q.z() / n);
+}
+
 }  // namespace
 
 double integrate_clump(ClumpBody& c, const ClumpLoad& load, const Eigen::Vector3d& gravity,
@@ -255,17 +270,17 @@ double integrate_clump(ClumpBody& c, const ClumpLoad& load, const Eigen::Vector3
   // leapfrogAsphericalRotate, expression by expression.
   const Eigen::Matrix3d a = c.ori.conjugate().toRotationMatrix();  // global -> local
   const Eigen::Vector3d l_n = c.angmom + dt / 2. * m;
-  const Eigen::Vector3d l_b_n = a * l_n;
+  const Eigen::Vector3d l_b_n = mat_vec(a, l_n);
   const Eigen::Vector3d w_b_n = l_b_n.cwiseQuotient(c.inertia);
   const Eigen::Quaterniond dq_n = dot_q(w_b_n, c.ori);
   const Eigen::Quaterniond q_half = add_scaled(c.ori, dt / 2., dq_n);
   c.angmom += dt * m;
-  const Eigen::Vector3d l_b_half = a * c.angmom;
+  const Eigen::Vector3d l_b_half = mat_vec(a, c.angmom);
   const Eigen::Vector3d w_b_half = l_b_half.cwiseQuotient(c.inertia);
   const Eigen::Quaterniond dq_half = dot_q(w_b_half, q_half);
   c.ori = add_scaled(c.ori, dt, dq_half);
   c.angvel = c.ori * w_b_half;  // (before normalising, as YADE)
-  c.ori.normalize();
+  normalize(c.ori);
   // leapfrogTranslate
   c.pos += dt * c.vel;
   return damping != 0 ? damp : 0.0;

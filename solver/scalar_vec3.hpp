@@ -1,8 +1,9 @@
 // A plain 3-vector of doubles for the solver's per-contact and per-particle loops. Eigen's
 // SSE packets of two do not fit three components: the shuffles cost more than the arithmetic
-// in these short expressions. Every operation is written out in the order Eigen's scalar
-// path uses, so results are bit-identical to the Eigen expressions they replace (dot products
-// sum x, y, z left to right; cross products as Eigen's cross3).
+// in these short expressions. Every operation is written out in the order YADE's (unvectorised)
+// Eigen evaluates it, so that our contacts round as YADE's do: a dot product or squared norm
+// sums x + (y + z) (Eigen's scalar unroller splits a reduction in halves; seen on the shared
+// clump case, where the other order moved penetrations by an ulp); cross products as cross3.
 #pragma once
 
 #include <Eigen/Core>
@@ -57,7 +58,7 @@ inline void add_to(Eigen::Vector3d& dst, const V3& v) {
   dst[2] += v.z;
 }
 inline double dot(const V3& a, const V3& b) {
-  return a.x * b.x + a.y * b.y + a.z * b.z;
+  return a.x * b.x + (a.y * b.y + a.z * b.z);
 }
 inline double squared_norm(const V3& a) {
   return dot(a, a);

@@ -89,7 +89,8 @@ void Simulation::set_clumps(std::vector<ClumpBody> clumps) {
         b.local_ori.size() != b.members.size())
       throw std::invalid_argument("clump " + std::to_string(c) + " has no members");
     if (!(b.mass > 0) || !(b.inertia.minCoeff() > 0))
-      throw std::invalid_argument("clump " + std::to_string(c) + " needs a positive mass and inertia");
+      throw std::invalid_argument("clump " + std::to_string(c) +
+                                  " needs a positive mass and inertia");
     for (const std::uint32_t i : b.members) {
       if (i >= p_.size())
         throw std::invalid_argument("clump " + std::to_string(c) + ": no particle " +
@@ -104,18 +105,29 @@ void Simulation::set_clumps(std::vector<ClumpBody> clumps) {
   invalidate_neighbors();
 }
 
-bool Simulation::integrate_clumps() {
-  const double dt = cfg_.dt;
-  bool finite = true;
-  double gravity_power = 0, damping = 0;
-  for (ClumpBody& c : clumps_) {
-    // YADE's Clump::addForceTorqueFromMembers, in member order.
+void Simulation::gather_clump_loads() {
+  clump_loads_.resize(clumps_.size());
+  for (std::size_t k = 0; k < clumps_.size(); ++k) {
+    const ClumpBody& c = clumps_[k];
+    // YADE's Clump::addForceTorqueFromMembers, in member order, with the member positions the
+    // contact loads were computed at.
     ClumpLoad load;
     for (const std::uint32_t i : c.members) {
       const Eigen::Vector3d& f = p_.force[i];
       load.force += f;
       load.torque += p_.torque[i] + (p_.pos[i] - c.pos).cross(f);
     }
+    clump_loads_[k] = load;
+  }
+}
+
+bool Simulation::integrate_clumps() {
+  const double dt = cfg_.dt;
+  bool finite = true;
+  double gravity_power = 0, damping = 0;
+  for (std::size_t k = 0; k < clumps_.size(); ++k) {
+    ClumpBody& c = clumps_[k];
+    const ClumpLoad& load = clump_loads_[k];
     gravity_power += c.mass * cfg_.gravity.dot(c.vel);
     damping += integrate_clump(c, load, cfg_.gravity, cfg_.damping, dt);
     finite = finite && c.pos.allFinite() && c.vel.allFinite() && c.angmom.allFinite();
@@ -490,6 +502,7 @@ void Simulation::step() {
     {
       accumulate_walls();
       update_servos();
+      if (!clumps_.empty()) gather_clump_loads();  // (before the integration moves members)
       for (const auto& w : walls_) ledger_.wall_work += -w.force.dot(w.vel) * dt;
     }  // (implicit barrier: servo velocities and the work terms use this step's loads)
 

@@ -139,6 +139,7 @@ class Simulation {
   /// Clump loads from their members, the clumps' integration, and the members moved rigidly;
   /// adds the clumps' gravity work and damping to the ledger. False on a non-finite state.
   bool integrate_clumps();
+  void gather_clump_loads();
   /// Wall loads, dissipation and work terms of this step, summed in pair / particle order.
   void accumulate_walls();
 
@@ -146,6 +147,7 @@ class Simulation {
   ParticleState p_;
   std::vector<WallState> walls_;
   std::vector<ClumpBody> clumps_;
+  std::vector<ClumpLoad> clump_loads_;
   NeighborList nl_;
   std::vector<ContactHistory> hist_;  // parallel to nl_.pairs
   std::vector<ContactParams> params_;
