@@ -460,3 +460,22 @@ TEST_F(DicCli, BadInputsGiveOneLineErrors) {
       "--subset: must be an odd number of px >= 5 (30)");
   EXPECT_FALSE(fs::exists(dir / "o.h5"));
 }
+
+// --help documents every option with the defaults of docs/dic.md (exact option lines as CLI11
+// prints them), exit code 0, nothing on stderr.
+TEST_F(DicCli, HelpListsTheOptionsWithTheirDefaults) {
+  const CliRun dic = granoscope("dic --help", dir);
+  EXPECT_EQ(dic.rc, 0);
+  EXPECT_EQ(dic.err, "");
+  for (const char* opt : {"--subset INT=31", "--step INT=2", "--roi TEXT", "--incremental",
+                          "--strain-window INT=15", "--strain TEXT=green", "--zncc-min FLOAT=0.9",
+                          "--search INT=30", "--threads INT=0", "--no-csv", "--no-vtk"})
+    EXPECT_NE(dic.out.find(opt), std::string::npos) << opt << "\n" << dic.out;
+  const CliRun render = granoscope("render --help", dir);
+  EXPECT_EQ(render.rc, 0);
+  EXPECT_EQ(render.err, "");
+  for (const char* opt :
+       {"--view TEXT=front", "--px-per-d50 FLOAT=25", "--margin FLOAT=0.5", "--supersample INT=3",
+        "--noise FLOAT=0", "--bits INT=8", "--format TEXT=png", "--seed UINT=1"})
+    EXPECT_NE(render.out.find(opt), std::string::npos) << opt << "\n" << render.out;
+}
