@@ -6,6 +6,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -219,6 +220,137 @@ TEST(CmdHhd, Trajectory3DTubesSliceAndSeries) {
       << slurp(dir / "log");
   expect_png_not_blank(dir / "fv" / "vortices_counts.png");
   expect_png_not_blank(dir / "fv" / "vortices_spectrum.png");
+  fs::remove_all(dir);
+}
+
+TEST(CmdHhd, PeriodicBoundaryCrossingIsTheMinimumImage) {
+  // 400 particles in a periodic 1 cm cell, frame 1 = frame 0 translated by t (4-7 % of the cell)
+  // with the particles that left the cell wrapped back (a jump of ~ one cell length). Exact
+  // answer: the minimum-image displacement is t at every node, and the decomposition of a
+  // uniform field on the mesh is all harmonic (the P1 load of a constant field vanishes at every
+  // interior node): u = 0, v = 0, grad u = curl v = 0, h = t in every simplex, to round-off.
+  // The same frames read as non-periodic give jumps of a cell length (the check is not vacuous).
+  const auto dir = temp_dir();
+  const double side = 0.01;
+  std::mt19937_64 rng(12);
+  std::uniform_real_distribution<double> u(0.0, side);
+  gs::Frame a;
+  a.domain.periodic = true;
+  a.domain.hi = Eigen::Vector3d::Constant(side);
+  a.domain.cell = side * Eigen::Matrix3d::Identity();
+  for (int i = 0; i < 400; ++i) {
+    gs::Particle p;
+    p.id = 3 * i + 1;
+    p.position = Eigen::Vector3d(u(rng), u(rng), u(rng));
+    p.radius = 3e-4;
+    a.particles.push_back(p);
+  }
+  const Eigen::Vector3d t(0.04 * side, -0.07 * side, 0.05 * side);
+  gs::Frame b = a;
+  std::size_t wrapped = 0;
+  for (auto& p : b.particles) {
+    p.position += t;
+    for (int k = 0; k < 3; ++k) {
+      const double w = std::floor(p.position[k] / side);
+      p.position[k] -= w * side;
+      wrapped += w != 0.0;
+    }
+  }
+  EXPECT_GT(wrapped, 50u);
+  gs::Trajectory tr;
+  tr.frames = {a, b};
+  gs::write_hdf5_trajectory(dir / "run.h5", tr);
+  ASSERT_EQ(
+      run("analyze hhd " + (dir / "run.h5").string() + " --to 1 -o " + (dir / "h.h5").string(),
+          dir / "log"),
+      0)
+      << slurp(dir / "log");
+  const auto vec = read_array<double>(dir / "h.h5", "/nodes/vector", H5T_NATIVE_DOUBLE);
+  ASSERT_EQ(vec.size(), 3u * 400u);
+  double worst = 0.0;
+  for (std::size_t k = 0; k < vec.size(); ++k) worst = std::max(worst, std::abs(vec[k] - t[k % 3]));
+  EXPECT_LE(worst, 1e-17);  // x_b - x_a of stored positions ~ 1 cm: rounding 2e-18
+  // Potentials and parts relative to |t|: round-off of the P1 sums (eps |t| L per node, measured
+  // 7e-17 |t| L) and of their gradients on the simplices (measured 2e-15 |t|).
+  const double tn = t.norm();
+  for (const char* name : {"/nodes/u", "/nodes/v"}) {
+    double m = 0.0;
+    for (double x : read_array<double>(dir / "h.h5", name, H5T_NATIVE_DOUBLE))
+      m = std::max(m, std::abs(x));
+    EXPECT_LE(m, 1e-15 * tn * side) << name;
+    std::printf("%s: max |.| = %.3g |t| L\n", name, m / (tn * side));
+  }
+  const auto hh = read_array<double>(dir / "h.h5", "/simplices/harmonic", H5T_NATIVE_DOUBLE);
+  const auto gu = read_array<double>(dir / "h.h5", "/simplices/grad_u", H5T_NATIVE_DOUBLE);
+  const auto cv = read_array<double>(dir / "h.h5", "/simplices/curl_v", H5T_NATIVE_DOUBLE);
+  const auto measure = read_array<double>(dir / "h.h5", "/simplices/measure", H5T_NATIVE_DOUBLE);
+  ASSERT_EQ(hh.size(), 3 * measure.size());
+  double worst_h = 0.0, worst_g = 0.0;
+  for (std::size_t s = 0; s < measure.size(); ++s) {
+    if (!(measure[s] > 0.0)) continue;  // flat in floating point: no part in the decomposition
+    for (std::size_t k = 0; k < 3; ++k) {
+      worst_h = std::max(worst_h, std::abs(hh[3 * s + k] - t[k]));
+      worst_g = std::max({worst_g, std::abs(gu[3 * s + k]), std::abs(cv[3 * s + k])});
+    }
+  }
+  std::printf("max |h - t| = %.3g |t|, max |grad u|, |curl v| = %.3g |t|\n", worst_h / tn,
+              worst_g / tn);
+  EXPECT_LE(worst_h, 1e-13 * tn);
+  EXPECT_LE(worst_g, 1e-13 * tn);
+  // Not periodic: the wrapped particles jump by about a cell length.
+  for (auto* f : {&tr.frames[0], &tr.frames[1]}) f->domain.periodic = false;
+  gs::write_hdf5_trajectory(dir / "plain.h5", tr);
+  ASSERT_EQ(
+      run("analyze hhd " + (dir / "plain.h5").string() + " --to 1 -o " + (dir / "p.h5").string(),
+          dir / "log"),
+      0)
+      << slurp(dir / "log");
+  double jump = 0.0;
+  for (double x : read_array<double>(dir / "p.h5", "/nodes/vector", H5T_NATIVE_DOUBLE))
+    jump = std::max(jump, std::abs(x));
+  EXPECT_GT(jump, 0.9 * side);
+  fs::remove_all(dir);
+}
+
+TEST(CmdHhd, ToleranceOfTheIterativeSolver) {
+  // --solver cg --tolerance TOL: each system stops at the relative residual ||K u - b|| / ||b||
+  // <= TOL (Eigen's CG criterion), so the eq 17 residual the command reports is at most TOL,
+  // and a tighter tolerance takes more iterations and ends with a smaller residual.
+  const auto dir = temp_dir();
+  std::mt19937_64 rng(9);
+  std::uniform_real_distribution<double> u(0.0, 0.05);
+  {
+    std::ofstream o(dir / "f.csv");
+    o << "x,y,ux,uy\n";
+    o.precision(17);
+    for (int i = 0; i < 800; ++i) {
+      const Eigen::Vector2d x(u(rng), u(rng));
+      const Eigen::Vector2d v = 1e-6 * (lamb_oseen(x, {0.02, 0.03}, 1e-2, 5e-3) +
+                                        Eigen::Vector2d(x.x() - 0.025, 0.5 * (x.y() - 0.02)));
+      o << x.x() << "," << x.y() << "," << v.x() << "," << v.y() << "\n";
+    }
+  }
+  double last_residual = 1.0, last_iterations = 0.0;
+  for (const double tol : {1e-3, 1e-6, 1e-12}) {
+    SCOPED_TRACE(tol);
+    const auto out = dir / "h.h5";
+    char opt[64];
+    std::snprintf(opt, sizeof opt, " --solver cg --tolerance %.0e", tol);
+    ASSERT_EQ(run("analyze hhd --csv " + (dir / "f.csv").string() + opt + " -o " + out.string(),
+                  dir / "log"),
+              0)
+        << slurp(dir / "log");
+    EXPECT_EQ(gs::test::read_attr(out, "/", "converged"), 1.0);
+    const double res = gs::test::read_attr(out, "/", "residual_eq17");
+    const double it = gs::test::read_attr(out, "/", "iterations_u");
+    std::printf("tolerance %.0e: residual eq 17 %.3g in %.0f iterations\n", tol, res, it);
+    EXPECT_LE(res, tol);
+    EXPECT_LT(res, last_residual);
+    EXPECT_GT(it, last_iterations);
+    last_residual = res;
+    last_iterations = it;
+    fs::remove(out);
+  }
   fs::remove_all(dir);
 }
 
