@@ -95,7 +95,15 @@ TEST(CmdHhd, Csv2DVortexPairFiguresAndOutputs) {
             0)
       << slurp(dir / "log");
   EXPECT_EQ(gs::test::read_format(dir / "h.h5"), "granoscope-hhd");
-  EXPECT_TRUE(fs::exists(dir / "h.vtu"));
+  // The VTU holds the mesh of the HDF5 output: the 2500 points, its triangles, the same u.
+  const auto tri = read_array<std::int32_t>(dir / "h.h5", "/simplices/vertices", H5T_NATIVE_INT32);
+  const std::string piece = gs::test::xml_tag(dir / "h.vtu", "Piece");
+  EXPECT_EQ(gs::test::xml_number(piece, "NumberOfPoints"), 2500.0);
+  EXPECT_EQ(gs::test::xml_number(piece, "NumberOfCells"), double(tri.size() / 3));
+  const auto pu = read_array<double>(dir / "h.h5", "/nodes/u", H5T_NATIVE_DOUBLE);
+  const auto [ulo, uhi] = gs::test::vtk_range(dir / "h.vtu", "PointData", "u");
+  EXPECT_EQ(ulo, *std::min_element(pu.begin(), pu.end()));
+  EXPECT_EQ(uhi, *std::max_element(pu.begin(), pu.end()));
   const double spacing = 0.05 / std::sqrt(2500.0);
   const auto left = strongest(extrema_rows(dir / "e.csv", "left_vortex"));
   const auto right = strongest(extrema_rows(dir / "e.csv", "right_vortex"));
@@ -157,7 +165,15 @@ TEST(CmdHhd, Trajectory3DTubesSliceAndSeries) {
   const double spacing = 0.02 / std::cbrt(1500.0);
   const auto left = strongest(extrema_rows(dir / "e.csv", "left_vortex"));
   EXPECT_LE(std::hypot(left[0] - 0.009, left[1] - 0.011), spacing);
-  EXPECT_TRUE(fs::exists(dir / "t.vtp"));
+  // The VTP: one polyline per tube of two or more nodes (/tubes/offsets).
+  const auto off = read_array<std::int64_t>(dir / "h.h5", "/tubes/offsets", H5T_NATIVE_INT64);
+  std::size_t long_tubes = 0, tube_nodes = 0;
+  for (std::size_t k = 0; k + 1 < off.size(); ++k)
+    if (off[k + 1] - off[k] >= 2) ++long_tubes, tube_nodes += std::size_t(off[k + 1] - off[k]);
+  EXPECT_GT(long_tubes, 0u);
+  const std::string tubes = gs::test::xml_tag(dir / "t.vtp", "Piece");
+  EXPECT_EQ(gs::test::xml_number(tubes, "NumberOfLines"), double(long_tubes));
+  EXPECT_EQ(gs::test::xml_number(tubes, "NumberOfPoints"), double(tube_nodes));
   // δ = 0: every centre is a one-node tube; the VTP then holds no line (and is still written).
   ASSERT_EQ(run("analyze hhd " + run_h5 + " --from 1 --to 2 -o " + (dir / "h0.h5").string() +
                     " --tubes " + (dir / "t0.vtp").string() + " --delta 0",
