@@ -37,9 +37,25 @@ def _reference_image(images_attr, input_path):
     return img
 
 
+def _check_shapes(f):
+    """Malformed files are a ValueError (one error line), not a traceback from matplotlib."""
+    x, y = f["x"], f["y"]
+    if x.ndim != 1 or y.ndim != 1 or x.shape[0] < 1 or y.shape[0] < 1:
+        raise ValueError("x, y must be non-empty 1-D datasets (shapes %s, %s)"
+                         % (x.shape, y.shape))
+    want = (y.shape[0], x.shape[0])
+    frames = f["u"].shape[0] if f["u"].ndim == 3 else None
+    for name in [n for n, _, _ in FIELDS] + ["valid"]:
+        d = f[name]
+        if d.ndim != 3 or d.shape[1:] != want or d.shape[0] != frames:
+            raise ValueError("dataset %s has shape %s, expected (frames, %d, %d)"
+                             % (name, d.shape, want[0], want[1]))
+
+
 def make(input_path, out_dir, args):
     plt = figutil.plt
     with h5py.File(input_path, "r") as f:
+        _check_shapes(f)
         x = f["x"][()]
         y = f["y"][()]
         nframes = f["u"].shape[0]

@@ -12,6 +12,8 @@ import figutil
 def load_frame(path, frame):
     with h5py.File(path, "r", swmr=True) as f:
         end = f["frames/end"][:]
+        if end.ndim != 2 or end.shape[1] != 3:
+            raise ValueError(f"frames/end has shape {end.shape}, expected (frames, 3)")
         n = len(end)
         if n == 0:
             raise ValueError("trajectory holds no frame")
@@ -22,6 +24,12 @@ def load_frame(path, frame):
         e = int(end[i][0])
         pos = f["particles/position"][b:e]
         rad = f["particles/radius"][b:e]
+        if not 0 <= b <= e or pos.shape != (e - b, 3) or rad.shape != (e - b,):
+            raise ValueError(f"frame {i}: particle rows {b}..{e} do not match "
+                             f"particles/position {f['particles/position'].shape} "
+                             f"and particles/radius {f['particles/radius'].shape}")
+        if len(f["frames/time"]) <= i:
+            raise ValueError(f"frames/time is shorter than frames/end ({len(f['frames/time'])})")
         t = float(f["frames/time"][i])
     return i, t, pos, rad
 

@@ -25,10 +25,30 @@ def make(input_path, out_dir, args):
     raise ValueError("not a strain or voidcells file (format %s)" % fmt)
 
 
+def _shape(f, name, *shape):
+    """Dataset `name` with the given shape (None: any length); a ValueError otherwise, so a
+    malformed file is one error line rather than a traceback from numpy or matplotlib."""
+    if name not in f:
+        raise KeyError("%s missing" % name)
+    d = f[name]
+    if len(d.shape) != len(shape) or any(w is not None and w != n for w, n in zip(shape, d.shape)):
+        raise ValueError("dataset %s has shape %s, expected %s"
+                         % (name, d.shape, tuple("N" if w is None else w for w in shape)))
+    return d[()]
+
+
 def _strain(f, out_dir):
-    if "particles/position" not in f:
-        raise KeyError("particles/position missing")
-    pos = f["particles/position"][()]
+    pos = _shape(f, "particles/position", None, 3)
+    n = len(pos)
+    for name in ("particles/valid", "particles/volumetric_strain",
+                 "particles/equivalent_shear_strain"):
+        _shape(f, name, n)
+    if "simplices/alpha" in f:  # checked before any figure is written
+        tri = _shape(f, "simplices/vertices", None, 3)
+        if tri.size and (tri.min() < 0 or tri.max() >= n):
+            raise ValueError("simplices/vertices index a particle out of range")
+        for name in ("simplices/sliver", "simplices/alpha", "simplices/w"):
+            _shape(f, name, len(tri))
     valid = f["particles/valid"][()].astype(bool)
     vol = f["particles/volumetric_strain"][()]
     shear = f["particles/equivalent_shear_strain"][()]
@@ -62,13 +82,20 @@ def _strain(f, out_dir):
 
 
 def _polygons(f):
-    off = f["cells/offsets"][()]
-    poly = f["cells/polygon"][()]
+    off = _shape(f, "cells/offsets", None)
+    poly = _shape(f, "cells/polygon", None, 2)
+    if len(off) < 1 or off[0] != 0 or off[-1] != len(poly) or (off[1:] < off[:-1]).any():
+        raise ValueError("cells/offsets do not partition cells/polygon")
     return [poly[off[i]:off[i + 1]] for i in range(len(off) - 1)]
 
 
 def _voidcells(f, out_dir):
     polys = _polygons(f)
+    for name in ("cells/alpha", "cells/w"):
+        _shape(f, name, len(polys))
+    n = len(_shape(f, "particles/position", None, 2))
+    _shape(f, "particles/active", n)
+    _shape(f, "particles/relative_velocity", n, 2)
     alpha = f["cells/alpha"][()]
     w = f["cells/w"][()]
     pos = f["particles/position"][()]

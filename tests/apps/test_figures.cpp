@@ -27,6 +27,7 @@
 #include <vector>
 
 #include "../dic/h5_read.hpp"
+#include "field_output.hpp"
 #include "hdf5_trajectory.hpp"
 #include "speckle_synthetic.hpp"
 
@@ -910,4 +911,45 @@ TEST_F(Figures, LabCurveDirectShearAndBadCurve) {
   EXPECT_EQ(bad.err, "error: " + p("lab.h5") + ": fig_labcurve: " + p("curve.csv") +
                          ": not a laboratory-test curve\n");
   EXPECT_TRUE(pngs(dir / "bad").empty());
+}
+
+// Files of the right format with malformed datasets: one line `error: FILE: fig_x: what`, exit
+// 2, no figure, never a Python traceback (fig_dic used to crash in imshow on a 2-D field).
+TEST_F(Figures, MalformedInputsAreOneErrorLine) {
+  {
+    gs::H5FieldFile h(dir / "dic.h5", "granoscope-dic");
+    h.write("/x", std::vector<double>{10, 14, 18});
+    h.write("/y", std::vector<double>{10, 14});
+    for (const char* n : {"/u", "/v", "/exx", "/eyy", "/exy"})
+      h.write(n, std::vector<double>(5, 0.0), {1, 5});
+    h.write("/valid", std::vector<std::uint8_t>(6, 1), {1, 2, 3});
+    h.commit();
+  }
+  {
+    gs::H5FieldFile h(dir / "strain.h5", "granoscope-strain");
+    h.write("/particles/position", std::vector<double>(12, 0.0), {4, 3});
+    h.write("/particles/valid", std::vector<std::uint8_t>(4, 1));
+    h.write("/particles/volumetric_strain", std::vector<double>(4, 0.0));
+    h.write("/particles/equivalent_shear_strain", std::vector<double>(4, 0.0));
+    h.write("/simplices/vertices", std::vector<std::int32_t>{0, 1, 9}, {1, 3});
+    h.write("/simplices/sliver", std::vector<std::uint8_t>{0});
+    h.write("/simplices/alpha", std::vector<double>{1});
+    h.write("/simplices/w", std::vector<double>{0});
+    h.commit();
+  }
+  {
+    gs::H5FieldFile h(dir / "cells.h5", "granoscope-voidcells");
+    h.write("/cells/offsets", std::vector<std::int64_t>{0, 3, 2});
+    h.write("/cells/polygon", std::vector<double>(6, 0.0), {3, 2});
+    h.commit();
+  }
+  for (const auto& [file, what] : std::vector<std::pair<std::string, std::string>>{
+           {"dic.h5", "fig_dic: dataset u has shape (1, 5), expected (frames, 2, 3)"},
+           {"strain.h5", "fig_strain: simplices/vertices index a particle out of range"},
+           {"cells.h5", "fig_strain: cells/offsets do not partition cells/polygon"}}) {
+    const CliRun r = run("figures " + p(file) + " -o " + p(file + "_figs"), false);
+    EXPECT_EQ(r.rc, 2) << file;
+    EXPECT_EQ(r.err, "error: " + p(file) + ": " + what + "\n");
+    EXPECT_TRUE(pngs(dir / (file + "_figs")).empty()) << file;
+  }
 }
