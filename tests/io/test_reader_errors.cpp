@@ -348,3 +348,31 @@ TEST(ReaderErrors, LiggghtsDumpNegativeMassDuplicateIds) {
     expect_cli_rejects(dir / file, msg, dir);
   }
 }
+
+// Damaged files of each VTK flavour, through the CLI: the exact one-line messages (file, what,
+// the offending token in parentheses), exit 2, nothing written.
+TEST(ReaderErrors, DamagedVtkVtuPvdFilesAreOneLineThroughTheCli) {
+  ScratchDir dir("rerr_damaged");
+  write_text(dir / "bad-spheres-0.vtk",
+             "# vtk DataFile Version 3.0.\nc\nASCII\nDATASET POLYDATA\nPOINTS 2 double\n0 0 0\n"
+             "1 abc 0\n");
+  write_text(dir / "cut.vtu", vtu("1 2 3", "1e-5 1e-5 1e-5").substr(0, 200));
+  write_text(dir / "missing.pvd", pvd("0", "gone/p.vtu"));
+  // A NUL byte right after the 37-byte header.
+  write_text(dir / "binary.vtk",
+             std::string("# vtk DataFile Version 3.0.\nc\nBINARY\n") + std::string(1, '\0') + "x");
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"bad-spheres-0.vtk", "bad-spheres-0.vtk: line 7: bad number in point coordinate (abc)"},
+      {"binary.vtk", "binary.vtk: binary content in a text file (NUL byte at offset 37)"},
+      {"missing.pvd", "gone/p.vtu: no such file"},
+  };
+  for (const auto& [file, what] : cases) {
+    const std::string msg = (dir.path / what).string();
+    EXPECT_EQ(error_of(dir / file), msg);
+    expect_cli_rejects(dir / file, msg, dir);
+  }
+  // A truncated XML file: VTK's parser reads no points; the message names the file.
+  const std::string cut = error_of(dir / "cut.vtu");
+  EXPECT_EQ(cut.rfind((dir / "cut.vtu").string() + ": ", 0), 0u) << cut;
+  expect_cli_rejects(dir / "cut.vtu", cut, dir);
+}
