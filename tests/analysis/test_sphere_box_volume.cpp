@@ -8,9 +8,9 @@
 
 #include "sphere_box_volume.hpp"
 
-using gs::analysis::disc_rectangle_area;
-using gs::analysis::sphere_box_volume;
-using gs::analysis::sphere_octant_volume;
+using gs::disc_rectangle_area;
+using gs::sphere_box_volume;
+using gs::sphere_octant_volume;
 
 namespace {
 

@@ -771,7 +771,7 @@ TEST(Membrane, PlaneStrainLoadsSumToSigmaCTimesProjectedArea) {
       EXPECT_GT(loaded, 20u);
       // The rays that hit a face carry its area: all of it when none misses (a ray between two
       // sphere rows can pass through a loose specimen; each miss leaves its bin unloaded).
-      const auto m = dynamic_cast<const PlaneStrainTest&>(test).membrane(sim);
+      const auto m = dynamic_cast<const PlaneStrainCompression&>(test).membrane(sim);
       std::size_t hit_minus = 0, hit_plus = 0;
       for (std::size_t r = 0; r < m.x_minus.size(); ++r) {
         hit_minus += !std::isnan(m.x_minus[r]);

@@ -1,4 +1,4 @@
-#include "direct_shear_test.hpp"
+#include "direct_shear.hpp"
 
 #include <cmath>
 #include <cstdio>
@@ -63,7 +63,7 @@ SpecimenGauge shear_box_gauge(const ShearBoxGeometry& g, const ShearBoxWalls& w)
   return gauge;
 }
 
-DirectShearTest::DirectShearTest(DirectShearSpec spec, ShearBoxGeometry geometry,
+DirectShear::DirectShear(DirectShearSpec spec, ShearBoxGeometry geometry,
                                  ShearBoxWalls walls)
     : MeasuredProgramme({spec.max_displacement_m, spec.frame_every_m}),
       spec_(spec),
@@ -78,11 +78,11 @@ DirectShearTest::DirectShearTest(DirectShearSpec spec, ShearBoxGeometry geometry
   target_ = {spec_.max_displacement_m, spec_.frame_every_m};
 }
 
-double DirectShearTest::specimen_height(const Simulation& sim) const {
+double DirectShear::specimen_height(const Simulation& sim) const {
   return sim.walls()[w_.platen].pos.z() - 0.5 * g_.wall_thickness_m;
 }
 
-void DirectShearTest::start(Simulation& sim) {
+void DirectShear::start(Simulation& sim) {
   reset_rotations(sim);
   for (const auto c : w_.closer) sim.set_wall_active(c, false);
   for (auto& w : sim.walls()) w.vel.setZero();
@@ -90,11 +90,11 @@ void DirectShearTest::start(Simulation& sim) {
   h0_ = specimen_height(sim);
 }
 
-double DirectShearTest::normal_stress(const Simulation& sim) const {
+double DirectShear::normal_stress(const Simulation& sim) const {
   return sim.walls()[w_.platen].force.z() / (g_.length_m * g_.width_m);
 }
 
-void DirectShearTest::control(Simulation& sim) {
+void DirectShear::control(Simulation& sim) {
   const Eigen::Vector3d v(spec_.shear_velocity_m_s, 0, 0);
   for (const auto k : w_.upper) sim.walls()[k].vel = v;
   const double area = g_.length_m * g_.width_m;
@@ -103,22 +103,22 @@ void DirectShearTest::control(Simulation& sim) {
   sim.walls()[w_.platen].vel = v + Eigen::Vector3d(0, 0, -vz);
 }
 
-double DirectShearTest::displacement(const Simulation& sim) const {
+double DirectShear::displacement(const Simulation& sim) const {
   return sim.walls()[w_.upper[0]].pos.x() - x0_;
 }
 
-double DirectShearTest::shear_stress(const Simulation& sim) const {
+double DirectShear::shear_stress(const Simulation& sim) const {
   double fx = sim.walls()[w_.platen].force.x();
   for (const auto k : w_.upper) fx += sim.walls()[k].force.x();
   return -fx / (g_.length_m * g_.width_m);
 }
 
-std::string DirectShearTest::curve_header() const {
+std::string DirectShear::curve_header() const {
   return "step,time_s,u_m,tau_Pa,sigma_n_Pa,tau_over_sigma_n,dh_m,eps_v_dilation,void_ratio,"
          "coordination,particles_outside";
 }
 
-std::string DirectShearTest::curve_row(const Simulation& sim) const {
+std::string DirectShear::curve_row(const Simulation& sim) const {
   const double u = displacement(sim), tau = shear_stress(sim), sn = normal_stress(sim);
   const double h = specimen_height(sim);
   // Particles whose centre left the box (through the gap) are not counted in the void ratio.
@@ -144,7 +144,7 @@ std::string DirectShearTest::curve_row(const Simulation& sim) const {
   return buf;
 }
 
-std::string DirectShearTest::summary(const Simulation& sim) const {
+std::string DirectShear::summary(const Simulation& sim) const {
   char buf[256];
   std::snprintf(buf, sizeof buf,
                 "direct shear: u %.4g m, peak tau/sigma_n %.4f (friction angle %.2f deg), "
@@ -154,7 +154,7 @@ std::string DirectShearTest::summary(const Simulation& sim) const {
   return buf;
 }
 
-std::string DirectShearTest::save_state() const {
+std::string DirectShear::save_state() const {
   ProgrammeState st;
   st.set("x0", x0_);
   st.set("h0", h0_);
@@ -162,7 +162,7 @@ std::string DirectShearTest::save_state() const {
   return st.text();
 }
 
-void DirectShearTest::load_state(const std::string& state) {
+void DirectShear::load_state(const std::string& state) {
   const ProgrammeState st(state);
   x0_ = st.number("x0");
   h0_ = st.number("h0");

@@ -1,4 +1,4 @@
-#include "triaxial_test.hpp"
+#include "triaxial_compression.hpp"
 
 #include <cmath>
 #include <cstdio>
@@ -15,7 +15,7 @@ double mobilised_friction_deg(double sigma1, double sigma3) {
   return std::asin(std::clamp(s, -1.0, 1.0)) * 180.0 / M_PI;
 }
 
-TriaxialTest::TriaxialTest(TriaxialSpec spec)
+TriaxialCompression::TriaxialCompression(TriaxialSpec spec)
     : MeasuredProgramme({spec.max_strain, spec.frame_every_strain}),
       spec_(spec),
       inertial_warning_{spec.inertial_warning} {
@@ -25,7 +25,7 @@ TriaxialTest::TriaxialTest(TriaxialSpec spec)
     throw std::invalid_argument("max strain must be in (0, 1)");
 }
 
-void TriaxialTest::start(Simulation& sim) {
+void TriaxialCompression::start(Simulation& sim) {
   reset_rotations(sim);
   const Eigen::Vector3d lo = cuboid_lo(sim), hi = cuboid_hi(sim);
   size0_ = hi - lo;
@@ -35,7 +35,7 @@ void TriaxialTest::start(Simulation& sim) {
   for (std::size_t f = 0; f < 6; ++f) sim.walls()[f].vel.setZero();
 }
 
-void TriaxialTest::control(Simulation& sim) {
+void TriaxialCompression::control(Simulation& sim) {
   const double v = 0.5 * spec_.strain_rate_1_s * h0_;
   sim.walls()[kZmin].vel = v * cuboid_inward(kZmin);
   sim.walls()[kZmax].vel = v * cuboid_inward(kZmax);
@@ -48,15 +48,15 @@ void TriaxialTest::control(Simulation& sim) {
   }
 }
 
-double TriaxialTest::axial_strain(const Simulation& sim) const {
+double TriaxialCompression::axial_strain(const Simulation& sim) const {
   return (h0_ - (cuboid_hi(sim).z() - cuboid_lo(sim).z())) / h0_;
 }
 
-double TriaxialTest::volumetric_strain(const Simulation& sim) const {
+double TriaxialCompression::volumetric_strain(const Simulation& sim) const {
   return ((cuboid_hi(sim) - cuboid_lo(sim)).prod() - v0_) / v0_;
 }
 
-Eigen::Vector3d TriaxialTest::wall_stresses(const Simulation& sim) const {
+Eigen::Vector3d TriaxialCompression::wall_stresses(const Simulation& sim) const {
   auto mean = [&](std::size_t a, std::size_t b) {
     return 0.5 * (wall_stress(sim, a, cuboid_inward(a), cuboid_face_area(sim, a)) +
                   wall_stress(sim, b, cuboid_inward(b), cuboid_face_area(sim, b)));
@@ -64,21 +64,21 @@ Eigen::Vector3d TriaxialTest::wall_stresses(const Simulation& sim) const {
   return {mean(kZmin, kZmax), mean(kYmin, kYmax), mean(kXmin, kXmax)};
 }
 
-double TriaxialTest::inertial_number(const Simulation& sim) const {
+double TriaxialCompression::inertial_number(const Simulation& sim) const {
   const Eigen::Vector3d s = wall_stresses(sim);
   const double p = s.mean();
   if (!(p > 0)) return std::numeric_limits<double>::quiet_NaN();
   return spec_.strain_rate_1_s * d50_ / std::sqrt(p / sim.config().material.density);
 }
 
-std::string TriaxialTest::curve_header() const {
+std::string TriaxialCompression::curve_header() const {
   return "step,time_s,eps1_shortening,eps2_shortening,eps3_shortening,eps_v_dilation,"
          "sigma1_Pa,sigma2_Pa,sigma3_Pa,p_Pa,q_Pa,sin_phi,phi_deg,void_ratio,core_void_ratio,"
          "coordination,"
          "inertial_number,unbalanced_force";
 }
 
-std::string TriaxialTest::curve_row(const Simulation& sim) const {
+std::string TriaxialCompression::curve_row(const Simulation& sim) const {
   const Eigen::Vector3d lo = cuboid_lo(sim), hi = cuboid_hi(sim);
   const Eigen::Vector3d s = wall_stresses(sim);
   const double e1 = axial_strain(sim);
@@ -104,7 +104,7 @@ std::string TriaxialTest::curve_row(const Simulation& sim) const {
   return buf;
 }
 
-std::string TriaxialTest::summary(const Simulation& sim) const {
+std::string TriaxialCompression::summary(const Simulation& sim) const {
   char buf[256];
   std::snprintf(buf, sizeof buf,
                 "triaxial: eps1 %.4f, eps_v %.4f (dilation positive), peak mobilised friction "
@@ -113,7 +113,7 @@ std::string TriaxialTest::summary(const Simulation& sim) const {
   return buf;
 }
 
-std::string TriaxialTest::save_state() const {
+std::string TriaxialCompression::save_state() const {
   ProgrammeState st;
   st.set("h0", h0_);
   st.set("v0", v0_);
@@ -126,7 +126,7 @@ std::string TriaxialTest::save_state() const {
   return st.text();
 }
 
-void TriaxialTest::load_state(const std::string& state) {
+void TriaxialCompression::load_state(const std::string& state) {
   const ProgrammeState st(state);
   h0_ = st.number("h0");
   v0_ = st.number("v0");

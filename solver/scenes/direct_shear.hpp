@@ -48,9 +48,9 @@ struct DirectShearSpec {
   double max_platen_speed_m_s = 0.05;
 };
 
-class DirectShearTest final : public MeasuredProgramme {
+class DirectShear final : public MeasuredProgramme {
  public:
-  DirectShearTest(DirectShearSpec spec, ShearBoxGeometry geometry, ShearBoxWalls walls);
+  DirectShear(DirectShearSpec spec, ShearBoxGeometry geometry, ShearBoxWalls walls);
   double measure(const Simulation& sim) const override { return displacement(sim); }
   std::string name() const override { return "direct_shear"; }
   void start(Simulation& sim) override;

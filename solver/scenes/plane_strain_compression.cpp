@@ -1,4 +1,4 @@
-#include "plane_strain_test.hpp"
+#include "plane_strain_compression.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -8,7 +8,7 @@
 
 #include "cuboid_walls.hpp"
 #include "specimen_preparation.hpp"
-#include "triaxial_test.hpp"
+#include "triaxial_compression.hpp"
 
 namespace gs::solver {
 
@@ -29,7 +29,7 @@ std::vector<WallSpec> membrane_clamps() {
   return w;
 }
 
-PlaneStrainTest::PlaneStrainTest(PlaneStrainSpec spec)
+PlaneStrainCompression::PlaneStrainCompression(PlaneStrainSpec spec)
     : MeasuredProgramme({spec.max_strain, spec.frame_every_strain}),
       spec_(spec),
       inertial_warning_{spec.inertial_warning} {
@@ -40,7 +40,7 @@ PlaneStrainTest::PlaneStrainTest(PlaneStrainSpec spec)
   if (spec_.refresh_steps < 1) throw std::invalid_argument("refresh_steps must be >= 1");
 }
 
-MembraneLoads PlaneStrainTest::membrane(const Simulation& sim) const {
+MembraneLoads PlaneStrainCompression::membrane(const Simulation& sim) const {
   const Eigen::Vector3d lo = cuboid_lo(sim), hi = cuboid_hi(sim);
   MembraneSpec m;
   m.pressure_Pa = spec_.confining_Pa;
@@ -49,14 +49,14 @@ MembraneLoads PlaneStrainTest::membrane(const Simulation& sim) const {
   return membrane_loads(sim.particles(), lo.y(), hi.y(), lo.z() + clamp_, hi.z() - clamp_, m);
 }
 
-void PlaneStrainTest::refresh(Simulation& sim) {
+void PlaneStrainCompression::refresh(Simulation& sim) {
   const MembraneLoads m = membrane(sim);
   auto& ext = sim.particles().external_force;
   std::fill(ext.begin(), ext.end(), Eigen::Vector3d::Zero());
   for (std::size_t k = 0; k < m.particle.size(); ++k) ext[m.particle[k]] = m.force[k];
 }
 
-void PlaneStrainTest::start(Simulation& sim) {
+void PlaneStrainCompression::start(Simulation& sim) {
   reset_rotations(sim);
   d50_ = spec_.d50_m > 0 ? spec_.d50_m : mean_diameter(sim.particles());
   for (std::size_t f = 0; f < 6; ++f) sim.walls()[f].vel.setZero();
@@ -82,16 +82,16 @@ void PlaneStrainTest::start(Simulation& sim) {
   start_step_ = sim.step_count();
 }
 
-double PlaneStrainTest::volume(const Simulation& sim) const {
+double PlaneStrainCompression::volume(const Simulation& sim) const {
   const double depth = cuboid_hi(sim).y() - cuboid_lo(sim).y();
   return membrane(sim).volume_m3 + 2 * clamp_ * b0_ * depth;
 }
 
-double PlaneStrainTest::top_shift(const Simulation& sim) const {
+double PlaneStrainCompression::top_shift(const Simulation& sim) const {
   return sim.walls()[kClamp + 2].pos.x() - top_x0_;
 }
 
-void PlaneStrainTest::control(Simulation& sim) {
+void PlaneStrainCompression::control(Simulation& sim) {
   const double axial_speed = spec_.strain_rate_1_s * h0_;
   const Eigen::Vector3d v = axial_speed * cuboid_inward(kZmax);
   sim.walls()[kZmax].vel = v;  // frictionless: its own lateral motion would change nothing
@@ -111,18 +111,18 @@ void PlaneStrainTest::control(Simulation& sim) {
   if ((sim.step_count() - start_step_) % spec_.refresh_steps == 0) refresh(sim);
 }
 
-double PlaneStrainTest::axial_strain(const Simulation& sim) const {
+double PlaneStrainCompression::axial_strain(const Simulation& sim) const {
   return (h0_ - (cuboid_hi(sim).z() - cuboid_lo(sim).z())) / h0_;
 }
 
-std::string PlaneStrainTest::curve_header() const {
+std::string PlaneStrainCompression::curve_header() const {
   return "step,time_s,eps1_shortening,eps_v_dilation,sigma1_Pa,sigma2_Pa,sigma3_Pa,p_Pa,q_Pa,"
          "sin_phi,phi_deg,void_ratio,core_void_ratio,width_m,coordination,inertial_number,"
          "unbalanced_force,"
          "membrane_particles,top_shift_m";
 }
 
-std::string PlaneStrainTest::curve_row(const Simulation& sim) const {
+std::string PlaneStrainCompression::curve_row(const Simulation& sim) const {
   const MembraneLoads m = membrane(sim);
   const Eigen::Vector3d lo = cuboid_lo(sim), hi = cuboid_hi(sim);
   const double depth = hi.y() - lo.y(), h = hi.z() - lo.z();
@@ -168,14 +168,14 @@ std::string PlaneStrainTest::curve_row(const Simulation& sim) const {
   return buf;
 }
 
-std::string PlaneStrainTest::summary(const Simulation& sim) const {
+std::string PlaneStrainCompression::summary(const Simulation& sim) const {
   char buf[256];
   std::snprintf(buf, sizeof buf, "plane strain: eps1 %.4f, peak mobilised friction angle %.2f deg",
                 axial_strain(sim), max_phi_deg_);
   return buf;
 }
 
-std::string PlaneStrainTest::save_state() const {
+std::string PlaneStrainCompression::save_state() const {
   ProgrammeState st;
   st.set("h0", h0_);
   st.set("v0", v0_);
@@ -189,7 +189,7 @@ std::string PlaneStrainTest::save_state() const {
   return st.text();
 }
 
-void PlaneStrainTest::load_state(const std::string& state) {
+void PlaneStrainCompression::load_state(const std::string& state) {
   const ProgrammeState st(state);
   h0_ = st.number("h0");
   v0_ = st.number("v0");

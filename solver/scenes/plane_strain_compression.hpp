@@ -46,9 +46,9 @@ struct PlaneStrainSpec {
 /// cuboid planes.
 std::vector<WallSpec> membrane_clamps();
 
-class PlaneStrainTest final : public MeasuredProgramme {
+class PlaneStrainCompression final : public MeasuredProgramme {
  public:
-  explicit PlaneStrainTest(PlaneStrainSpec spec);
+  explicit PlaneStrainCompression(PlaneStrainSpec spec);
   double measure(const Simulation& sim) const override { return axial_strain(sim); }
   std::string name() const override { return "plane_strain"; }
   void start(Simulation& sim) override;

@@ -79,9 +79,9 @@ std::vector<std::unique_ptr<LoadingProgramme>> scene_programmes(Scene& s) {
     gauge = cuboid_gauge();
     s.triaxial.core_inset_m = s.plane_strain.core_inset_m = max_diameter(s.particles);
     if (s.test == "triaxial") {
-      test = std::make_unique<TriaxialTest>(s.triaxial);
+      test = std::make_unique<TriaxialCompression>(s.triaxial);
     } else {
-      test = std::make_unique<PlaneStrainTest>(s.plane_strain);
+      test = std::make_unique<PlaneStrainCompression>(s.plane_strain);
     }
   } else {  // direct shear
     ShearBoxGeometry& g = s.shear_box;
@@ -112,7 +112,7 @@ std::vector<std::unique_ptr<LoadingProgramme>> scene_programmes(Scene& s) {
     try {
       s.walls = shear_box_walls(g, idx);
       gauge = shear_box_gauge(g, idx);
-      test = std::make_unique<DirectShearTest>(s.direct_shear, g, idx);
+      test = std::make_unique<DirectShear>(s.direct_shear, g, idx);
     } catch (const std::invalid_argument& e) {
       throw InputError(s.file.string(), std::string("[direct_shear]: ") + e.what());
     }

@@ -28,7 +28,7 @@ double box_void_ratio(const ParticleState& p, const Eigen::Vector3d& lo,
     if (((c.array() - r) >= lo.array()).all() && ((c.array() + r) <= hi.array()).all())
       solid += 4.0 / 3.0 * M_PI * r * r * r;  // wholly inside
     else if (((c.array() + r) > lo.array()).all() && ((c.array() - r) < hi.array()).all())
-      solid += analysis::sphere_box_volume(c, r, lo, hi);
+      solid += sphere_box_volume(c, r, lo, hi);
   }
   return (hi - lo).prod() / solid - 1;
 }

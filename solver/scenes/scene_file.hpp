@@ -10,14 +10,14 @@
 #include <memory>
 #include <optional>
 
-#include "direct_shear_test.hpp"
+#include "direct_shear.hpp"
 #include "loading_programme.hpp"
-#include "plane_strain_test.hpp"
+#include "plane_strain_compression.hpp"
 #include "simulation.hpp"
 #include "snapshot.hpp"
 #include "specimen_generation.hpp"
 #include "specimen_preparation.hpp"
-#include "triaxial_test.hpp"
+#include "triaxial_compression.hpp"
 
 namespace gs::solver {
 

@@ -1,4 +1,6 @@
 // Exact volume of a sphere cut by an axis-aligned box (and the area of a disc cut by a
+// (In io/, the model both the solver and the analyses use: the solver prepares specimens to an
+// exact core void ratio, the REV analysis measures it.)
 // rectangle): the solid volume of a REV cell (seed 000 §3, seed 004 §4.2.3) without counting
 // particle centres. Closed form, exact to round-off:
 //
@@ -18,7 +20,7 @@
 
 #include <Eigen/Core>
 
-namespace gs::analysis {
+namespace gs {
 
 /// vol{|x| < r, x > a, y > b, z > c} for a, b, c >= 0 (offsets from the centre, any order).
 double sphere_octant_volume(double r, double a, double b, double c);
@@ -43,4 +45,4 @@ struct HalfSpaceTerm {
 };
 int half_space_terms(double offset, double r, HalfSpaceTerm out[2]);
 
-}  // namespace gs::analysis
+}  // namespace gs

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <numbers>
 
-namespace gs::analysis {
+namespace gs {
 namespace {
 
 constexpr double kPi = std::numbers::pi;
@@ -130,4 +130,4 @@ double disc_rectangle_area(const Eigen::Vector2d& centre, double r, const Eigen:
   return a;
 }
 
-}  // namespace gs::analysis
+}  // namespace gs

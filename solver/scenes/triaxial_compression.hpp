@@ -21,9 +21,9 @@ struct TriaxialSpec {
   double core_inset_m = 0;  // core void ratio: box inset by this from the boundaries
 };
 
-class TriaxialTest final : public MeasuredProgramme {
+class TriaxialCompression final : public MeasuredProgramme {
  public:
-  explicit TriaxialTest(TriaxialSpec spec);
+  explicit TriaxialCompression(TriaxialSpec spec);
   double measure(const Simulation& sim) const override { return axial_strain(sim); }
   std::string name() const override { return "triaxial"; }
   void start(Simulation& sim) override;
