@@ -69,7 +69,7 @@ WallLoads wall_loads(const Frame& frame, const ContactBranches& branches, const 
     l.id = w.id;
     l.recorded = w.force;
     l.inferred = inferred[k] != 0;
-    if (w.kind == WallKind::Plane) {
+    if (w.kind == WallKind::Plane || w.kind == WallKind::Facet) {  // (a facet: its plane)
       l.normal = w.b.normalized();
       const double c = l.normal.dot(up);
       l.role = c > 0.9 ? "bottom" : c < -0.9 ? "top" : std::abs(c) < 0.1 ? "side" : "other";

@@ -85,9 +85,10 @@ void validate_frame(const Frame& f, const std::string& source) {
     check_finite(source, wid + "geometry", w.b);
     check_finite(source, wid + "force", w.force);
     check_finite(source, wid + "torque", w.torque);
-    if (w.kind != WallKind::Plane && w.kind != WallKind::Box)
+    if (w.kind != WallKind::Plane && w.kind != WallKind::Box && w.kind != WallKind::Facet)
       throw InputError(source, wid + "unknown kind", value_str(static_cast<int>(w.kind)));
-    if (w.kind == WallKind::Plane && std::abs(w.b.norm() - 1.0) > 1e-6)
+    if ((w.kind == WallKind::Plane || w.kind == WallKind::Facet) &&
+        std::abs(w.b.norm() - 1.0) > 1e-6)
       throw InputError(source, wid + "plane normal is not a unit vector, |n|",
                        value_str(w.b.norm()));
   }

@@ -44,6 +44,9 @@ struct Contact {
 enum class WallKind : std::int32_t {
   Plane = 0,  // a = point on the plane, b = unit normal (pointing into the granular domain)
   Box = 1,    // a = centre, b = half-extents (axis-aligned)
+  Facet = 2,  // one triangle (or flat region) of a mesh wall: a = reference point (the incircle
+              // centre of its first triangle), b = unit normal; the triangles are in the scene's
+              // mesh file
 };
 
 struct Wall {

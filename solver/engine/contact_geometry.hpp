@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "scalar_vec3.hpp"
+#include "triangle_facet.hpp"
 
 namespace gs::solver {
 
@@ -84,6 +85,59 @@ void box_sphere_geometry_inside(const V3& h, const V3& x, const V3& on_box, doub
   g.point = x - (r - 0.5 * g.penetration) * m;
   g.radius1 = g.radius2 = r;
   g.ratchet_free = false;
+}
+
+/// Triangular facet (at wall position w) and a sphere, as YADE's Ig2_Facet_Sphere_ScGeom:
+/// two-sided (the normal is flipped to the sphere's side); the in-plane branch vector's largest
+/// edge-normal component decides face (projection inside: penetration r − L along the facet
+/// normal), edge (closest point on the edge's line) or vertex contact (normal from the closest
+/// point to the centre, penetration r − distance); contact point x − (r − pen/2)·n. The radii
+/// are (2r, r) (YADE gives the facet twice the sphere's radius) unless `plane_radii`, which
+/// gives (r, r) as for plane walls. Returns the distance from the centre to the closest point.
+[[gnu::always_inline]] inline double facet_sphere_geometry(const TriangleFacet& f, const V3& w,
+                                                           const V3& x, double r, bool plane_radii,
+                                                           ContactGeometry& g) {
+  const V3 cl = x - (w + f.offset);
+  V3 n = f.normal;
+  double l = dot(n, cl);
+  if (l < 0) {
+    n = -n;
+    l = -l;
+  }
+  V3 cp = cl - l * n;
+  double bm = dot(f.edge_normal[0], cp);
+  int m = 0;
+  for (int i = 1; i < 3; ++i) {
+    const double b = dot(f.edge_normal[i], cp);
+    if (bm < b) {
+      bm = b;
+      m = i;
+    }
+  }
+  const double icr = f.incircle_radius;
+  double dist;
+  if (bm < icr) {
+    g.penetration = r - l;
+    dist = l;
+    n = n / std::sqrt(squared_norm(n));  // (YADE normalises the unit normal again)
+  } else {
+    cp = cp + f.edge_normal[m] * (icr - bm);
+    if (dot(cp, f.edge_normal[m == 0 ? 2 : m - 1]) > icr) {
+      cp = f.vertex_unit[m] * f.vertex_length[m];
+    } else if (dot(cp, f.edge_normal[m = (m == 2 ? 0 : m + 1)]) > icr) {
+      cp = f.vertex_unit[m] * f.vertex_length[m];
+    }
+    n = cl - cp;
+    dist = std::sqrt(squared_norm(n));
+    n = n / dist;
+    g.penetration = r - dist;
+  }
+  g.normal = n;
+  g.point = x - (r - 0.5 * g.penetration) * n;
+  g.radius1 = plane_radii ? r : 2 * r;
+  g.radius2 = r;
+  g.ratchet_free = false;
+  return dist;
 }
 
 /// Distance from a point to an axis-aligned box (0 inside).

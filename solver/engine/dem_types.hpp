@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "contact_stiffness.hpp"
+#include "triangle_facet.hpp"
 
 namespace gs::solver {
 
@@ -23,7 +24,9 @@ struct Material {
   RollingRadius rolling_radius = RollingRadius::Min;
 };
 
-enum class WallShape { Box, Plane };
+/// Facets: triangles of a mesh wall (one triangle per wall in YADE's layout, or the triangles
+/// of one flat region; boundaries/mesh_walls.hpp), relative to the wall's position.
+enum class WallShape { Box, Plane, Facets };
 
 /// A rigid wall. Boxes are axis-aligned (centre, half-extents); planes are infinite (point,
 /// unit normal pointing into the granular domain). Walls move with `velocity` (m/s) and planes
@@ -44,6 +47,11 @@ struct WallSpec {
   double servo_max_velocity = 0;  // m/s cap
   double friction_deg = -1;       // wall–sphere friction angle; negative: the material's
   bool active = true;             // false: starts switched off (a later stage turns it on)
+  // Facets only: the triangles (offsets from `center`), and the contact convention: YADE's
+  // (a facet counts as radius 2R: Kn = 4/3·Ec·R) or a plane wall's (Kn = Ec·R).
+  std::vector<TriangleFacet> facets;
+  bool plane_radii = false;
+  std::string group;  // the mesh's named facet group (forces are summed per group)
 };
 
 /// Per-particle state, structure of arrays (index = particle index, not id).

@@ -70,6 +70,42 @@ void NeighborList::build(const ParticleState& p, const std::vector<WallState>& w
     for (std::size_t i = 0; i < n; ++i)
       order[fill[cell_index[i]]++] = static_cast<std::uint32_t>(i);
   }
+  // Facet walls are binned into the cells their bounding box (grown by the largest reach) covers,
+  // so a mesh of many facets costs what its neighbourhood costs; other walls are checked by all.
+  std::vector<std::uint32_t> plain_walls, facet_start(ncells + 1, 0), facet_of;
+  std::vector<Eigen::Vector3d> facet_lo(walls.size()), facet_hi(walls.size());
+  {
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> cell_wall;  // (cell, wall)
+    for (std::size_t w = 0; w < walls.size(); ++w) {
+      const auto& wall = walls[w];
+      if (!wall.active) continue;
+      if (wall.spec.shape != WallShape::Facets) {
+        plain_walls.push_back(static_cast<std::uint32_t>(w));
+        continue;
+      }
+      Eigen::Vector3d lo_w = Eigen::Vector3d::Constant(HUGE_VAL), hi_w = -lo_w;
+      for (const auto& f : wall.spec.facets)
+        for (const auto& v : f.vertex) {
+          const Eigen::Vector3d x = wall.pos + (f.offset + v).eigen();
+          lo_w = lo_w.cwiseMin(x);
+          hi_w = hi_w.cwiseMax(x);
+        }
+      facet_lo[w] = lo_w;
+      facet_hi[w] = hi_w;
+      const Eigen::Vector3d grow = Eigen::Vector3d::Constant(rmax + skin);
+      const auto c0 = cell_of(lo_w - grow), c1 = cell_of(hi_w + grow);
+      for (int z = c0[2]; z <= c1[2]; ++z)
+        for (int y = c0[1]; y <= c1[1]; ++y)
+          for (int x = c0[0]; x <= c1[0]; ++x)
+            cell_wall.emplace_back(static_cast<std::uint32_t>((z * dims[1] + y) * dims[0] + x),
+                                   static_cast<std::uint32_t>(w));
+    }
+    std::sort(cell_wall.begin(), cell_wall.end());
+    for (const auto& cw : cell_wall) ++facet_start[cw.first + 1];
+    for (std::size_t c = 0; c < ncells; ++c) facet_start[c + 1] += facet_start[c];
+    facet_of.reserve(cell_wall.size());
+    for (const auto& cw : cell_wall) facet_of.push_back(cw.second);
+  }
   for (std::size_t i = 0; i < n; ++i) {
     const auto c = cell_of(p.pos[i]);
     for (int dz = -1; dz <= 1; ++dz)
@@ -88,9 +124,15 @@ void NeighborList::build(const ParticleState& p, const std::vector<WallState>& w
               pairs.emplace_back(static_cast<std::uint32_t>(i), j);
           }
         }
-    for (std::size_t w = 0; w < walls.size(); ++w) {
+    const std::size_t own = cell_index[i];
+    for (std::uint32_t e = facet_start[own]; e < facet_start[own + 1]; ++e) {
+      const std::uint32_t w = facet_of[e];
+      const Eigen::Vector3d h = 0.5 * (facet_hi[w] - facet_lo[w]);
+      if (box_distance(facet_lo[w] + h, h, p.pos[i]) < p.radius[i] + skin)
+        pairs.emplace_back(static_cast<std::uint32_t>(i), kWallBase + w);
+    }
+    for (const std::uint32_t w : plain_walls) {
       const auto& wall = walls[w];
-      if (!wall.active) continue;
       const double dist = wall.spec.shape == WallShape::Box
                               ? box_distance(wall.pos, wall.spec.half_extents, p.pos[i])
                               : (p.pos[i] - wall.pos).dot(wall.normal);

@@ -67,11 +67,14 @@ Simulation::Simulation(SimulationConfig config, const std::vector<Particle>& par
   }
   wall_id_base_ = max_id + 1;
   for (auto& spec : walls) {
+    if (spec.shape == WallShape::Facets && spec.facets.empty())
+      throw std::invalid_argument("facet wall '" + spec.name + "' has no triangles");
     WallState w;
     w.spec = spec;
     w.pos = spec.center;
-    w.normal =
-        spec.shape == WallShape::Plane ? Eigen::Vector3d(spec.normal.normalized()) : spec.normal;
+    w.normal = spec.shape == WallShape::Plane    ? Eigen::Vector3d(spec.normal.normalized())
+               : spec.shape == WallShape::Facets ? spec.facets[0].normal.eigen()
+                                                 : spec.normal;
     w.vel = spec.velocity;
     w.active = spec.active;
     walls_.push_back(w);
@@ -166,7 +169,11 @@ void Simulation::attach_histories(const std::vector<ContactHistory>& old) {
     hist_[k].b = pr.second;
     const double ra = p_.radius[pr.first];
     const double rb = pr.second >= kWallBase ? ra : p_.radius[pr.second];
-    params_[k] = contact_params(cfg_.material, ra, rb, cfg_.twist_beta, cfg_.twist_eta);
+    const WallSpec* ws = pr.second >= kWallBase ? &walls_[pr.second - kWallBase].spec : nullptr;
+    if (ws && ws->shape == WallShape::Facets && !ws->plane_radii)  // YADE: the facet is 2R, first
+      params_[k] = contact_params(cfg_.material, 2 * ra, ra, cfg_.twist_beta, cfg_.twist_eta);
+    else
+      params_[k] = contact_params(cfg_.material, ra, rb, cfg_.twist_beta, cfg_.twist_eta);
     if (pr.second >= kWallBase) {
       const double wf = walls_[pr.second - kWallBase].spec.friction_deg;
       if (wf >= 0) params_[k].tan_friction = std::tan(wf * M_PI / 180.0);
@@ -223,6 +230,23 @@ void Simulation::set_wall_active(std::size_t w, bool active) {
     if (w.spec.shape == WallShape::Box) {
       box_sphere_geometry(V3(w.pos), V3(w.spec.half_extents), m2.pos, p_.radius[a], g);
       m1 = {V3(w.pos), V3(w.vel), V3()};
+    } else if (w.spec.shape == WallShape::Facets) {
+      // The closest of the wall's triangles (one, in YADE's layout).
+      const V3 wp(w.pos);
+      const auto& fs = w.spec.facets;
+      double best = facet_sphere_geometry(fs[0], wp, m2.pos, p_.radius[a], w.spec.plane_radii, g);
+      std::size_t k_best = 0;
+      for (std::size_t k = 1; k < fs.size(); ++k) {
+        ContactGeometry gk;
+        const double d =
+            facet_sphere_geometry(fs[k], wp, m2.pos, p_.radius[a], w.spec.plane_radii, gk);
+        if (d < best) {
+          best = d;
+          g = gk;
+          k_best = k;
+        }
+      }
+      m1 = {wp + fs[k_best].offset, V3(w.vel), V3()};
     } else {
       plane_sphere_geometry(V3(w.pos), V3(w.normal), m2.pos, p_.radius[a], g);
       m1 = {V3(w.pos), V3(w.vel), V3(w.spec.angular_velocity)};
@@ -724,9 +748,13 @@ Frame Simulation::frame() const {
     const auto& ws = walls_[w];
     Wall wall;
     wall.id = wall_id(w);
-    wall.kind = ws.spec.shape == WallShape::Box ? WallKind::Box : WallKind::Plane;
+    wall.kind = ws.spec.shape == WallShape::Box      ? WallKind::Box
+                : ws.spec.shape == WallShape::Facets ? WallKind::Facet
+                                                     : WallKind::Plane;
     wall.a = ws.pos;
-    wall.b = ws.spec.shape == WallShape::Box ? ws.spec.half_extents : ws.normal;
+    wall.b = ws.spec.shape == WallShape::Box      ? ws.spec.half_extents
+             : ws.spec.shape == WallShape::Facets ? ws.spec.facets.at(0).normal.eigen()
+                                                  : ws.normal;
     wall.force = ws.force;
     wall.torque = ws.torque;
     f.walls.push_back(wall);

@@ -459,7 +459,9 @@ TEST(CmdRev, ContactAnalysesAgainstTheInputContacts) {
   for (std::size_t k = 0; k < 36; ++k) {
     EXPECT_EQ(rc[k], count[k]) << k;
     EXPECT_NEAR(rd[k], count[k] / (double(pp.size()) * 2 * kPi / 36), 1e-15) << k;
-    if (count[k] > 0) EXPECT_NEAR(rfn[k], sum_fn[k] / count[k], 1e-14) << k;
+    if (count[k] > 0) {
+      EXPECT_NEAR(rfn[k], sum_fn[k] / count[k], 1e-14) << k;
+    }
     sum += rc[k];
   }
   EXPECT_EQ(sum, double(pp.size()));  // every contact once: n and -n half each
