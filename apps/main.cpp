@@ -2,6 +2,7 @@
 #include <CLI/CLI.hpp>
 #include <exception>
 #include <iostream>
+#include <string>
 
 #include "commands.hpp"
 #include "snapshot.hpp"
@@ -35,8 +36,14 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    const int rc = app.exit(e);  // prints help / the usage error
-    return rc == 0 ? 0 : 2;
+    // --help and --version print as CLI11 prints them; a usage error is one line, the rule of
+    // every CLI path ("error: what (value)"), with no second "Run with --help" line.
+    if (e.get_exit_code() == static_cast<int>(CLI::ExitCodes::Success)) return app.exit(e);
+    std::string what = e.what();
+    for (char& c : what)
+      if (c == '\n') c = ' ';
+    std::cerr << "error: " << what << "\n";
+    return 2;
   } catch (const gs::cli::ExitStatus& s) {
     return s.code;
   } catch (const std::exception& e) {

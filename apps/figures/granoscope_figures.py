@@ -61,8 +61,9 @@ def main(argv):
     for m in modules:
         try:
             written = importlib.import_module(m).make(args.input, args.out, args)
-        except (ValueError, KeyError, OSError) as e:
-            print(f"error: {args.input}: {m}: {e}", file=sys.stderr)
+        except Exception as e:  # any failure of a figure script is one line, never a traceback
+            print(f"error: {args.input}: {m}: {e}".replace("\n", " "),
+                  file=sys.stderr)
             return 2
         for w in written:
             print(w)

@@ -269,3 +269,17 @@ TEST(Cli, FiguresWritesANonBlankPositionsPng) {
           dir.path),
       (kData / "packing_small.csv").string());
 }
+
+// Exact answer: an option value of the wrong type, an unknown option and a missing subcommand
+// are each one line "error: …" on stderr, exit code 2, nothing on stdout (the rule of every CLI
+// path; CLI11 alone prints two lines without the prefix).
+TEST(Cli, UsageErrorsAreOneLine) {
+  gs::test::ScratchDir dir("cli_usage");
+  for (const char* args : {"render x.h5 --bits abc", "info --no-such-option x.h5", ""}) {
+    const auto r = gs::test::run_cli(args, dir.path);
+    EXPECT_EQ(r.rc, 2) << args;
+    EXPECT_EQ(r.err.rfind("error: ", 0), 0u) << args << ": " << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << args << ": " << r.err;
+    EXPECT_TRUE(r.out.empty()) << args;
+  }
+}
