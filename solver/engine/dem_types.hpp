@@ -64,6 +64,8 @@ struct ParticleState {
   std::vector<std::uint8_t> rot_blocked;  // 1: angular velocity imposed, translation free
   std::vector<Eigen::Vector3d> external_force;  // N, applied loads (e.g. membrane pressure)
   std::vector<std::int32_t> clump;  // index of the clump the particle is a member of; -1: none
+  std::vector<std::uint8_t>
+      removed;  // 1: left through an outlet (frozen, in no contact, not output)
 
   std::size_t size() const { return pos.size(); }
 };

@@ -37,8 +37,14 @@ void NeighborList::build(const ParticleState& p, const std::vector<WallState>& w
   ++builds;
   if (n == 0) return;
   double rmax = 0;
-  Eigen::Vector3d lo = p.pos[0], hi = p.pos[0];
-  for (std::size_t i = 0; i < n; ++i) {
+  const bool removal = p.removed.size() == n;
+  auto gone = [&](std::size_t i) { return removal && p.removed[i] != 0; };
+  std::size_t first = 0;
+  while (first < n && gone(first)) ++first;
+  if (first == n) return;  // every particle has left
+  Eigen::Vector3d lo = p.pos[first], hi = p.pos[first];
+  for (std::size_t i = first; i < n; ++i) {
+    if (gone(i)) continue;
     rmax = std::max(rmax, p.radius[i]);
     lo = lo.cwiseMin(p.pos[i]);
     hi = hi.cwiseMax(p.pos[i]);
@@ -107,6 +113,7 @@ void NeighborList::build(const ParticleState& p, const std::vector<WallState>& w
     for (const auto& cw : cell_wall) facet_of.push_back(cw.second);
   }
   for (std::size_t i = 0; i < n; ++i) {
+    if (gone(i)) continue;
     const auto c = cell_of(p.pos[i]);
     for (int dz = -1; dz <= 1; ++dz)
       for (int dy = -1; dy <= 1; ++dy)
@@ -117,7 +124,7 @@ void NeighborList::build(const ParticleState& p, const std::vector<WallState>& w
           const std::size_t ci = static_cast<std::size_t>((cz * dims[1] + cy) * dims[0] + cx);
           for (std::uint32_t k = start[ci]; k < start[ci + 1]; ++k) {
             const std::uint32_t j = order[k];
-            if (j <= i) continue;
+            if (j <= i || gone(j)) continue;
             if (clumped && p.clump[i] >= 0 && p.clump[i] == p.clump[j]) continue;  // one clump
             const double reach = p.radius[i] + p.radius[j] + skin;
             if ((p.pos[j] - p.pos[i]).squaredNorm() < reach * reach)

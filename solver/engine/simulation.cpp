@@ -46,6 +46,7 @@ Simulation::Simulation(SimulationConfig config, const std::vector<Particle>& par
   p_.rot_blocked.assign(n, 0);
   p_.external_force.assign(n, Eigen::Vector3d::Zero());
   p_.clump.assign(n, -1);
+  p_.removed.assign(n, 0);
   std::int64_t max_id = -1;
   double rmin = std::numeric_limits<double>::infinity();
   for (std::size_t i = 0; i < n; ++i) {
@@ -146,6 +147,34 @@ bool Simulation::integrate_clumps() {
   ledger_.gravity_work += gravity_power * dt;
   ledger_.damping_dissipation += damping;
   return finite;
+}
+
+void Simulation::set_outlet(const Eigen::Vector3d& keep_lo, const Eigen::Vector3d& keep_hi) {
+  if (!keep_lo.allFinite() || !keep_hi.allFinite() || !(keep_lo.array() < keep_hi.array()).all())
+    throw std::invalid_argument("outlet: the region kept must be a box with lo < hi");
+  outlet_ = true;
+  keep_lo_ = keep_lo;
+  keep_hi_ = keep_hi;
+}
+
+void Simulation::remove_outflow() {
+  bool any = false;
+  for (std::size_t i = 0; i < p_.size(); ++i) {
+    if (p_.removed[i] || p_.clump[i] >= 0) continue;
+    const Eigen::Vector3d& x = p_.pos[i];
+    if ((x.array() >= keep_lo_.array()).all() && (x.array() <= keep_hi_.array()).all()) continue;
+    ledger_.outflow += 0.5 * p_.mass[i] * p_.vel[i].squaredNorm() +
+                       0.5 * p_.inertia[i] * p_.angvel[i].squaredNorm();
+    p_.removed[i] = 1;
+    p_.fixed[i] = 1;
+    p_.vel[i].setZero();
+    p_.angvel[i].setZero();
+    p_.external_force[i].setZero();
+    ++removed_count_;
+    removed_mass_ += p_.mass[i];
+    any = true;
+  }
+  if (any) invalidate_neighbors();  // (its pairs go with the rebuild before the next step)
 }
 
 void Simulation::rebuild_neighbors() {
@@ -572,6 +601,7 @@ void Simulation::step() {
   }
   time_ += dt;
   ++step_;
+  if (outlet_) remove_outflow();
 }
 
 void Simulation::run(std::int64_t steps) {
@@ -712,9 +742,10 @@ Frame Simulation::frame() const {
   f.step = step_;
   f.dt = cfg_.dt;
   const std::size_t n = p_.size();
-  f.particles.resize(n);
+  f.particles.reserve(n);
   for (std::size_t i = 0; i < n; ++i) {
-    auto& q = f.particles[i];
+    if (p_.removed[i]) continue;  // (left through the outlet)
+    auto& q = f.particles.emplace_back();
     q.id = p_.id[i];
     q.position = p_.pos[i];
     q.radius = p_.radius[i];
@@ -845,6 +876,9 @@ void Simulation::save_checkpoint(const std::filesystem::path& path,
       put(o, c.angvel);
       put(o, c.angmom);
     }
+    put_vec(o, p_.removed);
+    put(o, static_cast<std::uint64_t>(removed_count_));
+    put(o, removed_mass_);
     put(o, static_cast<std::uint64_t>(extra.size()));
     o.write(extra.data(), static_cast<std::streamsize>(extra.size()));
     if (!o.flush()) throw InputError(path.string(), "cannot write checkpoint");
@@ -914,6 +948,13 @@ std::string Simulation::load_checkpoint(const std::filesystem::path& path) {
     get(in, c.vel, file);
     get(in, c.angvel, file);
     get(in, c.angmom, file);
+  }
+  if (!v03) {
+    get_vec(in, p_.removed, n, file);
+    std::uint64_t removed = 0;
+    get(in, removed, file);
+    removed_count_ = static_cast<std::size_t>(removed);
+    get(in, removed_mass_, file);
   }
   std::uint64_t extra_size = 0;
   get(in, extra_size, file);

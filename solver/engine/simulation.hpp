@@ -36,10 +36,11 @@ struct EnergyLedger {
   double kinetic = 0, elastic_normal = 0, elastic_shear = 0, elastic_rolling = 0;
   double friction_dissipation = 0, rolling_dissipation = 0, damping_dissipation = 0;
   double gravity_work = 0, wall_work = 0, external_work = 0;
+  double outflow = 0;  // kinetic energy of the particles removed through an outlet
   double initial = 0;  // kinetic + elastic at the start
   double stored() const { return kinetic + elastic_normal + elastic_shear + elastic_rolling; }
   double dissipated() const {
-    return friction_dissipation + rolling_dissipation + damping_dissipation;
+    return friction_dissipation + rolling_dissipation + damping_dissipation + outflow;
   }
   /// stored + dissipated − (initial + work in): zero for an exact integration.
   double residual() const {
@@ -111,6 +112,14 @@ class Simulation {
   void set_clumps(std::vector<ClumpBody> clumps);
   const std::vector<ClumpBody>& clumps() const { return clumps_; }
 
+  /// Outlet: after each step, particles whose centre has left the box [lo, hi] are removed (seed
+  /// 004 §5.2, silo discharge): frozen where they left, in no contact, no longer in frames or
+  /// energies (their kinetic energy goes to the ledger's outflow term). Clump members are not
+  /// removed. Removal survives checkpoints.
+  void set_outlet(const Eigen::Vector3d& keep_lo, const Eigen::Vector3d& keep_hi);
+  std::size_t removed_count() const { return removed_count_; }
+  double removed_mass() const { return removed_mass_; }  // kg
+
   /// Forces a neighbour-list rebuild before the next step.
   void invalidate_neighbors() { nl_.ref_pos.clear(); }
 
@@ -146,7 +155,13 @@ class Simulation {
   SimulationConfig cfg_;
   ParticleState p_;
   std::vector<WallState> walls_;
+  void remove_outflow();
+
   std::vector<ClumpBody> clumps_;
+  bool outlet_ = false;
+  Eigen::Vector3d keep_lo_ = Eigen::Vector3d::Zero(), keep_hi_ = Eigen::Vector3d::Zero();
+  std::size_t removed_count_ = 0;
+  double removed_mass_ = 0;
   std::vector<ClumpLoad> clump_loads_;
   NeighborList nl_;
   std::vector<ContactHistory> hist_;  // parallel to nl_.pairs
