@@ -17,6 +17,7 @@
 #include "commands.hpp"
 #include "errors.hpp"
 #include "hdf5_trajectory.hpp"
+#include "mesh_walls.hpp"
 #include "scene_file.hpp"
 #include "text_parse.hpp"
 
@@ -126,9 +127,13 @@ std::string history_header(const solver::Simulation& sim) {
       "friction_dissipation_J,rolling_dissipation_J,damping_dissipation_J,gravity_work_J,"
       "wall_work_J,external_work_J,energy_residual_J";
   for (const auto& w : sim.walls()) {
+    if (w.spec.shape == solver::WallShape::Facets) continue;  // (per mesh group, below)
     const std::string n = w.spec.name.empty() ? "wall" : w.spec.name;
     for (const char* c : {"_fx_N", "_fy_N", "_fz_N", "_x_m", "_y_m", "_z_m"}) h += "," + n + c;
   }
+  for (const auto& g : solver::group_forces(sim))
+    for (const char* c : {"_fx_N", "_fy_N", "_fz_N"}) h += "," + g.group + c;
+  h += ",removed,removed_mass_kg";
   return h;
 }
 
@@ -144,10 +149,17 @@ std::string history_row(solver::Simulation& sim) {
                 e.external_work, e.residual());
   std::string row = buf;
   for (const auto& w : sim.walls()) {
+    if (w.spec.shape == solver::WallShape::Facets) continue;
     std::snprintf(buf, sizeof buf, ",%.17g,%.17g,%.17g,%.17g,%.17g,%.17g", w.force.x(), w.force.y(),
                   w.force.z(), w.pos.x(), w.pos.y(), w.pos.z());
     row += buf;
   }
+  for (const auto& g : solver::group_forces(sim)) {
+    std::snprintf(buf, sizeof buf, ",%.17g,%.17g,%.17g", g.force.x(), g.force.y(), g.force.z());
+    row += buf;
+  }
+  std::snprintf(buf, sizeof buf, ",%zu,%.17g", sim.removed_count(), sim.removed_mass());
+  row += buf;
   return row;
 }
 
@@ -177,6 +189,7 @@ void run(const Args& a) {
               << " s (YADE's PWaveTimeStep); the run may be unstable\n";
 
   solver::Simulation sim(scene.config, scene.particles, scene.walls);
+  if (scene.outlet) sim.set_outlet(scene.outlet->first, scene.outlet->second);
   RunMetadata meta;
   meta.provenance = "granoscope simulate " + a.scene;
   meta.parameters = scene.parameters;

@@ -7,7 +7,9 @@
 #include <sstream>
 
 #include "errors.hpp"
+#include "mesh_walls.hpp"
 #include "trajectory_io.hpp"
+#include "triangle_mesh.hpp"
 
 namespace gs::solver {
 
@@ -233,9 +235,9 @@ Scene load_scene(const std::filesystem::path& path) {
   Scene s;
   s.file = path;
   for (const auto& [k, v] : root) {
-    static const char* sections[] = {"scene",        "material",    "solver",      "output",
-                                     "walls",        "specimen",    "preparation", "triaxial",
-                                     "plane_strain", "direct_shear"};
+    static const char* sections[] = {"scene",        "material",     "solver",      "output",
+                                     "walls",        "specimen",     "preparation", "triaxial",
+                                     "plane_strain", "direct_shear", "mesh",        "outlet"};
     if (std::find(std::begin(sections), std::end(sections), k.str()) == std::end(sections))
       r.fail("[" + std::string(k.str()) + "]", "unknown section");
   }
@@ -402,6 +404,53 @@ Scene load_scene(const std::filesystem::path& path) {
       }
       s.walls.push_back(spec);
     }
+  }
+  if (!s.test.empty() && root.contains("mesh"))
+    r.fail("[[mesh]]", "a laboratory test builds its own walls; remove [[mesh]]");
+  if (const auto* meshes = root["mesh"].as_array()) {
+    for (std::size_t i = 0; i < meshes->size(); ++i) {
+      const auto* m = (*meshes)[i].as_table();
+      const std::string sec = "mesh[" + std::to_string(i) + "]";
+      if (!m) r.fail(sec, "expected a table");
+      r.only(m, sec, {"file", "scale", "contact", "velocity_m_s", "friction_deg", "name"});
+      const std::string file_name = r.string(m, sec, "file", true, "");
+      const auto mesh_path = path.parent_path() / file_name;
+      std::error_code missing;
+      if (!std::filesystem::exists(mesh_path, missing))
+        r.fail(sec + ".file", "no such file", mesh_path.string());
+      const double scale = r.positive(m, sec, "scale", false, 1.0);
+      const std::string contact = r.string(m, sec, "contact", false, "merged");
+      if (contact != "merged" && contact != "yade")
+        r.fail(sec + ".contact", "expected \"merged\" or \"yade\"", contact);
+      const std::string name = r.string(m, sec, "name", false, "");
+      const TriangleMesh tm = read_mesh(mesh_path, scale);  // (InputError names the mesh file)
+      MeshTriangles tri;
+      for (std::size_t t = 0; t < tm.triangles.size(); ++t) {
+        const auto& v = tm.triangles[t];
+        tri.triangles.push_back({tm.vertices[static_cast<std::size_t>(v[0])],
+                                 tm.vertices[static_cast<std::size_t>(v[1])],
+                                 tm.vertices[static_cast<std::size_t>(v[2])]});
+        const std::string& g = tm.group_names[static_cast<std::size_t>(tm.group[t])];
+        tri.group.push_back(name.empty() ? g : name + "/" + g);
+      }
+      try {
+        for (auto& w :
+             mesh_walls(tri, contact == "yade" ? MeshContact::YadeParity : MeshContact::Merged,
+                        r.vec3(m, sec, "velocity_m_s", false, Eigen::Vector3d::Zero()),
+                        r.number(m, sec, "friction_deg", false, -1)))
+          s.walls.push_back(std::move(w));
+      } catch (const std::invalid_argument& e) {
+        throw InputError(mesh_path.string(), e.what());
+      }
+    }
+  }
+  if (const auto* outlet = r.table("outlet", false)) {
+    r.only(outlet, "outlet", {"keep_lo_m", "keep_hi_m"});
+    const Eigen::Vector3d lo = r.vec3(outlet, "outlet", "keep_lo_m", true, {});
+    const Eigen::Vector3d hi = r.vec3(outlet, "outlet", "keep_hi_m", true, {});
+    if (!(lo.array() < hi.array()).all())
+      r.fail("outlet.keep_hi_m", "must exceed keep_lo_m on every axis");
+    s.outlet = std::make_pair(lo, hi);
   }
   std::ostringstream flat;
   flat << root;

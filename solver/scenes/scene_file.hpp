@@ -48,7 +48,9 @@ struct Scene {
   std::filesystem::path file;
   SimulationConfig config;
   std::vector<Particle> particles;
-  std::vector<WallSpec> walls;
+  std::vector<WallSpec> walls;  // [[walls]], then the walls of each [[mesh]]
+  /// [outlet]: particles leaving [keep_lo, keep_hi] are removed (Simulation::set_outlet).
+  std::optional<std::pair<Eigen::Vector3d, Eigen::Vector3d>> outlet;
   std::int64_t steps = 0;
   OutputSpec output;
   std::vector<std::pair<std::string, std::string>> parameters;  // flattened, for run metadata

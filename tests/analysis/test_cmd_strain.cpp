@@ -347,7 +347,7 @@ TEST(CmdStrain, PeriodicBoundaryCrossingIsTheMinimumImage) {
   gs::write_hdf5_trajectory(dir / "run.h5", tr);
   for (const auto& [to, expect] : {std::pair{1, Eigen::Matrix3d::Zero().eval()}, {2, h}}) {
     SCOPED_TRACE(to);
-    const auto out = dir / ("s" + std::to_string(to) + ".h5");
+    const auto out = dir / (std::to_string(to) + "s.h5");
     ASSERT_EQ(run("analyze strain " + (dir / "run.h5").string() + " --to " + std::to_string(to) +
                       " -o " + out.string(),
                   dir / "log"),

@@ -217,3 +217,126 @@ TEST(Simulate, OneAndTwoThreadsWriteIdenticalOutputs) {
     gs::test::expect_same_frame(a.frames[i], b.frames[i]);
   EXPECT_GT(a.frames.back().contacts.size(), 100u);  // the loads split between the threads
 }
+
+namespace {
+
+void write_text(const std::filesystem::path& p, const std::string& s) {
+  std::ofstream(p) << s;
+}
+
+/// A floor of two 10 × 4 mm strips (4 triangles, ASCII STL, millimetres) with a 2 mm slot
+/// between them along y at x ∈ [4, 6] mm.
+std::string slotted_floor_stl() {
+  auto facet = [](double x0, double y0, double x1, double y1, double x2, double y2) {
+    std::ostringstream o;
+    o << "facet normal 0 0 1\n outer loop\n  vertex " << x0 << " " << y0 << " 0\n  vertex " << x1
+      << " " << y1 << " 0\n  vertex " << x2 << " " << y2 << " 0\n endloop\nendfacet\n";
+    return o.str();
+  };
+  return "solid floor\n" + facet(0, 0, 4, 0, 4, 10) + facet(0, 0, 4, 10, 0, 10) +
+         facet(6, 0, 10, 0, 10, 10) + facet(6, 0, 10, 10, 6, 10) + "endsolid floor\n";
+}
+
+}  // namespace
+
+// Exact answer: 12 spheres of radius 0.8 mm at rest 3 mm above a slotted mesh floor; the six
+// whose centres are over the 2 mm slot (x = 5 mm) fall through it and are removed below the
+// outlet (z < −5 mm), the six over the strips come to rest on them. The history's last row
+// counts 6 removed, of mass 6·ρ·(4/3)π r³, and the floor group carries the weight of the other
+// six (Σ fz = −6·m·g once they rest, to 1e-6).
+TEST(Simulate, MeshFloorWithAnOutletRemovesWhatFallsThrough) {
+  gs::test::ScratchDir dir("sim_mesh_outlet");
+  write_text(dir / "floor.stl", slotted_floor_stl());
+  std::ostringstream packing;
+  packing << "id,x,y,z,r\n";
+  for (int i = 0; i < 12; ++i) {
+    const double x = i < 6 ? 0.005 : (i < 9 ? 0.0015 : 0.0085);
+    const double y = i < 6 ? 0.001 + 0.0016 * i : 0.002 + 0.003 * (i % 3);
+    packing << i << "," << x << "," << y << ",0.003,0.0008\n";
+  }
+  write_text(dir / "packing.csv", packing.str());
+  write_text(dir / "scene.toml", R"([scene]
+name = "slot"
+packing = "packing.csv"
+[material]
+young_Pa = 1.0e7
+stiffness_ratio = 0.3
+friction_deg = 30.0
+density_kg_m3 = 2500.0
+[solver]
+dt_s = 2.0e-6
+damping = 0.3
+gravity_m_s2 = [0.0, 0.0, -9.81]
+steps = 60000
+[output]
+trajectory = "slot.h5"
+every = 20000
+history_every = 1000
+checkpoint_every = 60000
+[[mesh]]
+file = "floor.stl"
+scale = 0.001
+[outlet]
+keep_lo_m = [-1.0, -1.0, -0.005]
+keep_hi_m = [1.0, 1.0, 1.0]
+)");
+  std::string err;
+  ASSERT_EQ(
+      run("simulate " + (dir / "scene.toml").string() + " -q -o " + (dir / "out").string(), &err),
+      0)
+      << err;
+  const std::string hist = slurp(dir / "out" / "history.csv");
+  std::istringstream in(hist);
+  std::string header, line, last;
+  std::getline(in, header);
+  while (std::getline(in, line))
+    if (!line.empty()) last = line;
+  auto column = [&](const std::string& name) {
+    std::istringstream h(header), v(last);
+    std::string hn, vv;
+    while (std::getline(h, hn, ',') && std::getline(v, vv, ','))
+      if (hn == name) return std::stod(vv);
+    ADD_FAILURE() << "no column " << name;
+    return 0.0;
+  };
+  const double m = 2500.0 * 4.0 / 3.0 * M_PI * std::pow(0.0008, 3);
+  EXPECT_EQ(column("removed"), 6.0);
+  EXPECT_NEAR(column("removed_mass_kg"), 6 * m, 1e-15 * 6 * m);
+  EXPECT_NEAR(column("floor_fz_N"), -6 * m * 9.81, 1e-6 * 6 * m * 9.81);
+  const auto t = gs::read_hdf5_trajectory(dir / "out" / "slot.h5");
+  EXPECT_EQ(t.frames.back().particles.size(), 6u);
+}
+
+// Bad [[mesh]] and [outlet] entries: one line naming the scene key (or the mesh file) and the
+// value.
+TEST(Simulate, BadMeshAndOutletNameTheKey) {
+  gs::test::ScratchDir dir("sim_mesh_bad");
+  write_text(dir / "floor.stl", slotted_floor_stl());
+  write_text(dir / "nan.stl",
+             "solid x\nfacet normal 0 0 1\n outer loop\n  vertex 0 0 0\n  vertex nan 0 0\n  vertex "
+             "0 1 0\n endloop\nendfacet\nendsolid x\n");
+  write_text(dir / "packing.csv", "id,x,y,z,r\n0,0.005,0.005,0.003,0.0008\n");
+  const std::string base =
+      "[scene]\nname = \"b\"\npacking = \"packing.csv\"\n[material]\nyoung_Pa = 1e7\n"
+      "stiffness_ratio = 0.3\nfriction_deg = 30.0\ndensity_kg_m3 = 2500.0\n"
+      "[solver]\ndt_s = 1e-6\nsteps = 10\n";
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"[[mesh]]\nfile = \"none.stl\"\n", "mesh[0].file: no such file"},
+      {"[[mesh]]\nfile = \"floor.stl\"\ncontact = \"glued\"\n",
+       "mesh[0].contact: expected \"merged\" or \"yade\" (glued)"},
+      {"[[mesh]]\nfile = \"floor.stl\"\nscale = -1.0\n", "mesh[0].scale"},
+      {"[[mesh]]\nfile = \"nan.stl\"\n", "nan.stl: line 5: vertex coordinate is not finite (nan)"},
+      {"[outlet]\nkeep_lo_m = [0.0, 0.0, 0.0]\nkeep_hi_m = [1.0, 1.0, -1.0]\n",
+       "outlet.keep_hi_m: must exceed keep_lo_m"}};
+  for (std::size_t k = 0; k < cases.size(); ++k) {
+    std::string name = "s";
+    name += std::to_string(k);
+    name += ".toml";
+    const auto scene = dir / name;
+    write_text(scene, base + cases[k].first);
+    std::string err;
+    EXPECT_EQ(run("simulate " + scene.string() + " -q -o " + (dir / "o").string(), &err), 2) << k;
+    EXPECT_NE(err.find(cases[k].second), std::string::npos) << k << ": " << err;
+    EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << k << ": " << err;
+  }
+}
