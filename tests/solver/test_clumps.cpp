@@ -7,53 +7,23 @@
 #include <filesystem>
 #include <map>
 
+#include "reference_case.hpp"
 #include "rigid_clump.hpp"
 #include "simulation.hpp"
-#include "text_parse.hpp"
 
 using namespace gs;
 using solver::ClumpMember;
 
 namespace {
 
-/// Rows of a CSV file with a header, as numbers (non-numeric columns skipped by name).
-struct Table {
-  std::vector<std::string> header;
-  std::vector<std::vector<double>> rows;
-  std::size_t col(const std::string& name) const {
-    for (std::size_t i = 0; i < header.size(); ++i)
-      if (header[i] == name) return i;
-    throw std::runtime_error("no column " + name);
-  }
-  double at(std::size_t r, const std::string& name) const { return rows.at(r).at(col(name)); }
-};
+using Table = test::CsvTable;
 
 Table read_table(const std::filesystem::path& p) {
-  const std::string text = text::read_text_file(p);
-  const auto lines = text::split_lines(text);
-  Table t;
-  for (const auto h : text::split_csv(lines.at(0))) t.header.emplace_back(text::trim(h));
-  for (std::size_t i = 1; i < lines.size(); ++i) {
-    if (text::trim(lines[i]).empty()) continue;
-    const auto f = text::split_csv(lines[i]);
-    std::vector<double> v;
-    for (const auto tok : f) {
-      char* end = nullptr;
-      const std::string s(text::trim(tok));
-      const double x = std::strtod(s.c_str(), &end);
-      v.push_back(end && *end == 0 && !s.empty() ? x : std::nan(""));
-    }
-    t.rows.push_back(std::move(v));
-  }
-  return t;
+  return test::read_csv_table(p);
 }
 
-/// The shared clump reference, or the copy of what this test asserts in tests/data.
 std::filesystem::path clump_reference_dir() {
-  const auto shared =
-      std::filesystem::path(GS_SOURCE_DIR) / ".." / "shared" / "reference" / "yade" / "clumps";
-  if (std::filesystem::exists(shared / "packing.csv")) return shared;
-  return std::filesystem::path(GS_TEST_DATA_DIR) / "yade_clumps";
+  return test::reference_case_dir("clumps");
 }
 
 double lens_volume(double r1, double r2, double d) {
@@ -134,21 +104,21 @@ TEST(ClumpMass, MemberSumReproducesYadeClumps) {
   const Table mem = read_table(dir / "out" / "clump_members.csv");
   std::map<int, std::vector<std::uint32_t>> members;
   for (std::size_t i = 0; i < pack.rows.size(); ++i)
-    members[static_cast<int>(pack.at(i, "clump"))].push_back(static_cast<std::uint32_t>(i));
+    members[static_cast<int>(pack.num(i, "clump"))].push_back(static_cast<std::uint32_t>(i));
   ASSERT_EQ(members.size(), cl.rows.size());
   double e_mass = 0, e_inertia = 0, e_local = 0;
   for (std::size_t c = 0; c < cl.rows.size(); ++c) {
     std::vector<Eigen::Vector3d> x;
     std::vector<double> r;
     for (const auto i : members[static_cast<int>(c)]) {
-      x.emplace_back(pack.at(i, "x"), pack.at(i, "y"), pack.at(i, "z"));
-      r.push_back(pack.at(i, "r"));
+      x.emplace_back(pack.num(i, "x"), pack.num(i, "y"), pack.num(i, "z"));
+      r.push_back(pack.num(i, "r"));
     }
-    const Eigen::Quaterniond q(cl.at(c, "qw"), cl.at(c, "qx"), cl.at(c, "qy"), cl.at(c, "qz"));
+    const Eigen::Quaterniond q(cl.num(c, "qw"), cl.num(c, "qx"), cl.num(c, "qy"), cl.num(c, "qz"));
     const auto body = solver::make_clump_body(members[static_cast<int>(c)], x, r, 2550,
                                               solver::ClumpMassModel::MemberSum, &q);
-    e_mass = std::max(e_mass, std::abs(body.mass / cl.at(c, "mass") - 1));
-    const Eigen::Vector3d iy(cl.at(c, "I1"), cl.at(c, "I2"), cl.at(c, "I3"));
+    e_mass = std::max(e_mass, std::abs(body.mass / cl.num(c, "mass") - 1));
+    const Eigen::Vector3d iy(cl.num(c, "I1"), cl.num(c, "I2"), cl.num(c, "I3"));
     e_inertia = std::max(e_inertia, (body.inertia - iy).norm() / iy.norm());
     // The principal moments from our own eigen-decomposition, too.
     const auto mp = solver::member_sum_mass_properties(
@@ -162,7 +132,7 @@ TEST(ClumpMass, MemberSumReproducesYadeClumps) {
         std::max(e_inertia, (solver::principal_axes(mp.inertia).moments - iy).norm() / iy.norm());
     for (std::size_t k = 0; k < x.size(); ++k) {
       const std::size_t row = members[static_cast<int>(c)][k];
-      const Eigen::Vector3d l(mem.at(row, "lx"), mem.at(row, "ly"), mem.at(row, "lz"));
+      const Eigen::Vector3d l(mem.num(row, "lx"), mem.num(row, "ly"), mem.num(row, "lz"));
       e_local = std::max(e_local, (body.local_pos[k] - l).norm());
     }
   }

@@ -7,49 +7,22 @@
 #include <filesystem>
 #include <map>
 
+#include "reference_case.hpp"
 #include "rigid_clump.hpp"
 #include "simulation.hpp"
-#include "text_parse.hpp"
 
 using namespace gs;
 
 namespace {
 
-struct Table {
-  std::vector<std::string> header;
-  std::vector<std::vector<double>> rows;
-  std::size_t col(const std::string& name) const {
-    for (std::size_t i = 0; i < header.size(); ++i)
-      if (header[i] == name) return i;
-    throw std::runtime_error("no column " + name);
-  }
-  double at(std::size_t r, const std::string& name) const { return rows.at(r).at(col(name)); }
-};
+using Table = test::CsvTable;
 
 Table read_table(const std::filesystem::path& p) {
-  const std::string text = text::read_text_file(p);
-  const auto lines = text::split_lines(text);
-  Table t;
-  for (const auto h : text::split_csv(lines.at(0))) t.header.emplace_back(text::trim(h));
-  for (std::size_t i = 1; i < lines.size(); ++i) {
-    if (text::trim(lines[i]).empty()) continue;
-    std::vector<double> v;
-    for (const auto tok : text::split_csv(lines[i])) {
-      const std::string s(text::trim(tok));
-      char* end = nullptr;
-      const double x = std::strtod(s.c_str(), &end);
-      v.push_back(end && *end == 0 && !s.empty() ? x : std::nan(""));
-    }
-    t.rows.push_back(std::move(v));
-  }
-  return t;
+  return test::read_csv_table(p);
 }
 
 std::filesystem::path reference_dir() {
-  const auto shared =
-      std::filesystem::path(GS_SOURCE_DIR) / ".." / "shared" / "reference" / "yade" / "clumps";
-  if (std::filesystem::exists(shared / "packing.csv")) return shared;
-  return std::filesystem::path(GS_TEST_DATA_DIR) / "yade_clumps";
+  return test::reference_case_dir("clumps");
 }
 
 /// case.json: CohFrictMat, NewtonIntegrator(damping 0.1), dt 2.37e-6 s, six box walls.
@@ -70,23 +43,16 @@ solver::SimulationConfig clump_config() {
 }
 
 std::vector<solver::WallSpec> clump_walls() {
-  auto box = [](const char* name, Eigen::Vector3d c, Eigen::Vector3d h, Eigen::Vector3d v) {
-    solver::WallSpec w;
-    w.name = name;
-    w.shape = solver::WallShape::Box;
-    w.center = c;
-    w.half_extents = h;
-    w.velocity = v;
-    return w;
-  };
+  using test::box_wall;
   const Eigen::Vector3d z = Eigen::Vector3d::Zero();
   const double zc = 0.039073934153445206, hz = 0.07814786830689041;
-  return {box("bottom", {0.012, 0.012, -0.002}, {0.024, 0.024, 0.002}, z),
-          box("x-", {-0.002, 0.012, zc}, {0.002, 0.024, hz}, z),
-          box("x+", {0.026000000000000002, 0.012, zc}, {0.002, 0.024, hz}, z),
-          box("y-", {0.012, -0.002, zc}, {0.024, 0.002, hz}, z),
-          box("y+", {0.012, 0.026000000000000002, zc}, {0.024, 0.002, hz}, z),
-          box("top", {0.012, 0.012, 0.021073934153445203}, {0.024, 0.024, 0.002}, {0, 0, -0.03})};
+  return {
+      box_wall("bottom", {0.012, 0.012, -0.002}, {0.024, 0.024, 0.002}, z),
+      box_wall("x-", {-0.002, 0.012, zc}, {0.002, 0.024, hz}, z),
+      box_wall("x+", {0.026000000000000002, 0.012, zc}, {0.002, 0.024, hz}, z),
+      box_wall("y-", {0.012, -0.002, zc}, {0.024, 0.002, hz}, z),
+      box_wall("y+", {0.012, 0.026000000000000002, zc}, {0.024, 0.002, hz}, z),
+      box_wall("top", {0.012, 0.012, 0.021073934153445203}, {0.024, 0.024, 0.002}, {0, 0, -0.03})};
 }
 
 struct ClumpCase {
@@ -104,10 +70,10 @@ ClumpCase load_case(const std::filesystem::path& dir) {
   for (std::size_t i = 0; i < pack.rows.size(); ++i) {
     Particle p;
     p.id = static_cast<std::int64_t>(i);
-    p.position = {pack.at(i, "x"), pack.at(i, "y"), pack.at(i, "z")};
-    p.radius = pack.at(i, "r");
+    p.position = {pack.num(i, "x"), pack.num(i, "y"), pack.num(i, "z")};
+    p.radius = pack.num(i, "r");
     k.particles.push_back(p);
-    members[static_cast<int>(pack.at(i, "clump"))].push_back(static_cast<std::uint32_t>(i));
+    members[static_cast<int>(pack.num(i, "clump"))].push_back(static_cast<std::uint32_t>(i));
   }
   for (std::size_t c = 0; c < cl.rows.size(); ++c) {
     std::vector<Eigen::Vector3d> x;
@@ -116,7 +82,7 @@ ClumpCase load_case(const std::filesystem::path& dir) {
       x.push_back(k.particles[i].position);
       r.push_back(k.particles[i].radius);
     }
-    const Eigen::Quaterniond q(cl.at(c, "qw"), cl.at(c, "qx"), cl.at(c, "qy"), cl.at(c, "qz"));
+    const Eigen::Quaterniond q(cl.num(c, "qw"), cl.num(c, "qx"), cl.num(c, "qy"), cl.num(c, "qz"));
     auto body = solver::make_clump_body(members.at(static_cast<int>(c)), x, r, 2550,
                                         solver::ClumpMassModel::MemberSum, &q);
     body.id = static_cast<std::int64_t>(pack.rows.size() + c);
@@ -132,8 +98,9 @@ struct Deviation {
 Deviation deviation(const std::vector<solver::ClumpBody>& clumps, const Table& ref) {
   Deviation d;
   for (std::size_t c = 0; c < clumps.size(); ++c) {
-    const Eigen::Vector3d x(ref.at(c, "x"), ref.at(c, "y"), ref.at(c, "z"));
-    const Eigen::Quaterniond q(ref.at(c, "qw"), ref.at(c, "qx"), ref.at(c, "qy"), ref.at(c, "qz"));
+    const Eigen::Vector3d x(ref.num(c, "x"), ref.num(c, "y"), ref.num(c, "z"));
+    const Eigen::Quaterniond q(ref.num(c, "qw"), ref.num(c, "qx"), ref.num(c, "qy"),
+                               ref.num(c, "qz"));
     d.pos = std::max(d.pos, (clumps[c].pos - x).norm());
     d.ori = std::max(d.ori, clumps[c].ori.angularDistance(q));
   }
@@ -178,8 +145,8 @@ TEST(YadeClumps, CentresOrientationsAndWallForcesMatchYade) {
   const Table walls = read_table(dir / "out" / "walls.csv");
   std::map<std::pair<long, int>, Eigen::Vector3d> ref_force;
   for (std::size_t i = 0; i < walls.rows.size(); ++i)
-    ref_force[{std::lround(walls.at(i, "step")), static_cast<int>(walls.at(i, "wall"))}] =
-        Eigen::Vector3d(walls.at(i, "fx"), walls.at(i, "fy"), walls.at(i, "fz"));
+    ref_force[{std::lround(walls.num(i, "step")), static_cast<int>(walls.num(i, "wall"))}] =
+        Eigen::Vector3d(walls.num(i, "fx"), walls.num(i, "fy"), walls.num(i, "fz"));
   double worst_wall = 0;
   for (long step = 100; step <= 2000; step += 100) {
     sim.run(100);

@@ -9,48 +9,21 @@
 #include <map>
 
 #include "mesh_walls.hpp"
+#include "reference_case.hpp"
 #include "simulation.hpp"
-#include "text_parse.hpp"
 
 using namespace gs;
 
 namespace {
 
-struct Table {
-  std::vector<std::string> header;
-  std::vector<std::vector<std::string>> rows;
-  std::size_t col(const std::string& name) const {
-    for (std::size_t i = 0; i < header.size(); ++i)
-      if (header[i] == name) return i;
-    throw std::runtime_error("no column " + name);
-  }
-  double num(std::size_t r, const std::string& name) const {
-    return std::strtod(rows.at(r).at(col(name)).c_str(), nullptr);
-  }
-  const std::string& str(std::size_t r, const std::string& name) const {
-    return rows.at(r).at(col(name));
-  }
-};
+using Table = test::CsvTable;
 
 Table read_table(const std::filesystem::path& p) {
-  const std::string text = text::read_text_file(p);
-  const auto lines = text::split_lines(text);
-  Table t;
-  for (const auto h : text::split_csv(lines.at(0))) t.header.emplace_back(text::trim(h));
-  for (std::size_t i = 1; i < lines.size(); ++i) {
-    if (text::trim(lines[i]).empty()) continue;
-    std::vector<std::string> v;
-    for (const auto tok : text::split_csv(lines[i])) v.emplace_back(text::trim(tok));
-    t.rows.push_back(std::move(v));
-  }
-  return t;
+  return test::read_csv_table(p);
 }
 
 std::filesystem::path reference_dir() {
-  const auto shared =
-      std::filesystem::path(GS_SOURCE_DIR) / ".." / "shared" / "reference" / "yade" / "facets";
-  if (std::filesystem::exists(shared / "packing.csv")) return shared;
-  return std::filesystem::path(GS_TEST_DATA_DIR) / "yade_facets";
+  return test::reference_case_dir("facets");
 }
 
 solver::MeshTriangles read_mesh_csv(const std::filesystem::path& p) {

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "packing_csv.hpp"
+#include "reference_case.hpp"
 #include "simulation.hpp"
 #include "text_parse.hpp"
 
@@ -17,10 +18,7 @@ namespace gs::test {
 /// has it beside it, else the copy of its packing, wall forces and first two states in
 /// tests/data/yade_oedometer (enough for the test's assertions).
 inline std::filesystem::path yade_reference_dir() {
-  const auto shared =
-      std::filesystem::path(GS_SOURCE_DIR) / ".." / "shared" / "reference" / "yade" / "oedometer";
-  if (std::filesystem::exists(shared / "packing.csv")) return shared;
-  return std::filesystem::path(GS_TEST_DATA_DIR) / "yade_oedometer";
+  return reference_case_dir("oedometer");
 }
 
 /// Parameters of case.json (material, damping, gravity, dt, walls).
@@ -41,15 +39,7 @@ inline solver::SimulationConfig oedometer_config(int threads = 1) {
 }
 
 inline std::vector<solver::WallSpec> oedometer_walls() {
-  auto box = [](const char* name, Eigen::Vector3d c, Eigen::Vector3d h, Eigen::Vector3d v) {
-    solver::WallSpec w;
-    w.name = name;
-    w.shape = solver::WallShape::Box;
-    w.center = c;
-    w.half_extents = h;
-    w.velocity = v;
-    return w;
-  };
+  const auto box = box_wall;
   const Eigen::Vector3d z = Eigen::Vector3d::Zero();
   return {box("bottom", {0.0125, 0.0125, -0.002}, {0.025, 0.025, 0.002}, z),
           box("x-", {-0.002, 0.0125, 0.05}, {0.002, 0.025, 0.1}, z),
