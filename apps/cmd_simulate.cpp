@@ -189,6 +189,7 @@ void run(const Args& a) {
               << " s (YADE's PWaveTimeStep); the run may be unstable\n";
 
   solver::Simulation sim(scene.config, scene.particles, scene.walls);
+  if (!scene.clumps.empty()) sim.set_clumps(scene.clumps);
   if (scene.outlet) sim.set_outlet(scene.outlet->first, scene.outlet->second);
   RunMetadata meta;
   meta.provenance = "granoscope simulate " + a.scene;

@@ -4,10 +4,12 @@
 #include <algorithm>
 #include <cmath>
 #include <iterator>
+#include <map>
 #include <sstream>
 
 #include "errors.hpp"
 #include "mesh_walls.hpp"
+#include "text_parse.hpp"
 #include "trajectory_io.hpp"
 #include "triangle_mesh.hpp"
 
@@ -217,6 +219,111 @@ void read_lab_sections(const Reader& r, const toml::table& root, Scene& s) {
   }
 }
 
+/// [[clump_template]] (name, members = [[x, y, z, r], …] in metres in the template frame) and
+/// [clumps] (packing = CSV of template,x,y,z,qw,qx,qy,qz[,scale]: the template rotated by the
+/// unit quaternion, scaled, placed at (x, y, z); mass = "member_sum" (YADE's default) or
+/// "union"). Members are appended to the particles, ids after the largest.
+void read_clumps(const Reader& r, const toml::table& root, const std::filesystem::path& path,
+                 Scene& s) {
+  std::map<std::string, std::vector<ClumpMember>> templates;
+  if (const auto* ts = root["clump_template"].as_array()) {
+    for (std::size_t i = 0; i < ts->size(); ++i) {
+      const auto* t = (*ts)[i].as_table();
+      const std::string sec = "clump_template[" + std::to_string(i) + "]";
+      if (!t) r.fail(sec, "expected a table");
+      r.only(t, sec, {"name", "members"});
+      const std::string name = r.string(t, sec, "name", true, "");
+      const auto* ms = (*t)["members"].as_array();
+      if (!ms || ms->empty()) r.fail(sec + ".members", "a clump template needs member spheres");
+      std::vector<ClumpMember> members;
+      for (std::size_t k = 0; k < ms->size(); ++k) {
+        const std::string key = sec + ".members[" + std::to_string(k) + "]";
+        const auto* m = (*ms)[k].as_array();
+        if (!m || m->size() != 4) r.fail(key, "expected [x, y, z, r]");
+        double v[4];
+        for (std::size_t c = 0; c < 4; ++c) {
+          const auto d = (*m)[c].value<double>();
+          if (!d || !std::isfinite(*d)) r.fail(key, "not a finite number");
+          v[c] = *d;
+        }
+        if (!(v[3] > 0)) r.fail(key, "member radius must be positive", value_str(v[3]));
+        members.push_back({{v[0], v[1], v[2]}, v[3]});
+      }
+      if (!templates.emplace(name, members).second)
+        r.fail(sec + ".name", "template defined twice", name);
+    }
+  }
+  const auto* clumps = r.table("clumps", false);
+  if (!clumps) {
+    if (!templates.empty()) r.fail("[clumps]", "templates given but no [clumps] packing");
+    return;
+  }
+  r.only(clumps, "clumps", {"packing", "mass"});
+  const std::string mass = r.string(clumps, "clumps", "mass", false, "member_sum");
+  if (mass != "member_sum" && mass != "union")
+    r.fail("clumps.mass", "expected \"member_sum\" or \"union\"", mass);
+  const auto file = path.parent_path() / r.string(clumps, "clumps", "packing", true, "");
+  std::error_code missing;
+  if (!std::filesystem::exists(file, missing))
+    r.fail("clumps.packing", "no such file", file.string());
+  const std::string f = file.string();
+  const std::string body_text = text::read_text_file(file);
+  const auto lines = text::split_lines(body_text);
+  if (lines.empty()) throw InputError(f, "empty clump packing");
+  const auto header = text::split_csv(lines[0]);
+  const std::vector<std::string_view> names = {"template", "x", "y", "z", "qw", "qx", "qy", "qz"};
+  const auto idx = text::column_indices(header, names);
+  for (std::size_t k = 0; k < names.size(); ++k)
+    if (idx[k] >= header.size()) throw InputError(f, "missing column", std::string(names[k]));
+  std::int64_t next_id = 0;
+  for (const auto& p : s.particles) next_id = std::max(next_id, p.id + 1);
+  for (std::size_t ln = 1; ln < lines.size(); ++ln) {
+    if (text::trim(lines[ln]).empty()) continue;
+    const auto tok = text::split_csv(lines[ln]);
+    if (tok.size() < header.size())
+      throw InputError(f, "line " + std::to_string(ln + 1) + ": too few columns");
+    const std::string name(text::trim(tok[idx[0]]));
+    const auto it = templates.find(name);
+    if (it == templates.end())
+      throw InputError(f, "line " + std::to_string(ln + 1) + ": unknown clump template", name);
+    auto num = [&](std::size_t k, const char* what) {
+      const double v = text::to_double(tok[idx[k]], f, ln + 1, what);
+      if (!std::isfinite(v))
+        throw InputError(f, "line " + std::to_string(ln + 1) + ": " + what + " is not finite",
+                         value_str(v));
+      return v;
+    };
+    const Eigen::Vector3d x(num(1, "x"), num(2, "y"), num(3, "z"));
+    Eigen::Quaterniond q(num(4, "qw"), num(5, "qx"), num(6, "qy"), num(7, "qz"));
+    if (!(std::abs(q.norm() - 1) < 1e-6))
+      throw InputError(f,
+                       "line " + std::to_string(ln + 1) + ": orientation is not a unit quaternion",
+                       value_str(q.norm()));
+    q.normalize();
+    std::vector<std::uint32_t> index;
+    std::vector<Eigen::Vector3d> pos;
+    std::vector<double> rad;
+    for (const auto& m : it->second) {
+      Particle p;
+      p.id = next_id++;
+      p.position = x + q * m.offset;
+      p.radius = m.radius;
+      index.push_back(static_cast<std::uint32_t>(s.particles.size()));
+      pos.push_back(p.position);
+      rad.push_back(p.radius);
+      s.particles.push_back(p);
+    }
+    auto body =
+        make_clump_body(index, pos, rad, s.config.material.density,
+                        mass == "union" ? ClumpMassModel::Union : ClumpMassModel::MemberSum);
+    body.id = -1;  // (numbered after the particles by the scene: below)
+    s.clumps.push_back(std::move(body));
+  }
+  for (auto& c : s.clumps) c.id = next_id++;
+  for (const auto& c : s.clumps)
+    for (const auto i : c.members) s.particles[i].clump_id = c.id;
+}
+
 }  // namespace
 
 Scene load_scene(const std::filesystem::path& path) {
@@ -235,9 +342,10 @@ Scene load_scene(const std::filesystem::path& path) {
   Scene s;
   s.file = path;
   for (const auto& [k, v] : root) {
-    static const char* sections[] = {"scene",        "material",     "solver",      "output",
-                                     "walls",        "specimen",     "preparation", "triaxial",
-                                     "plane_strain", "direct_shear", "mesh",        "outlet"};
+    static const char* sections[] = {"scene",          "material",     "solver",      "output",
+                                     "walls",          "specimen",     "preparation", "triaxial",
+                                     "plane_strain",   "direct_shear", "mesh",        "outlet",
+                                     "clump_template", "clumps"};
     if (std::find(std::begin(sections), std::end(sections), k.str()) == std::end(sections))
       r.fail("[" + std::string(k.str()) + "]", "unknown section");
   }
@@ -444,6 +552,7 @@ Scene load_scene(const std::filesystem::path& path) {
       }
     }
   }
+  read_clumps(r, root, path, s);
   if (const auto* outlet = r.table("outlet", false)) {
     r.only(outlet, "outlet", {"keep_lo_m", "keep_hi_m"});
     const Eigen::Vector3d lo = r.vec3(outlet, "outlet", "keep_lo_m", true, {});

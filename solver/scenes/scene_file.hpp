@@ -49,6 +49,9 @@ struct Scene {
   SimulationConfig config;
   std::vector<Particle> particles;
   std::vector<WallSpec> walls;  // [[walls]], then the walls of each [[mesh]]
+  /// [[clump_template]] + [clumps]: rigid clumps whose members were appended to `particles`
+  /// (Simulation::set_clumps).
+  std::vector<ClumpBody> clumps;
   /// [outlet]: particles leaving [keep_lo, keep_hi] are removed (Simulation::set_outlet).
   std::optional<std::pair<Eigen::Vector3d, Eigen::Vector3d>> outlet;
   std::int64_t steps = 0;

@@ -10,6 +10,7 @@
 #include <chrono>
 #include <fstream>
 #include <limits>
+#include <map>
 #include <sstream>
 #include <thread>
 #include <vector>
@@ -336,6 +337,124 @@ TEST(Simulate, BadMeshAndOutletNameTheKey) {
     write_text(scene, base + cases[k].first);
     std::string err;
     EXPECT_EQ(run("simulate " + scene.string() + " -q -o " + (dir / "o").string(), &err), 2) << k;
+    EXPECT_NE(err.find(cases[k].second), std::string::npos) << k << ": " << err;
+    EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << k << ": " << err;
+  }
+}
+
+// Exact answers: three dimers (two 1 mm spheres 1.4 mm apart, seed 003 §2.4's two-sphere clumps)
+// with the true volume of the union (mass = ρ·(2·4/3·πr³ − lens), the lens of two spheres at
+// distance 1.4 r) settle on a plane floor: once at rest the floor carries their weight, 3·M·g
+// (to 1e-6), the members stay at 1.4 mm of each other (rigid to 1e-15 m), and the frames mark
+// each member with its clump's id. (A single sphere settles beside them: its weight adds.)
+TEST(Simulate, ClumpsFromTemplatesSettleWithTheirUnionWeight) {
+  gs::test::ScratchDir dir("sim_clumps");
+  write_text(dir / "packing.csv", "id,x,y,z,r\n0,0.05,0.05,0.05,0.001\n");  // a spectator sphere
+  write_text(dir / "clumps.csv",
+             "template,x,y,z,qw,qx,qy,qz\n"
+             "dimer,0.0,0.0,0.003,1,0,0,0\n"
+             "dimer,0.005,0.0,0.004,0.7071067811865476,0,0.7071067811865476,0\n"
+             "dimer,0.0,0.006,0.002,0.9238795325112867,0.3826834323650898,0,0\n");
+  write_text(dir / "scene.toml", R"([scene]
+name = "clumps"
+packing = "packing.csv"
+[material]
+young_Pa = 1.0e7
+stiffness_ratio = 0.3
+friction_deg = 30.0
+density_kg_m3 = 2500.0
+[solver]
+dt_s = 2.0e-6
+damping = 0.4
+gravity_m_s2 = [0.0, 0.0, -9.81]
+steps = 150000
+[output]
+trajectory = "c.h5"
+every = 50000
+history_every = 50000
+checkpoint_every = 150000
+[[walls]]
+name = "floor"
+shape = "plane"
+point_m = [0.0, 0.0, 0.0]
+normal = [0.0, 0.0, 1.0]
+[[walls]]
+name = "roof"
+shape = "plane"
+point_m = [0.0, 0.0, 0.06]
+normal = [0.0, 0.0, -1.0]
+[[clump_template]]
+name = "dimer"
+members = [[-0.0007, 0.0, 0.0, 0.001], [0.0007, 0.0, 0.0, 0.001]]
+[clumps]
+packing = "clumps.csv"
+mass = "union"
+)");
+  std::string err;
+  ASSERT_EQ(
+      run("simulate " + (dir / "scene.toml").string() + " -q -o " + (dir / "out").string(), &err),
+      0)
+      << err;
+  const auto t = gs::read_hdf5_trajectory(dir / "out" / "c.h5");
+  const auto& last = t.frames.back();
+  ASSERT_EQ(last.particles.size(), 7u);
+  std::map<std::int64_t, std::vector<Eigen::Vector3d>> members;
+  for (const auto& p : last.particles)
+    if (p.clump_id >= 0) members[p.clump_id].push_back(p.position);
+  ASSERT_EQ(members.size(), 3u);
+  for (const auto& [id, x] : members) {
+    ASSERT_EQ(x.size(), 2u);
+    EXPECT_NEAR((x[0] - x[1]).norm(), 0.0014, 1e-15) << id;
+  }
+  const double r = 0.001, d = 0.0014;
+  const double lens = M_PI * std::pow(2 * r - d, 2) * (d * d + 4 * d * r) / (12 * d);
+  const double m = 2500.0 * (2 * (4.0 / 3.0) * M_PI * r * r * r - lens);
+  const std::string hist = slurp(dir / "out" / "history.csv");
+  std::istringstream in(hist);
+  std::string header, line, lastrow;
+  std::getline(in, header);
+  while (std::getline(in, line))
+    if (!line.empty()) lastrow = line;
+  std::istringstream h(header), v(lastrow);
+  std::string hn, vv;
+  double floor_fz = 0;
+  while (std::getline(h, hn, ',') && std::getline(v, vv, ','))
+    if (hn == "floor_fz_N") floor_fz = std::stod(vv);
+  const double sphere = 2500.0 * (4.0 / 3.0) * M_PI * r * r * r;  // the spectator, settled too
+  EXPECT_NEAR(floor_fz, -(3 * m + sphere) * 9.81, 1e-6 * (3 * m + sphere) * 9.81);
+}
+
+// Bad clump input: one line naming the key or file, the field and the value.
+TEST(Simulate, BadClumpsNameTheFieldAndValue) {
+  gs::test::ScratchDir dir("sim_clumps_bad");
+  write_text(dir / "packing.csv", "id,x,y,z,r\n0,0.05,0.05,0.05,0.001\n");
+  write_text(dir / "ok.csv", "template,x,y,z,qw,qx,qy,qz\ndimer,0,0,0.003,1,0,0,0\n");
+  write_text(dir / "unknown.csv", "template,x,y,z,qw,qx,qy,qz\ntrimer,0,0,0.003,1,0,0,0\n");
+  const std::string base =
+      "[scene]\nname = \"b\"\npacking = \"packing.csv\"\n[material]\nyoung_Pa = 1e7\n"
+      "stiffness_ratio = 0.3\nfriction_deg = 30.0\ndensity_kg_m3 = 2500.0\n"
+      "[solver]\ndt_s = 1e-6\nsteps = 10\n";
+  const std::string dimer =
+      "[[clump_template]]\nname = \"dimer\"\nmembers = [[-0.0007, 0.0, 0.0, 0.001], [0.0007, 0.0, "
+      "0.0, 0.001]]\n";
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"[[clump_template]]\nname = \"dimer\"\nmembers = []\n[clumps]\npacking = \"ok.csv\"\n",
+       "clump_template[0].members: a clump template needs member spheres"},
+      {"[[clump_template]]\nname = \"dimer\"\nmembers = [[0.0, 0.0, 0.0, 0.0]]\n[clumps]\npacking "
+       "= \"ok.csv\"\n",
+       "clump_template[0].members[0]: member radius must be positive (0)"},
+      {dimer + "[clumps]\npacking = \"unknown.csv\"\n",
+       "unknown.csv: line 2: unknown clump template (trimer)"},
+      {dimer + "[clumps]\npacking = \"ok.csv\"\nmass = \"heavy\"\n",
+       "clumps.mass: expected \"member_sum\" or \"union\" (heavy)"}};
+  for (std::size_t k = 0; k < cases.size(); ++k) {
+    std::string name = "c";
+    name += std::to_string(k);
+    name += ".toml";
+    write_text(dir / name, base + cases[k].first);
+    std::string err;
+    EXPECT_EQ(run("simulate " + (dir / name).string() + " -q -o " + (dir / "o").string(), &err), 2)
+        << k;
     EXPECT_NE(err.find(cases[k].second), std::string::npos) << k << ": " << err;
     EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << k << ": " << err;
   }
