@@ -10,7 +10,7 @@
 
 namespace gs::text {
 
-std::string read_text_file(const std::filesystem::path& path, std::size_t max_bytes) {
+std::string read_file_bytes(const std::filesystem::path& path, std::size_t max_bytes) {
   const std::string name = path.string();
   std::error_code ec;
   if (!std::filesystem::exists(path, ec)) throw InputError(name, "no such file");
@@ -23,6 +23,12 @@ std::string read_text_file(const std::filesystem::path& path, std::size_t max_by
   std::string s(size, '\0');
   in.read(s.data(), static_cast<std::streamsize>(size));
   if (static_cast<std::size_t>(in.gcount()) != size) throw InputError(name, "short read");
+  return s;
+}
+
+std::string read_text_file(const std::filesystem::path& path, std::size_t max_bytes) {
+  const std::string name = path.string();
+  std::string s = read_file_bytes(path, max_bytes);
   if (s.find('\0') != std::string::npos)
     throw InputError(name, "binary content in a text file",
                      "NUL byte at offset " + std::to_string(s.find('\0')));

@@ -57,23 +57,6 @@ bool is_blank(unsigned char c) {
   return c == ' ' || (c >= '\t' && c <= '\r');
 }
 
-// Whole file as bytes (binary or text), with the messages of text::read_text_file.
-std::string read_bytes(const std::filesystem::path& path, std::size_t max_bytes = 1ull << 32) {
-  const std::string name = path.string();
-  std::error_code ec;
-  if (!std::filesystem::exists(path, ec)) throw InputError(name, "no such file");
-  if (!std::filesystem::is_regular_file(path, ec)) throw InputError(name, "not a regular file");
-  const auto size = std::filesystem::file_size(path, ec);
-  if (ec) throw InputError(name, "cannot stat file", ec.message());
-  if (size > max_bytes) throw InputError(name, "file too large", std::to_string(size) + " bytes");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(name, "cannot open file");
-  std::string s(size, '\0');
-  in.read(s.data(), static_cast<std::streamsize>(size));
-  if (static_cast<std::size_t>(in.gcount()) != size) throw InputError(name, "short read");
-  return s;
-}
-
 // Builds a mesh, merging exactly equal vertices (−0 and +0 count as equal) and numbering the
 // groups in order of first use.
 class MeshBuilder {
@@ -313,7 +296,7 @@ void validate_mesh(const TriangleMesh& mesh, const std::string& source) {
 
 TriangleMesh read_stl(const std::filesystem::path& path) {
   const std::string name = path.string();
-  const std::string bytes = read_bytes(path);
+  const std::string bytes = text::read_file_bytes(path);
   std::size_t b = 0;
   while (b < bytes.size() && is_blank(static_cast<unsigned char>(bytes[b]))) ++b;
   if (b == bytes.size()) throw InputError(name, "empty file");

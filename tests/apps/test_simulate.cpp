@@ -225,6 +225,21 @@ void write_text(const std::filesystem::path& p, const std::string& s) {
   std::ofstream(p) << s;
 }
 
+/// The value of `column` in the last row of a history CSV (NaN, with a failure, if absent).
+double last_history_value(const std::filesystem::path& history, const std::string& column) {
+  std::istringstream in(slurp(history));
+  std::string header, line, last;
+  std::getline(in, header);
+  while (std::getline(in, line))
+    if (!line.empty()) last = line;
+  std::istringstream h(header), v(last);
+  std::string hn, vv;
+  while (std::getline(h, hn, ',') && std::getline(v, vv, ','))
+    if (hn == column) return std::stod(vv);
+  ADD_FAILURE() << "no column " << column << " in " << history;
+  return std::nan("");
+}
+
 /// A floor of two 10 × 4 mm strips (4 triangles, ASCII STL, millimetres) with a 2 mm slot
 /// between them along y at x ∈ [4, 6] mm.
 std::string slotted_floor_stl() {
@@ -286,19 +301,8 @@ keep_hi_m = [1.0, 1.0, 1.0]
       run("simulate " + (dir / "scene.toml").string() + " -q -o " + (dir / "out").string(), &err),
       0)
       << err;
-  const std::string hist = slurp(dir / "out" / "history.csv");
-  std::istringstream in(hist);
-  std::string header, line, last;
-  std::getline(in, header);
-  while (std::getline(in, line))
-    if (!line.empty()) last = line;
   auto column = [&](const std::string& name) {
-    std::istringstream h(header), v(last);
-    std::string hn, vv;
-    while (std::getline(h, hn, ',') && std::getline(v, vv, ','))
-      if (hn == name) return std::stod(vv);
-    ADD_FAILURE() << "no column " << name;
-    return 0.0;
+    return last_history_value(dir / "out" / "history.csv", name);
   };
   const double m = 2500.0 * 4.0 / 3.0 * M_PI * std::pow(0.0008, 3);
   EXPECT_EQ(column("removed"), 6.0);
@@ -409,17 +413,7 @@ mass = "union"
   const double r = 0.001, d = 0.0014;
   const double lens = M_PI * std::pow(2 * r - d, 2) * (d * d + 4 * d * r) / (12 * d);
   const double m = 2500.0 * (2 * (4.0 / 3.0) * M_PI * r * r * r - lens);
-  const std::string hist = slurp(dir / "out" / "history.csv");
-  std::istringstream in(hist);
-  std::string header, line, lastrow;
-  std::getline(in, header);
-  while (std::getline(in, line))
-    if (!line.empty()) lastrow = line;
-  std::istringstream h(header), v(lastrow);
-  std::string hn, vv;
-  double floor_fz = 0;
-  while (std::getline(h, hn, ',') && std::getline(v, vv, ','))
-    if (hn == "floor_fz_N") floor_fz = std::stod(vv);
+  const double floor_fz = last_history_value(dir / "out" / "history.csv", "floor_fz_N");
   const double sphere = 2500.0 * (4.0 / 3.0) * M_PI * r * r * r;  // the spectator, settled too
   EXPECT_NEAR(floor_fz, -(3 * m + sphere) * 9.81, 1e-6 * (3 * m + sphere) * 9.81);
 }
