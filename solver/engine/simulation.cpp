@@ -136,10 +136,10 @@ bool Simulation::integrate_clumps() {
     damping += integrate_clump(c, load, cfg_.gravity, cfg_.damping, dt);
     finite = finite && c.pos.allFinite() && c.vel.allFinite() && c.angmom.allFinite();
     // YADE's Clump::moveMembers.
-    for (std::size_t k = 0; k < c.members.size(); ++k) {
-      const std::uint32_t i = c.members[k];
-      p_.pos[i] = c.pos + c.ori * c.local_pos[k];
-      p_.ori[i] = c.ori * c.local_ori[k];
+    for (std::size_t m = 0; m < c.members.size(); ++m) {
+      const std::uint32_t i = c.members[m];
+      p_.pos[i] = c.pos + c.ori * c.local_pos[m];
+      p_.ori[i] = c.ori * c.local_ori[m];
       p_.vel[i] = c.vel + c.angvel.cross(p_.pos[i] - c.pos);
       p_.angvel[i] = c.angvel;
     }
