@@ -240,6 +240,23 @@ double last_history_value(const std::filesystem::path& history, const std::strin
   return std::nan("");
 }
 
+/// Each case (scene text appended to `base`, expected part of the message) fails with one line
+/// containing the expected text, exit code 2.
+void expect_one_line_errors(const std::filesystem::path& dir, const std::string& base,
+                            const std::vector<std::pair<std::string, std::string>>& cases) {
+  for (std::size_t k = 0; k < cases.size(); ++k) {
+    std::string name = "case";
+    name += std::to_string(k);
+    name += ".toml";
+    write_text(dir / name, base + cases[k].first);
+    std::string err;
+    EXPECT_EQ(run("simulate " + (dir / name).string() + " -q -o " + (dir / "o").string(), &err), 2)
+        << k;
+    EXPECT_NE(err.find(cases[k].second), std::string::npos) << k << ": " << err;
+    EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << k << ": " << err;
+  }
+}
+
 /// A floor of two 10 × 4 mm strips (4 triangles, ASCII STL, millimetres) with a 2 mm slot
 /// between them along y at x ∈ [4, 6] mm.
 std::string slotted_floor_stl() {
@@ -333,17 +350,7 @@ TEST(Simulate, BadMeshAndOutletNameTheKey) {
       {"[[mesh]]\nfile = \"nan.stl\"\n", "nan.stl: line 5: vertex coordinate is not finite (nan)"},
       {"[outlet]\nkeep_lo_m = [0.0, 0.0, 0.0]\nkeep_hi_m = [1.0, 1.0, -1.0]\n",
        "outlet.keep_hi_m: must exceed keep_lo_m"}};
-  for (std::size_t k = 0; k < cases.size(); ++k) {
-    std::string name = "s";
-    name += std::to_string(k);
-    name += ".toml";
-    const auto scene = dir / name;
-    write_text(scene, base + cases[k].first);
-    std::string err;
-    EXPECT_EQ(run("simulate " + scene.string() + " -q -o " + (dir / "o").string(), &err), 2) << k;
-    EXPECT_NE(err.find(cases[k].second), std::string::npos) << k << ": " << err;
-    EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << k << ": " << err;
-  }
+  expect_one_line_errors(dir.path, base, cases);
 }
 
 // Exact answers: three dimers (two 1 mm spheres 1.4 mm apart, seed 003 §2.4's two-sphere clumps)
@@ -441,15 +448,5 @@ TEST(Simulate, BadClumpsNameTheFieldAndValue) {
        "unknown.csv: line 2: unknown clump template (trimer)"},
       {dimer + "[clumps]\npacking = \"ok.csv\"\nmass = \"heavy\"\n",
        "clumps.mass: expected \"member_sum\" or \"union\" (heavy)"}};
-  for (std::size_t k = 0; k < cases.size(); ++k) {
-    std::string name = "c";
-    name += std::to_string(k);
-    name += ".toml";
-    write_text(dir / name, base + cases[k].first);
-    std::string err;
-    EXPECT_EQ(run("simulate " + (dir / name).string() + " -q -o " + (dir / "o").string(), &err), 2)
-        << k;
-    EXPECT_NE(err.find(cases[k].second), std::string::npos) << k << ": " << err;
-    EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << k << ": " << err;
-  }
+  expect_one_line_errors(dir.path, base, cases);
 }
