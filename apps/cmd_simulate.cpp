@@ -131,8 +131,16 @@ std::string history_header(const solver::Simulation& sim) {
     const std::string n = w.spec.name.empty() ? "wall" : w.spec.name;
     for (const char* c : {"_fx_N", "_fy_N", "_fz_N", "_x_m", "_y_m", "_z_m"}) h += "," + n + c;
   }
-  for (const auto& g : solver::group_forces(sim))
-    for (const char* c : {"_fx_N", "_fy_N", "_fz_N"}) h += "," + g.group + c;
+  auto groups = solver::group_forces(sim);
+  for (const auto& g : solver::mesh_forces(sim)) groups.push_back(g);
+  for (const auto& g : groups)
+    for (const char* c : {"_fx_N", "_fy_N", "_fz_N", "_tx_Nm", "_ty_Nm", "_tz_Nm"})
+      h += "," + g.group + c;
+  if (sim.facet_forces())
+    for (const auto& w : sim.walls())
+      for (std::size_t f = 0; f < w.facets.size(); ++f)
+        for (const char* c : {"_fx_N", "_fy_N", "_fz_N"})
+          h += "," + w.spec.name + "." + std::to_string(f) + c;
   h += ",removed,removed_mass_kg";
   return h;
 }
@@ -154,10 +162,21 @@ std::string history_row(solver::Simulation& sim) {
                   w.force.z(), w.pos.x(), w.pos.y(), w.pos.z());
     row += buf;
   }
-  for (const auto& g : solver::group_forces(sim)) {
-    std::snprintf(buf, sizeof buf, ",%.17g,%.17g,%.17g", g.force.x(), g.force.y(), g.force.z());
+  auto groups = solver::group_forces(sim);
+  for (const auto& g : solver::mesh_forces(sim)) groups.push_back(g);
+  for (const auto& g : groups) {
+    std::snprintf(buf, sizeof buf, ",%.17g,%.17g,%.17g,%.17g,%.17g,%.17g", g.force.x(), g.force.y(),
+                  g.force.z(), g.torque.x(), g.torque.y(), g.torque.z());
     row += buf;
   }
+  if (sim.facet_forces())
+    for (const auto& w : sim.walls())
+      for (std::size_t f = 0; f < w.facets.size(); ++f) {
+        const Eigen::Vector3d F =
+            f < w.facet_force.size() ? w.facet_force[f] : Eigen::Vector3d::Zero();
+        std::snprintf(buf, sizeof buf, ",%.17g,%.17g,%.17g", F.x(), F.y(), F.z());
+        row += buf;
+      }
   std::snprintf(buf, sizeof buf, ",%zu,%.17g", sim.removed_count(), sim.removed_mass());
   row += buf;
   return row;
@@ -191,6 +210,7 @@ void run(const Args& a) {
   solver::Simulation sim(scene.config, scene.particles, scene.walls);
   if (!scene.clumps.empty()) sim.set_clumps(scene.clumps);
   if (scene.outlet) sim.set_outlet(scene.outlet->first, scene.outlet->second);
+  if (scene.output.facet_forces) sim.set_facet_forces(true);
   RunMetadata meta;
   meta.provenance = "granoscope simulate " + a.scene;
   meta.parameters = scene.parameters;

@@ -67,6 +67,21 @@ struct Domain {
   Eigen::Matrix3d cell = Eigen::Matrix3d::Identity();
 };
 
+/// A rigid clump body (seed 003 §2.4, seed 004 §4.3) at one instant: its members are the
+/// particles with clump_id == id. Centre of mass, orientation of its principal frame (body ->
+/// lab, principal axes = columns of its rotation matrix), velocities, mass and principal moments
+/// of inertia (kg·m², in the order of the principal axes), and the scene's template name.
+struct Clump {
+  std::int64_t id = 0;
+  std::string template_name;
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();
+  Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();
+  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
+  Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();  // rad/s
+  double mass = 0.0;                                           // kg
+  Eigen::Vector3d principal_inertia = Eigen::Vector3d::Zero();
+};
+
 struct Frame {
   double time = 0.0;  // s
   std::int64_t step = 0;
@@ -76,6 +91,7 @@ struct Frame {
   std::vector<Particle> particles;
   std::vector<Contact> contacts;
   std::vector<Wall> walls;
+  std::vector<Clump> clumps;  // empty for a frame of free spheres
 };
 
 /// Run-level metadata: free-form key/value scene parameters plus provenance.
@@ -94,7 +110,9 @@ struct Trajectory {
 std::pair<Eigen::Vector3d, Eigen::Vector3d> particle_bounds(const Frame& frame);
 
 /// Throws InputError naming `source` and the first invalid field: non-finite numbers, radius
-/// <= 0, negative mass, non-unit contact and plane-wall normals, duplicate particle ids.
+/// <= 0, negative mass, non-unit contact and plane-wall normals, duplicate particle ids; for clump
+/// bodies a non-unit orientation, mass <= 0, negative principal inertia, duplicate ids, a member
+/// naming a missing clump, or a clump without members.
 void validate_frame(const Frame& frame, const std::string& source);
 
 /// The project version string, e.g. "granoscope 0.1.0".

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <map>
 #include <numeric>
+#include <set>
 #include <stdexcept>
 
 #include "triangle_facet.hpp"
@@ -113,20 +114,41 @@ std::vector<WallSpec> mesh_walls(const MeshTriangles& mesh, MeshContact mode,
   return walls;
 }
 
-std::vector<GroupForce> group_forces(const Simulation& sim) {
+namespace {
+// Forces and torques summed over the walls, keyed by `key` (walls with an empty key skipped).
+template <class Key>
+std::vector<GroupForce> sum_by(const Simulation& sim, Key key) {
   std::vector<GroupForce> out;
   std::map<std::string, std::size_t> index;
   for (const auto& w : sim.walls()) {
-    if (w.spec.group.empty()) continue;
-    auto it = index.find(w.spec.group);
+    const std::string& k = key(w.spec);
+    if (k.empty()) continue;
+    auto it = index.find(k);
     if (it == index.end()) {
-      it = index.emplace(w.spec.group, out.size()).first;
-      out.push_back({w.spec.group, Eigen::Vector3d::Zero(), 0});
+      it = index.emplace(k, out.size()).first;
+      out.push_back({k, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), 0});
     }
-    out[it->second].force += w.force;
-    ++out[it->second].walls;
+    GroupForce& g = out[it->second];
+    g.force += w.force;
+    g.torque += w.torque + (w.pos - w.rot_center).cross(w.force);
+    ++g.walls;
   }
   return out;
+}
+}  // namespace
+
+std::vector<GroupForce> group_forces(const Simulation& sim) {
+  return sum_by(sim, [](const WallSpec& s) -> const std::string& { return s.group; });
+}
+
+std::vector<GroupForce> mesh_forces(const Simulation& sim) {
+  std::map<std::string, std::set<std::string>> groups;
+  for (const auto& w : sim.walls())
+    if (!w.spec.mesh.empty()) groups[w.spec.mesh].insert(w.spec.group);
+  static const std::string none;
+  return sum_by(sim, [&](const WallSpec& s) -> const std::string& {
+    return !s.mesh.empty() && groups[s.mesh].size() > 1 ? s.mesh : none;
+  });
 }
 
 }  // namespace gs::solver

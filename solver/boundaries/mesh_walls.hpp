@@ -40,12 +40,17 @@ std::vector<WallSpec> mesh_walls(const MeshTriangles& mesh, MeshContact mode,
 std::vector<int> flat_regions(const MeshTriangles& mesh, double angle_tol = 1e-9,
                               double offset_tol = 1e-12);
 
-/// Σ of the wall forces (N, exerted by the particles on the walls) over each group's walls.
+/// Σ of the wall forces (N, exerted by the particles on the walls) over each group's walls, and
+/// their torque (N·m) about the walls' rotation centre (a scene's mesh: the centre of its
+/// bounding box unless it says otherwise).
 struct GroupForce {
   std::string group;
   Eigen::Vector3d force = Eigen::Vector3d::Zero();
+  Eigen::Vector3d torque = Eigen::Vector3d::Zero();
   std::size_t walls = 0;
 };
 std::vector<GroupForce> group_forces(const Simulation& sim);
+/// The same per mesh (WallSpec::mesh), for the meshes of more than one group.
+std::vector<GroupForce> mesh_forces(const Simulation& sim);
 
 }  // namespace gs::solver

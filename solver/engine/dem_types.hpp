@@ -4,6 +4,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -29,9 +30,11 @@ struct Material {
 enum class WallShape { Box, Plane, Facets };
 
 /// A rigid wall. Boxes are axis-aligned (centre, half-extents); planes are infinite (point,
-/// unit normal pointing into the granular domain). Walls move with `velocity` (m/s) and planes
-/// may rotate with `angular_velocity` (rad/s) about their point. A servo wall adjusts its
-/// velocity along `servo_axis` to hold the normal stress on it at `servo_stress_Pa`.
+/// unit normal pointing into the granular domain). Walls move with `velocity` (m/s); planes
+/// may rotate with `angular_velocity` (rad/s) about their point, facet walls about
+/// `rotation_center` (which moves with `velocity`). A servo wall adjusts its velocity along its
+/// servo axis to hold the normal stress on it (on all walls of its `body`: the walls of one
+/// rigid mesh) at `servo_stress_Pa`.
 struct WallSpec {
   std::string name;
   WallShape shape = WallShape::Box;
@@ -52,6 +55,10 @@ struct WallSpec {
   std::vector<TriangleFacet> facets;
   bool plane_radii = false;
   std::string group;  // the mesh's named facet group (forces are summed per group)
+  std::string mesh;   // the name of the mesh the wall belongs to
+  Eigen::Vector3d rotation_center = Eigen::Vector3d::Zero();  // facets only
+  int body = -1;  // walls with the same body ≥ 0 form one rigid mesh (servo on their sum)
+  double off_at_s = HUGE_VAL;  // switched off once the time reaches this (an outlet opening)
 };
 
 /// Per-particle state, structure of arrays (index = particle index, not id).
@@ -77,6 +84,13 @@ struct WallState {
   Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
   Eigen::Vector3d vel = Eigen::Vector3d::Zero();
   Eigen::Vector3d force = Eigen::Vector3d::Zero(), torque = Eigen::Vector3d::Zero();
+  // Facets: the rotation since the start (spec.facets → facets) and the current centre of it;
+  // `reach` bounds the distance of the facets' points from pos (m).
+  Eigen::Quaterniond ori = Eigen::Quaterniond::Identity();
+  Eigen::Vector3d rot_center = Eigen::Vector3d::Zero();
+  std::vector<TriangleFacet> facets;  // current (rotated) triangles, relative to pos
+  double reach = 0;
+  std::vector<Eigen::Vector3d> facet_force;  // N per facet (Simulation::set_facet_forces)
   bool active = true;            // an inactive wall touches nothing (e.g. replaced by a membrane)
   double contact_stiffness = 0;  // Σ Kn of its contacts in the last step, N/m
   std::size_t contacts = 0;      // its contacts in the last step

@@ -17,8 +17,15 @@ bool NeighborList::stale(const ParticleState& p, const std::vector<WallState>& w
   if (2 * dmax > skin) return true;
   double wmax = 0;
   for (std::size_t w = 0; w < walls.size(); ++w) {
-    wmax = std::max(wmax, (walls[w].pos - wall_ref[w]).norm());
-    if ((walls[w].normal - wall_normal_ref[w]).norm() > 0) return true;  // rotated plane
+    const WallState& wall = walls[w];
+    double move = (wall.pos - wall_ref[w]).norm();
+    if (wall.spec.shape == WallShape::Facets) {
+      // A rotated mesh: its points moved at most 2·sin(θ/2)·reach more than its reference.
+      move += 2 * std::abs(std::sin(0.5 * wall.ori.angularDistance(wall_ori_ref[w]))) * wall.reach;
+    } else if ((wall.normal - wall_normal_ref[w]).norm() > 0) {
+      return true;  // rotated plane
+    }
+    wmax = std::max(wmax, move);
   }
   return dmax + wmax > skin;
 }
@@ -30,9 +37,11 @@ void NeighborList::build(const ParticleState& p, const std::vector<WallState>& w
   ref_pos = p.pos;
   wall_ref.clear();
   wall_normal_ref.clear();
+  wall_ori_ref.clear();
   for (const auto& w : walls) {
     wall_ref.push_back(w.pos);
     wall_normal_ref.push_back(w.normal);
+    wall_ori_ref.push_back(w.ori);
   }
   ++builds;
   if (n == 0) return;
@@ -90,7 +99,7 @@ void NeighborList::build(const ParticleState& p, const std::vector<WallState>& w
         continue;
       }
       Eigen::Vector3d lo_w = Eigen::Vector3d::Constant(HUGE_VAL), hi_w = -lo_w;
-      for (const auto& f : wall.spec.facets)
+      for (const auto& f : wall.facets)
         for (const auto& v : f.vertex) {
           const Eigen::Vector3d x = wall.pos + (f.offset + v).eigen();
           lo_w = lo_w.cwiseMin(x);

@@ -19,6 +19,7 @@ struct NeighborList {
   std::vector<Eigen::Vector3d> ref_pos;   // particle positions at the last build
   std::vector<Eigen::Vector3d> wall_ref;  // wall positions at the last build
   std::vector<Eigen::Vector3d> wall_normal_ref;
+  std::vector<Eigen::Quaterniond> wall_ori_ref;  // facet walls' rotations at the last build
   std::int64_t builds = 0;
 
   /// True when some pair may have come within contact since the last build.

@@ -63,6 +63,7 @@ PrincipalAxes principal_axes(const Eigen::Matrix3d& inertia);
 /// principal frame (YADE's Clump.members).
 struct ClumpBody {
   std::int64_t id = -1;
+  std::string template_name;                  // the scene's template (output only)
   std::vector<std::uint32_t> members;         // particle indices
   std::vector<Eigen::Vector3d> local_pos;     // member centre in the principal frame
   std::vector<Eigen::Quaterniond> local_ori;  // member orientation relative to the clump

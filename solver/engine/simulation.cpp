@@ -78,6 +78,12 @@ Simulation::Simulation(SimulationConfig config, const std::vector<Particle>& par
                                                  : spec.normal;
     w.vel = spec.velocity;
     w.active = spec.active;
+    if (spec.shape == WallShape::Facets) {
+      w.facets = spec.facets;
+      w.rot_center = spec.rotation_center;
+      for (const auto& f : spec.facets)
+        for (const auto& v : f.vertex) w.reach = std::max(w.reach, (f.offset + v).eigen().norm());
+    }
     walls_.push_back(w);
   }
   nl_.skin = cfg_.skin > 0 ? cfg_.skin : (n > 0 ? 0.5 * rmin : 1e-3);
@@ -189,6 +195,7 @@ void Simulation::attach_histories(const std::vector<ContactHistory>& old) {
   const std::size_t np = nl_.pairs.size();
   hist_.assign(np, ContactHistory{});
   params_.resize(np);
+  if (facet_forces_) pair_facet_.assign(np, 0);
   std::size_t o = 0;
   for (std::size_t k = 0; k < np; ++k) {
     const auto pr = nl_.pairs[k];
@@ -250,8 +257,23 @@ void Simulation::set_wall_active(std::size_t w, bool active) {
   invalidate_neighbors();
 }
 
+void Simulation::place_rotated_facets(WallState& w) {
+  w.pos = w.rot_center + w.ori * (w.spec.center - w.spec.rotation_center);
+  for (std::size_t k = 0; k < w.facets.size(); ++k)
+    w.facets[k] = rotated_facet(w.spec.facets[k], w.ori);
+  w.normal = w.facets.at(0).normal.eigen();
+}
+
+void Simulation::set_facet_forces(bool on) {
+  facet_forces_ = on;
+  if (!on)
+    for (auto& w : walls_) w.facet_force.clear();
+  invalidate_neighbors();
+}
+
 [[gnu::always_inline]] inline bool Simulation::pair_geometry(std::size_t k, ContactGeometry& g,
-                                                             BodyMotion& m1, BodyMotion& m2) const {
+                                                             BodyMotion& m1, BodyMotion& m2,
+                                                             std::uint32_t* facet) const {
   const auto [a, b] = nl_.pairs[k];
   if (b >= kWallBase) {
     const WallState& w = walls_[b - kWallBase];
@@ -262,7 +284,7 @@ void Simulation::set_wall_active(std::size_t w, bool active) {
     } else if (w.spec.shape == WallShape::Facets) {
       // The closest of the wall's triangles (one, in YADE's layout).
       const V3 wp(w.pos);
-      const auto& fs = w.spec.facets;
+      const auto& fs = w.facets;
       double best = facet_sphere_geometry(fs[0], wp, m2.pos, p_.radius[a], w.spec.plane_radii, g);
       std::size_t k_best = 0;
       for (std::size_t k = 1; k < fs.size(); ++k) {
@@ -275,7 +297,10 @@ void Simulation::set_wall_active(std::size_t w, bool active) {
           k_best = k;
         }
       }
-      m1 = {wp + fs[k_best].offset, V3(w.vel), V3()};
+      // The wall moves rigidly: v + ω × (x − c) about its rotation centre c (torques about pos).
+      const Eigen::Vector3d& om = w.spec.angular_velocity;
+      m1 = {wp, V3(w.vel + om.cross(w.pos - w.rot_center)), V3(om)};
+      if (facet) *facet = static_cast<std::uint32_t>(k_best);
     } else {
       plane_sphere_geometry(V3(w.pos), V3(w.normal), m2.pos, p_.radius[a], g);
       m1 = {V3(w.pos), V3(w.vel), V3(w.spec.angular_velocity)};
@@ -288,12 +313,25 @@ void Simulation::set_wall_active(std::size_t w, bool active) {
 }
 
 void Simulation::update_servos() {
+  // The force on each rigid mesh (body): the sum over its walls, in wall order.
+  std::vector<Eigen::Vector3d> body_force;
+  for (const auto& w : walls_)
+    if (w.spec.body >= 0 && w.spec.servo_area_m2 > 0) {
+      const auto b = static_cast<std::size_t>(w.spec.body);
+      if (body_force.size() <= b) body_force.resize(b + 1, Eigen::Vector3d::Zero());
+    }
+  if (!body_force.empty())
+    for (const auto& w : walls_)
+      if (w.spec.body >= 0 && static_cast<std::size_t>(w.spec.body) < body_force.size())
+        body_force[static_cast<std::size_t>(w.spec.body)] += w.force;
   for (auto& w : walls_) {
     const auto& s = w.spec;
     if (!(s.servo_area_m2 > 0)) continue;
     // Compressive stress on the wall: the particles push it along −normal (its inward normal).
     const Eigen::Vector3d axis = s.shape == WallShape::Plane ? w.normal : s.normal.normalized();
-    const double stress = -w.force.dot(axis) / s.servo_area_m2;
+    const Eigen::Vector3d& force =
+        s.body >= 0 ? body_force[static_cast<std::size_t>(s.body)] : w.force;
+    const double stress = -force.dot(axis) / s.servo_area_m2;
     const double v = std::clamp(s.servo_gain * (s.servo_stress_Pa - stress), -s.servo_max_velocity,
                                 s.servo_max_velocity);
     w.vel = v * axis;  // too little stress: move into the domain
@@ -307,11 +345,14 @@ void Simulation::accumulate_walls() {
     w.contact_stiffness = 0;
     w.contacts = 0;
   }
+  if (facet_forces_)
+    for (auto& w : walls_) w.facet_force.assign(w.facets.size(), Eigen::Vector3d::Zero());
   for (const std::uint32_t k : wall_pairs_) {
     if (!active_[k]) continue;
     const ContactLoads& L = loads_[k];
     WallState& w = walls_[nl_.pairs[k].second - kWallBase];
     add_to(w.force, L.force1);
+    if (facet_forces_ && !w.facet_force.empty()) add_to(w.facet_force[pair_facet_[k]], L.force1);
     w.contact_stiffness += params_[k].kn;
     ++w.contacts;
     add_to(w.torque, L.arm1);
@@ -326,7 +367,8 @@ void Simulation::accumulate_walls() {
   const auto [a, b] = nl_.pairs[k];
   ContactGeometry g;
   BodyMotion m1, m2;
-  if (!pair_geometry(k, g, m1, m2) || g.penetration < 0) {
+  if (!pair_geometry(k, g, m1, m2, facet_forces_ ? &pair_facet_[k] : nullptr) ||
+      g.penetration < 0) {
     // Coincident centres, or not touching (YADE erases the interaction).
     h.real = false;
     return false;
@@ -596,11 +638,21 @@ void Simulation::step() {
   for (auto& w : walls_) {
     w.pos += w.vel * dt;
     const double om = w.spec.angular_velocity.norm();
-    if (w.spec.shape == WallShape::Plane && om > 0)
-      w.normal = (Eigen::AngleAxisd(om * dt, w.spec.angular_velocity / om) * w.normal).normalized();
+    if (!(om > 0)) continue;
+    const Eigen::AngleAxisd turn(om * dt, w.spec.angular_velocity / om);
+    if (w.spec.shape == WallShape::Plane) {
+      w.normal = (turn * w.normal).normalized();
+    } else if (w.spec.shape == WallShape::Facets) {
+      // Rigid rotation about the moving centre, from the initial triangles (no drift).
+      w.rot_center += w.vel * dt;
+      w.ori = (Eigen::Quaterniond(turn) * w.ori).normalized();
+      place_rotated_facets(w);
+    }
   }
   time_ += dt;
   ++step_;
+  for (std::size_t w = 0; w < walls_.size(); ++w)
+    if (walls_[w].active && time_ >= walls_[w].spec.off_at_s) set_wall_active(w, false);
   if (outlet_) remove_outflow();
 }
 
@@ -784,11 +836,23 @@ Frame Simulation::frame() const {
                                                      : WallKind::Plane;
     wall.a = ws.pos;
     wall.b = ws.spec.shape == WallShape::Box      ? ws.spec.half_extents
-             : ws.spec.shape == WallShape::Facets ? ws.spec.facets.at(0).normal.eigen()
+             : ws.spec.shape == WallShape::Facets ? ws.facets.at(0).normal.eigen()
                                                   : ws.normal;
     wall.force = ws.force;
     wall.torque = ws.torque;
     f.walls.push_back(wall);
+  }
+  f.clumps.reserve(clumps_.size());
+  for (const auto& c : clumps_) {
+    auto& q = f.clumps.emplace_back();
+    q.id = c.id;
+    q.template_name = c.template_name;
+    q.position = c.pos;
+    q.orientation = c.ori;
+    q.velocity = c.vel;
+    q.angular_velocity = c.angvel;
+    q.mass = c.mass;
+    q.principal_inertia = c.inertia;
   }
   const auto [lo, hi] = particle_bounds(f);
   f.domain.lo = lo;
@@ -799,7 +863,8 @@ Frame Simulation::frame() const {
 // ------------------------------------------------------------------ checkpoints
 
 namespace {
-constexpr char kMagic[8] = {'G', 'S', 'C', 'K', 'P', 'T', '0', '4'};
+constexpr char kMagic[8] = {'G', 'S', 'C', 'K', 'P', 'T', '0', '5'};
+constexpr char kMagicV04[8] = {'G', 'S', 'C', 'K', 'P', 'T', '0', '4'};  // (no wall rotation)
 constexpr char kMagicV03[8] = {'G', 'S', 'C', 'K', 'P', 'T', '0', '3'};  // (no clumps)
 
 template <class T>
@@ -861,6 +926,8 @@ void Simulation::save_checkpoint(const std::filesystem::path& path,
       put(o, w.torque);
       put(o, w.contact_stiffness);
       put(o, static_cast<std::uint64_t>(w.contacts));
+      put(o, w.ori);
+      put(o, w.rot_center);
     }
     // Contact histories of real contacts, sorted by pair.
     std::vector<ContactHistory> real;
@@ -893,7 +960,8 @@ std::string Simulation::load_checkpoint(const std::filesystem::path& path) {
   char magic[8];
   in.read(magic, 8);
   const bool v03 = in && std::memcmp(magic, kMagicV03, 8) == 0;
-  if (!in || (!v03 && std::memcmp(magic, kMagic, 8) != 0))
+  const bool v04 = in && std::memcmp(magic, kMagicV04, 8) == 0;
+  if (!in || (!v03 && !v04 && std::memcmp(magic, kMagic, 8) != 0))
     throw InputError(file, "not a granoscope checkpoint");
   get(in, step_, file);
   get(in, time_, file);
@@ -931,6 +999,14 @@ std::string Simulation::load_checkpoint(const std::filesystem::path& path) {
     std::uint64_t contacts = 0;
     get(in, contacts, file);
     w.contacts = static_cast<std::size_t>(contacts);
+    if (v03 || v04) {  // (walls did not rotate about a centre)
+      w.rot_center = w.pos - (w.spec.center - w.spec.rotation_center);
+    } else {
+      get(in, w.ori, file);
+      get(in, w.rot_center, file);
+    }
+    if (w.spec.shape == WallShape::Facets && w.spec.angular_velocity.norm() > 0)
+      place_rotated_facets(w);
   }
   std::uint64_t nc = 0;
   get(in, nc, file);

@@ -120,6 +120,11 @@ class Simulation {
   std::size_t removed_count() const { return removed_count_; }
   double removed_mass() const { return removed_mass_; }  // kg
 
+  /// Per-facet forces: with `on`, each facet wall sums its contact forces per triangle too
+  /// (WallState::facet_force, in the order of its facets), for wall-stress profiles.
+  void set_facet_forces(bool on);
+  bool facet_forces() const { return facet_forces_; }
+
   /// Forces a neighbour-list rebuild before the next step.
   void invalidate_neighbors() { nl_.ref_pos.clear(); }
 
@@ -133,7 +138,10 @@ class Simulation {
   /// Re-attaches contact histories (sorted by pair) to the current pair list.
   void attach_histories(const std::vector<ContactHistory>& old);
   /// Geometry and body motions of candidate pair k; false when the centres coincide.
-  bool pair_geometry(std::size_t k, ContactGeometry& g, BodyMotion& m1, BodyMotion& m2) const;
+  bool pair_geometry(std::size_t k, ContactGeometry& g, BodyMotion& m1, BodyMotion& m2,
+                     std::uint32_t* facet = nullptr) const;
+  /// pos, facets and normal of a rotating facet wall from its rotation and centre.
+  static void place_rotated_facets(WallState& w);
   /// Geometry, motions, history and parameters of candidate pair k into lane j of a batch;
   /// false when the pair does not touch (its history is then marked not real). Raises
   /// max_overlap_ratio past the blow-up limit.
@@ -165,6 +173,8 @@ class Simulation {
   std::vector<ClumpLoad> clump_loads_;
   NeighborList nl_;
   std::vector<ContactHistory> hist_;  // parallel to nl_.pairs
+  bool facet_forces_ = false;
+  std::vector<std::uint32_t> pair_facet_;  // closest facet of each wall pair (facet forces on)
   std::vector<ContactParams> params_;
   std::vector<ContactLoads> loads_;
   std::vector<std::uint8_t> active_;

@@ -50,4 +50,18 @@ TriangleFacet make_triangle_facet(const Eigen::Vector3d& v0, const Eigen::Vector
   return f;
 }
 
+TriangleFacet rotated_facet(const TriangleFacet& f, const Eigen::Quaterniond& q) {
+  const Eigen::Matrix3d R = q.toRotationMatrix();
+  auto rot = [&](const V3& v) { return V3(R * v.eigen()); };
+  TriangleFacet g = f;
+  g.offset = rot(f.offset);
+  g.normal = rot(f.normal);
+  for (int i = 0; i < 3; ++i) {
+    g.vertex[i] = rot(f.vertex[i]);
+    g.edge_normal[i] = rot(f.edge_normal[i]);
+    g.vertex_unit[i] = rot(f.vertex_unit[i]);
+  }
+  return g;
+}
+
 }  // namespace gs::solver

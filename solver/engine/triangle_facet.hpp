@@ -5,6 +5,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 
 #include "scalar_vec3.hpp"
 
@@ -30,5 +31,9 @@ Eigen::Vector3d incircle_centre(const Eigen::Vector3d& v0, const Eigen::Vector3d
 /// std::invalid_argument for a degenerate (zero-area) or non-finite triangle.
 TriangleFacet make_triangle_facet(const Eigen::Vector3d& v0, const Eigen::Vector3d& v1,
                                   const Eigen::Vector3d& v2, const Eigen::Vector3d& reference);
+
+/// The facet rotated rigidly by q about the wall's reference point: offset, vertices, normals
+/// and vertex directions rotated; lengths, area and incircle radius kept.
+TriangleFacet rotated_facet(const TriangleFacet& f, const Eigen::Quaterniond& q);
 
 }  // namespace gs::solver

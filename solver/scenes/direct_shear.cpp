@@ -63,8 +63,7 @@ SpecimenGauge shear_box_gauge(const ShearBoxGeometry& g, const ShearBoxWalls& w)
   return gauge;
 }
 
-DirectShear::DirectShear(DirectShearSpec spec, ShearBoxGeometry geometry,
-                                 ShearBoxWalls walls)
+DirectShear::DirectShear(DirectShearSpec spec, ShearBoxGeometry geometry, ShearBoxWalls walls)
     : MeasuredProgramme({spec.max_displacement_m, spec.frame_every_m}),
       spec_(spec),
       g_(geometry),

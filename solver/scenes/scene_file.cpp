@@ -317,6 +317,7 @@ void read_clumps(const Reader& r, const toml::table& root, const std::filesystem
         make_clump_body(index, pos, rad, s.config.material.density,
                         mass == "union" ? ClumpMassModel::Union : ClumpMassModel::MemberSum);
     body.id = -1;  // (numbered after the particles by the scene: below)
+    body.template_name = name;
     s.clumps.push_back(std::move(body));
   }
   for (auto& c : s.clumps) c.id = next_id++;
@@ -454,7 +455,7 @@ Scene load_scene(const std::filesystem::path& path) {
   const auto* out = r.table("output", false);
   r.only(out, "output",
          {"trajectory", "every", "contacts", "history", "history_every", "checkpoint_every",
-          "curve", "curve_every", "specimen", "preparation"});
+          "curve", "curve_every", "specimen", "preparation", "facet_forces"});
   s.output.trajectory = r.string(out, "output", "trajectory", false, s.output.trajectory);
   s.output.every = r.integer(out, "output", "every", false, s.output.every, 1);
   s.output.contacts = out && out->contains("contacts") ? (*out)["contacts"].value_or(true) : true;
@@ -467,6 +468,11 @@ Scene load_scene(const std::filesystem::path& path) {
   s.output.curve_every = r.integer(out, "output", "curve_every", false, s.output.curve_every, 1);
   s.output.specimen = r.string(out, "output", "specimen", false, s.output.specimen);
   s.output.preparation = r.string(out, "output", "preparation", false, s.output.preparation);
+  if (out && out->contains("facet_forces")) {
+    const auto v = (*out)["facet_forces"].value<bool>();
+    if (!v) r.fail("output.facet_forces", "expected true or false");
+    s.output.facet_forces = *v;
+  }
   read_lab_sections(r, root, s);
 
   if (!s.test.empty() && root.contains("walls"))
@@ -520,7 +526,9 @@ Scene load_scene(const std::filesystem::path& path) {
       const auto* m = (*meshes)[i].as_table();
       const std::string sec = "mesh[" + std::to_string(i) + "]";
       if (!m) r.fail(sec, "expected a table");
-      r.only(m, sec, {"file", "scale", "contact", "velocity_m_s", "friction_deg", "name"});
+      r.only(m, sec,
+             {"file", "scale", "contact", "velocity_m_s", "friction_deg", "name",
+              "angular_velocity_rad_s", "rotation_center_m", "servo", "off_at_s"});
       const std::string file_name = r.string(m, sec, "file", true, "");
       const auto mesh_path = path.parent_path() / file_name;
       std::error_code missing;
@@ -541,12 +549,49 @@ Scene load_scene(const std::filesystem::path& path) {
         const std::string& g = tm.group_names[static_cast<std::size_t>(tm.group[t])];
         tri.group.push_back(name.empty() ? g : name + "/" + g);
       }
+      // The mesh moves as one rigid body: velocity, rotation about a centre (default the centre
+      // of its bounding box), a servo on the force summed over its triangles, switched off at a
+      // time (an outlet opening).
+      const Eigen::Vector3d omega =
+          r.vec3(m, sec, "angular_velocity_rad_s", false, Eigen::Vector3d::Zero());
+      Eigen::Vector3d lo = Eigen::Vector3d::Constant(HUGE_VAL), hi = -lo;
+      for (const auto& t : tri.triangles)
+        for (const auto& v : t) {
+          lo = lo.cwiseMin(v);
+          hi = hi.cwiseMax(v);
+        }
+      const Eigen::Vector3d centre = r.vec3(m, sec, "rotation_center_m", false, 0.5 * (lo + hi));
+      const double off_at = r.number(m, sec, "off_at_s", false, HUGE_VAL);
+      if (!(off_at >= 0)) r.fail(sec + ".off_at_s", "must be >= 0", value_str(off_at));
+      WallSpec servo;
+      if (const auto* sv = (*m)["servo"].as_table()) {
+        const std::string ss = sec + ".servo";
+        r.only(sv, ss, {"stress_Pa", "area_m2", "gain_m_s_per_Pa", "max_velocity_m_s", "axis"});
+        servo.servo_stress_Pa = r.number(sv, ss, "stress_Pa", true, 0);
+        servo.servo_area_m2 = r.positive(sv, ss, "area_m2", true, 0);
+        servo.servo_gain = r.positive(sv, ss, "gain_m_s_per_Pa", true, 0);
+        servo.servo_max_velocity = r.positive(sv, ss, "max_velocity_m_s", true, 0);
+        servo.normal = r.vec3(sv, ss, "axis", true, {});
+        if (!(servo.normal.norm() > 0)) r.fail(ss + ".axis", "must not be zero");
+      }
+      const int body = static_cast<int>(i);
       try {
         for (auto& w :
              mesh_walls(tri, contact == "yade" ? MeshContact::YadeParity : MeshContact::Merged,
                         r.vec3(m, sec, "velocity_m_s", false, Eigen::Vector3d::Zero()),
-                        r.number(m, sec, "friction_deg", false, -1)))
+                        r.number(m, sec, "friction_deg", false, -1))) {
+          w.angular_velocity = omega;
+          w.rotation_center = centre;
+          w.body = body;
+          w.mesh = name.empty() ? mesh_path.stem().string() : name;
+          w.off_at_s = off_at;
+          w.servo_stress_Pa = servo.servo_stress_Pa;
+          w.servo_area_m2 = servo.servo_area_m2;
+          w.servo_gain = servo.servo_gain;
+          w.servo_max_velocity = servo.servo_max_velocity;
+          w.normal = servo.normal;
           s.walls.push_back(std::move(w));
+        }
       } catch (const std::invalid_argument& e) {
         throw InputError(mesh_path.string(), e.what());
       }

@@ -32,6 +32,7 @@ struct OutputSpec {
   std::int64_t curve_every = 200;
   std::string specimen = "specimen.h5";  // the prepared specimen (one frame)
   std::string preparation = "preparation.csv";
+  bool facet_forces = false;  // per-triangle forces of the mesh walls in the history
 };
 
 /// [specimen]: a seeded random specimen generated instead of reading a packing.
