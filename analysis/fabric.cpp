@@ -1,7 +1,10 @@
-// Kanatani contact fabric (seed 003 eq 18–21) and clump orientation fabric.
+// Kanatani contact fabric (seed 003 eq 18–21) and clump orientation fabric D^p (seed 003 §4.3
+// with eq 20–21).
 #include "fabric.hpp"
 
 #include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <stdexcept>
@@ -50,7 +53,69 @@ Fabric contact_fabric(const std::vector<Eigen::Vector3d>& normals, std::size_t p
   return f;
 }
 
+const char* orientation_source_name(OrientationSource s) {
+  switch (s) {
+    case OrientationSource::Bodies:
+      return "clump bodies";
+    case OrientationSource::Members:
+      return "clump members";
+    case OrientationSource::None:
+      break;
+  }
+  return "none";
+}
+
+namespace {
+
+/// Phi = <m m^T> over the axes, D^p = anisotropy(Phi) (seed 003 §4.3 with eq 20–21).
+void finish_orientation(OrientationFabric& o, int dim) {
+  o.bodies = o.clump.size();
+  if (o.bodies == 0) return;
+  o.Phi.setZero();
+  for (const auto& m : o.axis) o.Phi.noalias() += m * m.transpose();
+  o.Phi /= static_cast<double>(o.bodies);
+  o.D = anisotropy(o.Phi, dim);
+  o.D_norm = o.D.norm();
+}
+
+}  // namespace
+
+std::optional<Eigen::Vector3d> clump_long_axis(const Clump& c) {
+  const Eigen::Vector3d& I = c.principal_inertia;
+  int k = 0;
+  for (int j = 1; j < 3; ++j)
+    if (I[j] < I[k]) k = j;
+  const double next = std::min(I[(k + 1) % 3], I[(k + 2) % 3]);
+  if (!(next - I[k] > 1e-9 * next)) return std::nullopt;
+  return Eigen::Vector3d(c.orientation.normalized().toRotationMatrix().col(k));
+}
+
+OrientationFabric body_orientation_fabric(const std::vector<Clump>& clumps, int dim) {
+  OrientationFabric o;
+  o.source = OrientationSource::Bodies;
+  for (const auto& c : clumps) {
+    auto m = clump_long_axis(c);
+    if (!m) continue;
+    if (dim == 2) {
+      m->z() = 0.0;
+      const double len = m->norm();
+      if (!(len > 1e-12)) continue;  // a long axis normal to the plane: none in the plane
+      *m /= len;
+    }
+    o.clump.push_back(c.id);
+    o.axis.push_back(*m);
+    o.centroid.push_back(c.position);
+  }
+  finish_orientation(o, dim);
+  return o;
+}
+
 OrientationFabric orientation_fabric(const Frame& frame) {
+  if (!frame.clumps.empty()) return body_orientation_fabric(frame.clumps, frame.two_d ? 2 : 3);
+  return member_orientation_fabric(frame);
+}
+
+OrientationFabric member_orientation_fabric(const Frame& frame) {
   OrientationFabric o;
   std::map<std::int64_t, std::vector<std::size_t>> members;
   for (std::size_t i = 0; i < frame.particles.size(); ++i)
@@ -79,13 +144,9 @@ OrientationFabric orientation_fabric(const Frame& frame) {
     o.clump.push_back(id);
     o.axis.push_back(m);
     o.centroid.push_back(c);
-    o.Phi.noalias() += m * m.transpose();
   }
-  o.bodies = o.clump.size();
-  if (o.bodies == 0) return o;
-  o.Phi /= static_cast<double>(o.bodies);
-  o.D = anisotropy(o.Phi, dim);
-  o.D_norm = o.D.norm();
+  if (!members.empty()) o.source = OrientationSource::Members;
+  finish_orientation(o, dim);
   return o;
 }
 

@@ -9,14 +9,22 @@
 // |D| = sqrt(D_ij D_ij); for N uniformly random normals its expectation is about sqrt(37.5 / N)
 // in 3D and sqrt(8 / N) in 2D (sampling error).
 //
-// Particle-orientation fabric for non-spherical bodies (clumps of spheres, seed 003 §2.4): the
-// long axis m of each clump (principal direction of the largest second moment of its members'
-// volumes about the clump centroid), Phi_ij = <m_i m_j> over the clumps, and its anisotropy
-// 15/2 (Phi - I/3) (2D: 4 (Phi - I/2)).
+// Particle-orientation fabric D^p for non-spherical bodies (the two-sphere clumps of seed 003
+// §2.4; D^p is defined in §4.3 by E^p(n) = (1 + D^p_ij n_i n_j) / E_0, "determined using the
+// similar methodology" as the contact fabric, i.e. eq 20–21 with the long axes m of the bodies in
+// place of the contact normals): Phi_ij = <m_i m_j> over the clumps (eq 20 with N_c = N_p, each
+// axis once; m and -m give the same term, so Phi has trace 1 = omega), and
+// D^p = 15/2 (Phi - I/3) (eq 21; 2D: 4 (Phi - I/2)). The long axis m comes from
+//  - the clump bodies when the frame has them (Frame::clumps): the principal axis of the smallest
+//    principal moment of inertia (the long axis of an elongated body);
+//  - else the members (imported data with clump_id and no bodies): the principal direction of
+//    the largest second moment of the members' volumes about their volume centroid.
+// For a two-sphere clump both give the line through the two centres.
 #pragma once
 
 #include <Eigen/Core>
 #include <cstddef>
+#include <optional>
 #include <vector>
 
 #include "snapshot.hpp"
@@ -39,17 +47,36 @@ struct Fabric {
 /// (x, y) components. Throws std::invalid_argument for no particle or no contact.
 Fabric contact_fabric(const std::vector<Eigen::Vector3d>& normals, std::size_t particles, int dim);
 
+enum class OrientationSource {
+  None,     // no clumps in the frame
+  Bodies,   // from the clump bodies' principal frames
+  Members,  // from the members' volume second moments
+};
+
+const char* orientation_source_name(OrientationSource s);
+
 struct OrientationFabric {
-  std::size_t bodies = 0;  // clumps with at least two members
+  OrientationSource source = OrientationSource::None;
+  std::size_t bodies = 0;  // clumps with a long axis (members: at least two; bodies: a distinct
+                           // smallest principal moment)
   Eigen::Matrix3d Phi = Eigen::Matrix3d::Zero();
   Eigen::Matrix3d D = Eigen::Matrix3d::Zero();
   double D_norm = 0.0;
   std::vector<std::int64_t> clump;        // clump ids
   std::vector<Eigen::Vector3d> axis;      // long axis per clump (unit; sign arbitrary)
-  std::vector<Eigen::Vector3d> centroid;  // volume centroid per clump
+  std::vector<Eigen::Vector3d> centroid;  // volume centroid (members) / centre of mass (bodies)
 };
 
-/// Orientation fabric of the clumps of a frame (bodies = 0 when there are none).
+/// The long axis of a clump body: the principal axis (a column of the orientation's rotation
+/// matrix) of the smallest principal moment of inertia; nullopt when that moment is not
+/// distinctly the smallest (relative gap < 1e-9: no long axis, e.g. a one-sphere clump).
+std::optional<Eigen::Vector3d> clump_long_axis(const Clump& clump);
+
+/// Orientation fabric from the clump bodies (2D: axes projected on the x-y plane).
+OrientationFabric body_orientation_fabric(const std::vector<Clump>& clumps, int dim);
+/// Orientation fabric from the members (particles with clump_id >= 0) of the frame.
+OrientationFabric member_orientation_fabric(const Frame& frame);
+/// Bodies when the frame has clump bodies, else members (bodies = 0 when there are no clumps).
 OrientationFabric orientation_fabric(const Frame& frame);
 
 }  // namespace gs::analysis

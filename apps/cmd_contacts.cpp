@@ -66,17 +66,23 @@ void run_fabric(const FabricArgs& a) {
   std::vector<Eigen::Vector3d> normals;
   for (const auto& br : b.branches)
     normals.push_back(f.contacts[static_cast<std::size_t>(br.contact)].normal);
-  Frame sub = f;  // particles of the selection (for N_p and the clumps)
+  Frame sub = f;  // particles (for N_p and the clump members) and clump bodies of the selection
   sub.particles.clear();
+  sub.clumps.clear();
   for (const auto& p : f.particles)
     if (sel.contains(p.position)) sub.particles.push_back(p);
+  for (const auto& c : f.clumps)
+    if (sel.contains(c.position)) sub.clumps.push_back(c);
   ga::Fabric fab;
   try {
     fab = ga::contact_fabric(normals, sub.particles.size(), f.two_d ? 2 : 3);
   } catch (const std::invalid_argument& e) {
     throw InputError(a.in.input, std::string(e.what()) + " (empty selection?)");
   }
-  const auto o = ga::orientation_fabric(sub);
+  // Particle-orientation fabric D^p (seed 003 §4.3, eq 20–21): from the clump bodies when the
+  // frame has them (selected by centre of mass), else from the members (selected one by one).
+  const auto o = f.clumps.empty() ? ga::member_orientation_fabric(sub)
+                                  : ga::body_orientation_fabric(sub.clumps, fab.dim);
   H5FieldFile h(a.output, "granoscope-fabric");
   h.attr("source", a.in.input);
   h.attr("frame", static_cast<long long>(a.in.frame_index()));
@@ -93,6 +99,7 @@ void run_fabric(const FabricArgs& a) {
   h.group("/orientation");
   h.attr("bodies", static_cast<long long>(o.bodies), "/orientation");
   h.attr("D_norm", o.D_norm, "/orientation");
+  h.attr("source", ga::orientation_source_name(o.source), "/orientation");
   h.write("/orientation/Phi", flat(o.Phi), {3, 3});
   h.write("/orientation/D", flat(o.D), {3, 3});
   h.write("/orientation/axis", o.axis);
@@ -111,7 +118,9 @@ void run_fabric(const FabricArgs& a) {
   std::cout << std::setprecision(4) << "fabric: " << fab.particles << " particles, " << fab.contacts
             << " contacts, coordination omega = " << fab.omega << ", |D| = " << fab.D_norm
             << ", D principal " << fab.D_principal.transpose();
-  if (o.bodies > 0) std::cout << "; " << o.bodies << " clumps, orientation |D| = " << o.D_norm;
+  if (o.source != ga::OrientationSource::None)
+    std::cout << "; " << o.bodies << " clumps (orientation from the "
+              << ga::orientation_source_name(o.source) << "), orientation |D| = " << o.D_norm;
   std::cout << "\n";
 }
 

@@ -56,6 +56,7 @@ struct Column {
   hid_t (*mem_type)();  // native type getter (H5T_NATIVE_* are runtime values)
   std::vector<hsize_t> tail;
   hsize_t chunk_rows;
+  int since = 1;  // first schema version that has this dataset
 };
 
 hid_t t_f64() {
@@ -69,6 +70,17 @@ hid_t t_i32() {
 }
 hid_t t_i8() {
   return H5T_NATIVE_INT8;
+}
+// Fixed-length, NUL-padded ASCII strings of kTemplateBytes (clump template names): fixed length
+// keeps them in the chunks (filters and checksums apply; no global heap under SWMR).
+hid_t t_str() {
+  static const hid_t t = [] {
+    const hid_t s = H5Tcopy(H5T_C_S1);
+    H5Tset_size(s, kClumpTemplateBytes);
+    H5Tset_strpad(s, H5T_STR_NULLPAD);
+    return s;
+  }();
+  return t;
 }
 
 // Rows per chunk of the per-particle and per-contact datasets. The chunk that a frame ends in is
@@ -105,6 +117,14 @@ enum Col : int {
   W_B,
   W_FORCE,
   W_TORQUE,
+  K_ID,
+  K_TEMPLATE,
+  K_POS,
+  K_ORI,
+  K_VEL,
+  K_ANGVEL,
+  K_MASS,
+  K_INERTIA,
   F_TIME,
   F_STEP,
   F_DT,
@@ -113,6 +133,7 @@ enum Col : int {
   F_HI,
   F_PERIODIC,
   F_CELL,
+  F_CLUMP_END,
   F_END,
   N_COLS
 };
@@ -144,6 +165,14 @@ const std::vector<Column>& columns() {
       {"walls", "b", t_f64, {3}, kFrameChunk},
       {"walls", "force", t_f64, {3}, kFrameChunk},
       {"walls", "torque", t_f64, {3}, kFrameChunk},
+      {"clumps", "id", t_i64, {}, kRowChunk, 2},
+      {"clumps", "template", t_str, {}, kRowChunk, 2},
+      {"clumps", "position", t_f64, {3}, kRowChunk, 2},
+      {"clumps", "orientation", t_f64, {4}, kRowChunk, 2},
+      {"clumps", "velocity", t_f64, {3}, kRowChunk, 2},
+      {"clumps", "angular_velocity", t_f64, {3}, kRowChunk, 2},
+      {"clumps", "mass", t_f64, {}, kRowChunk, 2},
+      {"clumps", "principal_inertia", t_f64, {3}, kRowChunk, 2},
       {"frames", "time", t_f64, {}, kFrameChunk},
       {"frames", "step", t_i64, {}, kFrameChunk},
       {"frames", "dt", t_f64, {}, kFrameChunk},
@@ -152,6 +181,7 @@ const std::vector<Column>& columns() {
       {"frames", "domain_hi", t_f64, {3}, kFrameChunk},
       {"frames", "periodic", t_i8, {}, kFrameChunk},
       {"frames", "cell", t_f64, {3, 3}, kFrameChunk},
+      {"frames", "clump_end", t_i64, {}, kFrameChunk, 2},
       {"frames", "end", t_i64, {3}, kFrameChunk},
   };
   return cols;
@@ -165,6 +195,50 @@ hsize_t row_width(const Column& c) {
   hsize_t w = 1;
   for (auto t : c.tail) w *= t;
   return w;
+}
+
+bool is_string(const Column& c) {
+  return c.mem_type == t_str;
+}
+
+/// The file type of a column: little-endian numbers, or the fixed-length string type.
+hid_t file_type(const Column& c) {
+  if (is_string(c)) return t_str();
+  return c.mem_type() == H5T_NATIVE_DOUBLE  ? H5T_IEEE_F64LE
+         : c.mem_type() == H5T_NATIVE_INT64 ? H5T_STD_I64LE
+         : c.mem_type() == H5T_NATIVE_INT32 ? H5T_STD_I32LE
+                                            : H5T_STD_I8LE;
+}
+
+/// An empty, extendable dataset for column `c`: chunked, shuffled and deflated (level > 0), and
+/// Fletcher-32 checksummed.
+void create_dataset(hid_t file, const Column& c, int deflate_level, const std::string& name) {
+  std::vector<hsize_t> dims{0}, maxdims{H5S_UNLIMITED}, chunk{c.chunk_rows};
+  for (auto t : c.tail) {
+    dims.push_back(t);
+    maxdims.push_back(t);
+    chunk.push_back(t);
+  }
+  Hid space(H5Screate_simple(static_cast<int>(dims.size()), dims.data(), maxdims.data()), H5Sclose);
+  Hid dcpl(H5Pcreate(H5P_DATASET_CREATE), H5Pclose);
+  H5Pset_chunk(dcpl.get(), static_cast<int>(chunk.size()), chunk.data());
+  if (deflate_level > 0) {
+    H5Pset_shuffle(dcpl.get());
+    H5Pset_deflate(dcpl.get(), static_cast<unsigned>(deflate_level));
+  }
+  H5Pset_fletcher32(dcpl.get());
+  Hid d(H5Dcreate2(file, col_path(c).c_str(), file_type(c), space.get(), H5P_DEFAULT, dcpl.get(),
+                   H5P_DEFAULT),
+        H5Dclose);
+  if (!d.valid()) throw InputError(name, "cannot create dataset", col_path(c));
+}
+
+/// Reads the schema_version root attribute (-1 when missing or unreadable).
+long long read_schema_version(hid_t file) {
+  Hid a(H5Aopen(file, "schema_version", H5P_DEFAULT), H5Aclose);
+  long long v = -1;
+  if (!a.valid() || H5Aread(a.get(), H5T_NATIVE_LLONG, &v) < 0) return -1;
+  return v;
 }
 
 Hid latest_fapl() {
@@ -264,6 +338,18 @@ Eigen::Vector3d get3(const double* in) {
   return {in[0], in[1], in[2]};
 }
 
+// Quaternions as (w, x, y, z).
+void put_quat(double* out, const Eigen::Quaterniond& q) {
+  out[0] = q.w();
+  out[1] = q.x();
+  out[2] = q.y();
+  out[3] = q.z();
+}
+
+Eigen::Quaterniond get_quat(const double* in) {
+  return {in[0], in[1], in[2], in[3]};
+}
+
 }  // namespace
 
 std::filesystem::path partial_path(const std::filesystem::path& final_path) {
@@ -332,35 +418,11 @@ struct TrajectoryWriter::Impl {
         write_string_attr(g.get(), k, v, name());
       }
     }
-    for (const char* g : {"particles", "contacts", "walls", "frames"}) {
+    for (const char* g : {"particles", "contacts", "walls", "clumps", "frames"}) {
       Hid grp(H5Gcreate2(file.get(), g, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose);
       if (!grp.valid()) throw InputError(name(), "cannot create group", g);
     }
-    for (const auto& c : columns()) {
-      std::vector<hsize_t> dims{0}, maxdims{H5S_UNLIMITED}, chunk{c.chunk_rows};
-      for (auto t : c.tail) {
-        dims.push_back(t);
-        maxdims.push_back(t);
-        chunk.push_back(t);
-      }
-      Hid space(H5Screate_simple(static_cast<int>(dims.size()), dims.data(), maxdims.data()),
-                H5Sclose);
-      Hid dcpl(H5Pcreate(H5P_DATASET_CREATE), H5Pclose);
-      H5Pset_chunk(dcpl.get(), static_cast<int>(chunk.size()), chunk.data());
-      if (options.deflate_level > 0) {
-        H5Pset_shuffle(dcpl.get());
-        H5Pset_deflate(dcpl.get(), static_cast<unsigned>(options.deflate_level));
-      }
-      H5Pset_fletcher32(dcpl.get());
-      hid_t ftype = c.mem_type() == H5T_NATIVE_DOUBLE  ? H5T_IEEE_F64LE
-                    : c.mem_type() == H5T_NATIVE_INT64 ? H5T_STD_I64LE
-                    : c.mem_type() == H5T_NATIVE_INT32 ? H5T_STD_I32LE
-                                                       : H5T_STD_I8LE;
-      Hid d(H5Dcreate2(file.get(), col_path(c).c_str(), ftype, space.get(), H5P_DEFAULT, dcpl.get(),
-                       H5P_DEFAULT),
-            H5Dclose);
-      if (!d.valid()) throw InputError(name(), "cannot create dataset", col_path(c));
-    }
+    for (const auto& c : columns()) create_dataset(file.get(), c, options.deflate_level, name());
     open_datasets();
     start_swmr();
   }
@@ -374,12 +436,29 @@ struct TrajectoryWriter::Impl {
     if (H5Fflush(file.get(), H5F_SCOPE_LOCAL) < 0) throw InputError(name(), "cannot flush");
   }
 
+  /// Schema 1 -> current, before resuming: the datasets added since (empty clump rows, and a
+  /// /frames/clump_end of zeros for the frames already written), then the version attribute.
+  void upgrade_from_v1() {
+    Hid grp(H5Gcreate2(file.get(), "clumps", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose);
+    if (!grp.valid()) throw InputError(name(), "cannot create group", "clumps");
+    for (const auto& c : columns())
+      if (c.since > 1) create_dataset(file.get(), c, options.deflate_level, name());
+    open_datasets();
+    const std::vector<std::int64_t> zeros(ds[F_END].rows, 0);
+    ds[F_CLUMP_END].append(zeros.data(), zeros.size(), name());
+    Hid a(H5Aopen(file.get(), "schema_version", H5P_DEFAULT), H5Aclose);
+    const long long v = kTrajectorySchemaVersion;
+    if (!a.valid() || H5Awrite(a.get(), H5T_NATIVE_LLONG, &v) < 0)
+      throw InputError(name(), "cannot write attribute", "schema_version");
+  }
+
   void append(const Frame& f) {
     const std::string n = name();
     const auto& P = f.particles;
     const auto& C = f.contacts;
     const auto& W = f.walls;
-    const std::size_t np = P.size(), nc = C.size(), nw = W.size();
+    const auto& K = f.clumps;
+    const std::size_t np = P.size(), nc = C.size(), nw = W.size(), nk = K.size();
     auto wr = [&](int col, const auto& vec, std::size_t rows) {
       ds[col].append(vec.data(), rows, n);
     };
@@ -389,16 +468,7 @@ struct TrajectoryWriter::Impl {
     wr(P_VEL, gather<double>(np, 3, [&](auto i, auto* o) { put3(o, P[i].velocity); }), np);
     wr(P_ANGVEL, gather<double>(np, 3, [&](auto i, auto* o) { put3(o, P[i].angular_velocity); }),
        np);
-    wr(P_ORI,
-       gather<double>(np, 4,
-                      [&](auto i, auto* o) {
-                        const auto& q = P[i].orientation;
-                        o[0] = q.w();
-                        o[1] = q.x();
-                        o[2] = q.y();
-                        o[3] = q.z();
-                      }),
-       np);
+    wr(P_ORI, gather<double>(np, 4, [&](auto i, auto* o) { put_quat(o, P[i].orientation); }), np);
     wr(P_ROT, gather<double>(np, 3, [&](auto i, auto* o) { put3(o, P[i].rotation); }), np);
     wr(P_MASS, gather<double>(np, 1, [&](auto i, auto* o) { *o = P[i].mass; }), np);
     wr(P_CLUMP, gather<std::int64_t>(np, 1, [&](auto i, auto* o) { *o = P[i].clump_id; }), np);
@@ -424,6 +494,22 @@ struct TrajectoryWriter::Impl {
     wr(W_FORCE, gather<double>(nw, 3, [&](auto i, auto* o) { put3(o, W[i].force); }), nw);
     wr(W_TORQUE, gather<double>(nw, 3, [&](auto i, auto* o) { put3(o, W[i].torque); }), nw);
 
+    wr(K_ID, gather<std::int64_t>(nk, 1, [&](auto i, auto* o) { *o = K[i].id; }), nk);
+    wr(K_TEMPLATE,
+       gather<char>(nk, kClumpTemplateBytes,
+                    [&](auto i, auto* o) {
+                      std::memcpy(o, K[i].template_name.data(), K[i].template_name.size());
+                    }),
+       nk);
+    wr(K_POS, gather<double>(nk, 3, [&](auto i, auto* o) { put3(o, K[i].position); }), nk);
+    wr(K_ORI, gather<double>(nk, 4, [&](auto i, auto* o) { put_quat(o, K[i].orientation); }), nk);
+    wr(K_VEL, gather<double>(nk, 3, [&](auto i, auto* o) { put3(o, K[i].velocity); }), nk);
+    wr(K_ANGVEL, gather<double>(nk, 3, [&](auto i, auto* o) { put3(o, K[i].angular_velocity); }),
+       nk);
+    wr(K_MASS, gather<double>(nk, 1, [&](auto i, auto* o) { *o = K[i].mass; }), nk);
+    wr(K_INERTIA, gather<double>(nk, 3, [&](auto i, auto* o) { put3(o, K[i].principal_inertia); }),
+       nk);
+
     const std::int8_t two_d = f.two_d ? 1 : 0, periodic = f.domain.periodic ? 1 : 0;
     double lo[3], hi[3], cell[9];
     put3(lo, f.domain.lo);
@@ -438,6 +524,8 @@ struct TrajectoryWriter::Impl {
     ds[F_HI].append(hi, 1, n);
     ds[F_PERIODIC].append(&periodic, 1, n);
     ds[F_CELL].append(cell, 1, n);
+    const auto clump_end = static_cast<std::int64_t>(ds[K_ID].rows);
+    ds[F_CLUMP_END].append(&clump_end, 1, n);
     flush();
     // Commit marker: the frame exists for readers once its end offsets are on disk.
     const std::int64_t end[3] = {static_cast<std::int64_t>(ds[P_ID].rows),
@@ -493,18 +581,31 @@ TrajectoryWriter TrajectoryWriter::resume(std::filesystem::path path, std::size_
           Hid(H5Fopen(impl->file_path.string().c_str(), H5F_ACC_RDWR, fapl.get()), H5Fclose);
   }
   if (!impl->file.valid()) throw InputError(impl->name(), "cannot reopen trajectory to resume");
+  const long long version = read_schema_version(impl->file.get());
+  if (version == 1) {
+    impl->upgrade_from_v1();
+  } else if (version != kTrajectorySchemaVersion) {
+    throw InputError(impl->name(), "cannot resume, unsupported schema_version",
+                     std::to_string(version));
+  }
   impl->open_datasets();
   const std::size_t have = impl->ds[F_END].rows;
   const std::size_t keep = std::min(have, keep_frames);
-  std::array<std::int64_t, 3> end{0, 0, 0};
+  std::array<std::int64_t, 4> end{0, 0, 0, 0};  // particles, contacts, walls, clumps
   if (keep > 0) {
-    Hid fspace(H5Dget_space(impl->ds[F_END].ds.get()), H5Sclose);
-    hsize_t start[2] = {keep - 1, 0}, count[2] = {1, 3};
-    H5Sselect_hyperslab(fspace.get(), H5S_SELECT_SET, start, nullptr, count, nullptr);
-    Hid mspace(H5Screate_simple(2, count, nullptr), H5Sclose);
-    if (H5Dread(impl->ds[F_END].ds.get(), H5T_NATIVE_INT64, mspace.get(), fspace.get(), H5P_DEFAULT,
-                end.data()) < 0)
-      throw InputError(impl->name(), "cannot read frame index", "/frames/end");
+    auto read_row = [&](int col, std::int64_t* out) {
+      const hsize_t w = row_width(columns()[col]);
+      Hid fspace(H5Dget_space(impl->ds[col].ds.get()), H5Sclose);
+      const int rank = w == 1 ? 1 : 2;
+      hsize_t start[2] = {keep - 1, 0}, count[2] = {1, w};
+      H5Sselect_hyperslab(fspace.get(), H5S_SELECT_SET, start, nullptr, count, nullptr);
+      Hid mspace(H5Screate_simple(rank, count, nullptr), H5Sclose);
+      if (H5Dread(impl->ds[col].ds.get(), H5T_NATIVE_INT64, mspace.get(), fspace.get(), H5P_DEFAULT,
+                  out) < 0)
+        throw InputError(impl->name(), "cannot read frame index", col_path(columns()[col]));
+    };
+    read_row(F_END, end.data());
+    read_row(F_CLUMP_END, end.data() + 3);
   }
   for (int i = 0; i < N_COLS; ++i) {
     const auto& c = columns()[i];
@@ -512,6 +613,7 @@ TrajectoryWriter TrajectoryWriter::resume(std::filesystem::path path, std::size_
     const hsize_t rows = g == "particles"  ? end[0]
                          : g == "contacts" ? end[1]
                          : g == "walls"    ? end[2]
+                         : g == "clumps"   ? end[3]
                                            : keep;
     if (rows == impl->ds[i].rows) continue;
     std::vector<hsize_t> dims{rows};
@@ -543,7 +645,13 @@ TrajectoryWriter::~TrajectoryWriter() {
 }
 
 void TrajectoryWriter::append(const Frame& frame) {
-  validate_frame(frame, impl_->final_path.string());
+  const std::string name = impl_->final_path.string();
+  validate_frame(frame, name);
+  for (const auto& k : frame.clumps)  // before any row is written
+    if (k.template_name.size() > kClumpTemplateBytes)
+      throw InputError(
+          name, "clump template name longer than " + std::to_string(kClumpTemplateBytes) + " bytes",
+          k.template_name);
   impl_->append(frame);
 }
 
@@ -569,17 +677,20 @@ struct TrajectoryReader::Impl {
   std::vector<Hid> ds;
   std::vector<hsize_t> rows;
   std::size_t n = 0;
-  // Per-frame tables, read once.
+  long long version = 0;
+  // Per-frame tables, read once (clump_end: zeros for a version 1 file).
   std::vector<double> time, dt, lo, hi, cell;
-  std::vector<std::int64_t> step, end;
+  std::vector<std::int64_t> step, end, clump_end;
   std::vector<std::int8_t> two_d, periodic;
+
+  bool has(int col) const { return columns()[col].since <= version; }
 
   template <class T>
   std::vector<T> read_rows(int col, hsize_t first, hsize_t count) const {
     const auto& c = columns()[col];
-    const hsize_t w = row_width(c);
+    const hsize_t w = row_width(c) * (is_string(c) ? kClumpTemplateBytes : 1);
     std::vector<T> out(count * w);
-    if (count == 0) return out;
+    if (count == 0 || !has(col)) return out;
     Hid fspace(H5Dget_space(ds[col].get()), H5Sclose);
     std::vector<hsize_t> start(1 + c.tail.size(), 0), cnt{count};
     cnt.insert(cnt.end(), c.tail.begin(), c.tail.end());
@@ -616,14 +727,10 @@ struct TrajectoryReader::Impl {
     const std::string fmt = attr_string("format");
     if (fmt != kTrajectoryFormatName)
       throw InputError(file_name, "not a granoscope trajectory, format", fmt);
-    {
-      Hid a(H5Aopen(file.get(), "schema_version", H5P_DEFAULT), H5Aclose);
-      long long v = -1;
-      if (!a.valid() || H5Aread(a.get(), H5T_NATIVE_LLONG, &v) < 0)
-        throw InputError(file_name, "missing root attribute", "schema_version");
-      if (v != kTrajectorySchemaVersion)
-        throw InputError(file_name, "unsupported schema_version", std::to_string(v));
-    }
+    version = read_schema_version(file.get());
+    if (version == -1) throw InputError(file_name, "missing root attribute", "schema_version");
+    if (version < 1 || version > kTrajectorySchemaVersion)
+      throw InputError(file_name, "unsupported schema_version", std::to_string(version));
     meta.code_version = attr_string("code_version");
     meta.provenance = attr_string("provenance");
     {
@@ -656,6 +763,7 @@ struct TrajectoryReader::Impl {
     rows.assign(N_COLS, 0);
     for (int i = 0; i < N_COLS; ++i) {
       const auto& c = columns()[i];
+      if (!has(i)) continue;  // added after this file's schema_version: no rows
       ds[i] = Hid(H5Dopen2(file.get(), col_path(c).c_str(), H5P_DEFAULT), H5Dclose);
       if (!ds[i].valid()) throw InputError(file_name, "missing dataset", col_path(c));
       Hid space(H5Dget_space(ds[i].get()), H5Sclose);
@@ -671,13 +779,14 @@ struct TrajectoryReader::Impl {
       Hid type(H5Dget_type(ds[i].get()), H5Tclose);
       const auto cls = H5Tget_class(type.get());
       const bool want_float = c.mem_type() == H5T_NATIVE_DOUBLE;
-      if ((want_float && cls != H5T_FLOAT) || (!want_float && cls != H5T_INTEGER))
+      const H5T_class_t want = is_string(c) ? H5T_STRING : want_float ? H5T_FLOAT : H5T_INTEGER;
+      if (cls != want || (is_string(c) && H5Tis_variable_str(type.get()) > 0))
         throw InputError(file_name, "dataset has wrong type", col_path(c));
       rows[i] = dims[0];
     }
     n = rows[F_END];
     for (int i = F_TIME; i < N_COLS; ++i)
-      if (rows[i] < n)
+      if (has(i) && rows[i] < n)
         throw InputError(file_name, "frame table shorter than frame index", col_path(columns()[i]));
     time = read_rows<double>(F_TIME, 0, n);
     step = read_rows<std::int64_t>(F_STEP, 0, n);
@@ -688,28 +797,35 @@ struct TrajectoryReader::Impl {
     periodic = read_rows<std::int8_t>(F_PERIODIC, 0, n);
     cell = read_rows<double>(F_CELL, 0, n);
     end = read_rows<std::int64_t>(F_END, 0, n);
-    const hsize_t limits[3] = {rows[P_ID], rows[C_ID1], rows[W_ID]};
-    const int first_col[3] = {P_ID, C_ID1, W_ID}, last_col[3] = {P_MAT, C_OVERLAP, W_TORQUE};
-    for (int k = 0; k < 3; ++k) {
+    clump_end = read_rows<std::int64_t>(F_CLUMP_END, 0, n);
+    // Row groups k = particles, contacts, walls (columns of /frames/end), clumps (clump_end).
+    const hsize_t limits[4] = {rows[P_ID], rows[C_ID1], rows[W_ID], rows[K_ID]};
+    const int first_col[4] = {P_ID, C_ID1, W_ID, K_ID};
+    const int last_col[4] = {P_MAT, C_OVERLAP, W_TORQUE, K_INERTIA};
+    for (int k = 0; k < 4; ++k) {
       for (int c = first_col[k]; c <= last_col[k]; ++c)
         if (rows[c] != limits[k])
           throw InputError(file_name, "datasets of one group differ in length",
                            col_path(columns()[c]));
       std::int64_t prev = 0;
       for (std::size_t i = 0; i < n; ++i) {
-        const std::int64_t e = end[i * 3 + k];
+        const std::int64_t e = end_of(i, k);
         if (e < prev || static_cast<hsize_t>(e) > limits[k])
           throw InputError(file_name,
-                           "corrupt frame index /frames/end at frame " + std::to_string(i),
+                           std::string("corrupt frame index ") +
+                               (k < 3 ? "/frames/end" : "/frames/clump_end") + " at frame " +
+                               std::to_string(i),
                            std::to_string(e));
         prev = e;
       }
     }
   }
 
+  std::int64_t end_of(std::size_t i, int k) const { return k < 3 ? end[i * 3 + k] : clump_end[i]; }
+
   std::pair<hsize_t, hsize_t> range(std::size_t i, int k) const {
-    const hsize_t b = i == 0 ? 0 : static_cast<hsize_t>(end[(i - 1) * 3 + k]);
-    return {b, static_cast<hsize_t>(end[i * 3 + k]) - b};
+    const hsize_t b = i == 0 ? 0 : static_cast<hsize_t>(end_of(i - 1, k));
+    return {b, static_cast<hsize_t>(end_of(i, k)) - b};
   }
 };
 
@@ -736,6 +852,13 @@ std::size_t TrajectoryReader::particle_count(std::size_t i) const {
 std::size_t TrajectoryReader::contact_count(std::size_t i) const {
   if (i >= impl_->n) throw std::out_of_range("frame index");
   return impl_->range(i, 1).second;
+}
+std::size_t TrajectoryReader::clump_count(std::size_t i) const {
+  if (i >= impl_->n) throw std::out_of_range("frame index");
+  return impl_->range(i, 3).second;
+}
+int TrajectoryReader::schema_version() const {
+  return static_cast<int>(impl_->version);
 }
 
 Frame TrajectoryReader::frame(std::size_t i) const {
@@ -774,8 +897,7 @@ Frame TrajectoryReader::frame(std::size_t i) const {
       p.radius = rad[k];
       p.velocity = get3(&vel[k * 3]);
       p.angular_velocity = get3(&av[k * 3]);
-      p.orientation =
-          Eigen::Quaterniond(ori[k * 4], ori[k * 4 + 1], ori[k * 4 + 2], ori[k * 4 + 3]);
+      p.orientation = get_quat(&ori[k * 4]);
       p.rotation = get3(&rot[k * 3]);
       p.mass = mass[k];
       p.clump_id = clump[k];
@@ -824,6 +946,30 @@ Frame TrajectoryReader::frame(std::size_t i) const {
       w.b = get3(&bb[k * 3]);
       w.force = get3(&force[k * 3]);
       w.torque = get3(&torque[k * 3]);
+    }
+  }
+  {
+    const auto [b, cnt] = m.range(i, 3);
+    const auto id = m.read_rows<std::int64_t>(K_ID, b, cnt);
+    const auto tpl = m.read_rows<char>(K_TEMPLATE, b, cnt);
+    const auto pos = m.read_rows<double>(K_POS, b, cnt);
+    const auto ori = m.read_rows<double>(K_ORI, b, cnt);
+    const auto vel = m.read_rows<double>(K_VEL, b, cnt);
+    const auto av = m.read_rows<double>(K_ANGVEL, b, cnt);
+    const auto mass = m.read_rows<double>(K_MASS, b, cnt);
+    const auto inertia = m.read_rows<double>(K_INERTIA, b, cnt);
+    f.clumps.resize(cnt);
+    for (hsize_t k = 0; k < cnt; ++k) {
+      auto& c = f.clumps[k];
+      c.id = id[k];
+      const char* name = &tpl[k * kClumpTemplateBytes];
+      c.template_name.assign(name, strnlen(name, kClumpTemplateBytes));
+      c.position = get3(&pos[k * 3]);
+      c.orientation = get_quat(&ori[k * 4]);
+      c.velocity = get3(&vel[k * 3]);
+      c.angular_velocity = get3(&av[k * 3]);
+      c.mass = mass[k];
+      c.principal_inertia = get3(&inertia[k * 3]);
     }
   }
   validate_frame(f, m.file_name + " frame " + std::to_string(i));

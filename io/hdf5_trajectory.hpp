@@ -1,7 +1,8 @@
-// HDF5 trajectory format (docs/format.md, schema_version 1): plain chunked, compressed,
-// checksummed arrays, one row block per frame, appended frame by frame. The frame index
-// /frames/end is appended last and flushed, so a run killed mid-write leaves every completed
-// frame readable (HDF5 single-writer/multiple-reader mode keeps the file consistent).
+// HDF5 trajectory format (docs/format.md, schema_version 2; version 1 files, which have no
+// /clumps group, are read too): plain chunked, compressed, checksummed arrays, one row block per
+// frame, appended frame by frame. The frame index /frames/end is appended last and flushed, so a
+// run killed mid-write leaves every completed frame readable (HDF5 single-writer/multiple-reader
+// mode keeps the file consistent).
 #pragma once
 
 #include <cstddef>
@@ -13,7 +14,10 @@
 
 namespace gs {
 
-inline constexpr int kTrajectorySchemaVersion = 1;
+/// Version written. 2 added the clump bodies (/clumps, /frames/clump_end); 1 is still read.
+inline constexpr int kTrajectorySchemaVersion = 2;
+/// Bytes of the fixed-length clump template names (/clumps/template); longer names are rejected.
+inline constexpr std::size_t kClumpTemplateBytes = 64;
 inline constexpr const char* kTrajectoryFormatName = "granoscope-trajectory";
 
 /// Name under which a trajectory is written until finish() renames it to its final name.
@@ -31,7 +35,8 @@ class TrajectoryWriter {
   TrajectoryWriter(std::filesystem::path path, const RunMetadata& metadata, Options options);
   TrajectoryWriter(std::filesystem::path path, const RunMetadata& metadata);
   /// Re-opens an existing `<path>.partial` to append further frames, first dropping every frame
-  /// after the first `keep_frames` ones.
+  /// after the first `keep_frames` ones. A schema_version 1 file is upgraded in place to the
+  /// current version (its frames have no clump bodies).
   static TrajectoryWriter resume(std::filesystem::path path, std::size_t keep_frames,
                                  Options options);
   TrajectoryWriter(TrajectoryWriter&&) noexcept;
@@ -65,7 +70,11 @@ class TrajectoryReader {
   /// Particle and contact counts of frame i without reading the rows.
   std::size_t particle_count(std::size_t i) const;
   std::size_t contact_count(std::size_t i) const;
+  /// Clump bodies of frame i (0 for a schema_version 1 file).
+  std::size_t clump_count(std::size_t i) const;
   double time(std::size_t i) const;
+  /// The file's schema_version (1 or 2).
+  int schema_version() const;
 
  private:
   struct Impl;

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <limits>
+#include <unordered_map>
 #include <unordered_set>
 
 #include "errors.hpp"
@@ -38,6 +39,46 @@ void check_finite(const std::string& source, const std::string& field,
                   const Eigen::MatrixBase<Derived>& v) {
   for (Eigen::Index i = 0; i < v.size(); ++i)
     if (!std::isfinite(v(i))) throw InputError(source, field + " is not finite", value_str(v(i)));
+}
+
+/// Clump bodies (seed 003 §2.4): finite, unit orientation, positive mass, non-negative principal
+/// inertia, unique ids; and, when a frame has bodies, every member (clump_id >= 0) names one of
+/// them and each of them has a member. (Frames without bodies may still carry clump_id, e.g.
+/// imported YADE data: those ids are not checked.)
+void validate_clumps(const Frame& f, const std::string& source) {
+  if (f.clumps.empty()) return;
+  std::unordered_map<std::int64_t, std::size_t> members;
+  members.reserve(f.clumps.size());
+  for (const auto& c : f.clumps) {
+    const std::string cid = "clump " + std::to_string(c.id) + " ";
+    check_finite(source, cid + "position", c.position);
+    check_finite(source, cid + "orientation", c.orientation.coeffs());
+    check_finite(source, cid + "velocity", c.velocity);
+    check_finite(source, cid + "angular velocity", c.angular_velocity);
+    check_finite(source, cid + "mass", c.mass);
+    check_finite(source, cid + "principal inertia", c.principal_inertia);
+    if (std::abs(c.orientation.norm() - 1.0) > 1e-6)
+      throw InputError(source, cid + "orientation is not a unit quaternion, |q|",
+                       value_str(c.orientation.norm()));
+    if (!(c.mass > 0)) throw InputError(source, cid + "mass is not positive", value_str(c.mass));
+    for (int k = 0; k < 3; ++k)
+      if (c.principal_inertia[k] < 0)
+        throw InputError(source, cid + "principal inertia is negative",
+                         value_str(c.principal_inertia[k]));
+    if (!members.emplace(c.id, 0).second)
+      throw InputError(source, "duplicate clump id", value_str(c.id));
+  }
+  for (const auto& p : f.particles) {
+    if (p.clump_id < 0) continue;
+    const auto it = members.find(p.clump_id);
+    if (it == members.end())
+      throw InputError(source, "particle " + std::to_string(p.id) + " names a missing clump",
+                       value_str(p.clump_id));
+    ++it->second;
+  }
+  for (const auto& c : f.clumps)
+    if (members.at(c.id) == 0)
+      throw InputError(source, "clump has no member particle", value_str(c.id));
 }
 
 }  // namespace
@@ -92,6 +133,7 @@ void validate_frame(const Frame& f, const std::string& source) {
       throw InputError(source, wid + "plane normal is not a unit vector, |n|",
                        value_str(w.b.norm()));
   }
+  validate_clumps(f, source);
 }
 
 }  // namespace gs

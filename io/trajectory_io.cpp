@@ -84,6 +84,8 @@ Trajectory read_snapshots(const std::filesystem::path& path, const ImportOptions
       auto vtp = opt.contacts.value_or(std::filesystem::path(path).replace_extension(".vtp"));
       std::error_code ec;
       if (std::filesystem::exists(vtp, ec)) read_vtp_contacts(vtp, f);
+      const auto clumps = clumps_sibling(path);
+      if (std::filesystem::exists(clumps, ec)) read_vtu_clumps(clumps, f);
       return single(std::move(f), "read from " + name);
     }
     case SnapshotFormat::Pvd:
@@ -126,6 +128,12 @@ void write_snapshots(const std::filesystem::path& path, const Trajectory& t, lon
     case SnapshotFormat::Vtu: {
       const Frame& f = pick();
       write_vtp_contacts(std::filesystem::path(path).replace_extension(".vtp"), f);
+      const auto clumps = clumps_sibling(path);
+      std::error_code ec;
+      if (!f.clumps.empty())
+        write_vtu_clumps(clumps, f);
+      else
+        std::filesystem::remove(clumps, ec);  // a stale one would be read back with this frame
       write_vtu_particles(path, f);
       return;
     }

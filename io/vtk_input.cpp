@@ -10,6 +10,7 @@
 #include <vtkPointData.h>
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
+#include <vtkStringArray.h>
 #include <vtkUnstructuredGrid.h>
 #include <vtkXMLPolyDataReader.h>
 #include <vtkXMLUnstructuredGridReader.h>
@@ -194,6 +195,48 @@ void read_vtp_contacts(const std::filesystem::path& path, Frame& f) {
   validate_frame(f, name);
 }
 
+void read_vtu_clumps(const std::filesystem::path& path, Frame& f) {
+  const std::string name = path.string();
+  vtkNew<vtkXMLUnstructuredGridReader> r;
+  run_reader(r.Get(), path);
+  vtkUnstructuredGrid* g = r->GetOutput();
+  if (!g) throw InputError(name, "no unstructured grid in file");
+  const vtkIdType n = g->GetNumberOfPoints();
+  auto* pd = g->GetPointData();
+  vtkDataArray* id = find_array(pd, {"id"}, 1, n, name, true);
+  vtkDataArray* tpl = find_array(pd, {"template"}, 1, n, name, true);
+  vtkDataArray* vel = find_array(pd, {"velocity"}, 3, n, name, true);
+  vtkDataArray* av = find_array(pd, {"angular_velocity"}, 3, n, name, true);
+  vtkDataArray* ori = find_array(pd, {"orientation"}, 4, n, name, true);
+  vtkDataArray* mass = find_array(pd, {"mass"}, 1, n, name, true);
+  vtkDataArray* inertia = find_array(pd, {"principal_inertia"}, 3, n, name, true);
+  auto* names =
+      g->GetFieldData()
+          ? vtkStringArray::SafeDownCast(g->GetFieldData()->GetAbstractArray("template_names"))
+          : nullptr;
+  if (n > 0 && !names) throw InputError(name, "missing array", "template_names");
+  f.clumps.resize(static_cast<std::size_t>(n));
+  for (vtkIdType i = 0; i < n; ++i) {
+    auto& c = f.clumps[static_cast<std::size_t>(i)];
+    double x[3];
+    g->GetPoints()->GetPoint(i, x);
+    c.position = {x[0], x[1], x[2]};
+    c.id = id_value(id, i, name, "clump id");
+    const std::int64_t k = id_value(tpl, i, name, "clump template index");
+    if (k < 0 || k >= names->GetNumberOfValues())
+      throw InputError(name, "clump template index out of range", value_str(k));
+    c.template_name = names->GetValue(static_cast<vtkIdType>(k));
+    c.velocity = tuple3(vel, i);
+    c.angular_velocity = tuple3(av, i);
+    double q[4];
+    ori->GetTuple(i, q);
+    c.orientation = Eigen::Quaterniond(q[0], q[1], q[2], q[3]);
+    c.mass = mass->GetComponent(i, 0);
+    c.principal_inertia = tuple3(inertia, i);
+  }
+  validate_frame(f, name);
+}
+
 Trajectory read_pvd_series(const std::filesystem::path& pvd_path) {
   const std::string name = pvd_path.string();
   auto entries = [&](const std::filesystem::path& p) {
@@ -237,6 +280,14 @@ Trajectory read_pvd_series(const std::filesystem::path& pvd_path) {
       throw InputError(cpvd.string(), "contact series length differs from particle series",
                        std::to_string(cs.size()));
     for (std::size_t i = 0; i < cs.size(); ++i) read_vtp_contacts(cs[i].second, t.frames[i]);
+  }
+  const auto kpvd = clumps_sibling(pvd_path);
+  if (std::filesystem::exists(kpvd, ec)) {
+    const auto ks = entries(kpvd);
+    if (ks.size() != t.frames.size())
+      throw InputError(kpvd.string(), "clump series length differs from particle series",
+                       std::to_string(ks.size()));
+    for (std::size_t i = 0; i < ks.size(); ++i) read_vtu_clumps(ks[i].second, t.frames[i]);
   }
   return t;
 }

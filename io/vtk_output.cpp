@@ -8,13 +8,16 @@
 #include <vtkPointData.h>
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
+#include <vtkStringArray.h>
 #include <vtkTypeInt64Array.h>
 #include <vtkUnstructuredGrid.h>
 #include <vtkXMLPolyDataWriter.h>
 #include <vtkXMLUnstructuredGridWriter.h>
 
+#include <Eigen/Geometry>
 #include <cstdio>
 #include <fstream>
+#include <map>
 #include <unordered_map>
 
 #include "atomic_file.hpp"
@@ -161,6 +164,69 @@ void write_vtp_contacts(const std::filesystem::path& path, const Frame& f) {
   write_xml(w.Get(), path);
 }
 
+void write_vtu_clumps(const std::filesystem::path& path, const Frame& f) {
+  const auto n = static_cast<vtkIdType>(f.clumps.size());
+  vtkNew<vtkPoints> pts;
+  pts->SetDataTypeToDouble();
+  pts->SetNumberOfPoints(n);
+  vtkNew<vtkTypeInt64Array> id;
+  id->SetName("id");
+  id->SetNumberOfTuples(n);
+  vtkNew<vtkIntArray> tpl;
+  tpl->SetName("template");
+  tpl->SetNumberOfTuples(n);
+  vtkNew<vtkStringArray> names;  // field data: template index k is template_names[k]
+  names->SetName("template_names");
+  std::map<std::string, int> index;
+  auto vel = vec_array("velocity", 3, n), av = vec_array("angular_velocity", 3, n),
+       ori = vec_array("orientation", 4, n), mass = vec_array("mass", 1, n),
+       inertia = vec_array("principal_inertia", 3, n), a1 = vec_array("axis_1", 3, n),
+       a2 = vec_array("axis_2", 3, n), a3 = vec_array("axis_3", 3, n);
+  vtkDoubleArray* axes[3] = {a1, a2, a3};
+  vtkNew<vtkCellArray> cells;
+  for (vtkIdType i = 0; i < n; ++i) {
+    const auto& c = f.clumps[static_cast<std::size_t>(i)];
+    pts->SetPoint(i, c.position.data());
+    id->SetValue(i, c.id);
+    const auto [it, added] = index.emplace(c.template_name, static_cast<int>(index.size()));
+    if (added) names->InsertNextValue(c.template_name);
+    tpl->SetValue(i, it->second);
+    vel->SetTuple(i, c.velocity.data());
+    av->SetTuple(i, c.angular_velocity.data());
+    const double q[4] = {c.orientation.w(), c.orientation.x(), c.orientation.y(),
+                         c.orientation.z()};
+    ori->SetTuple(i, q);
+    mass->SetValue(i, c.mass);
+    inertia->SetTuple(i, c.principal_inertia.data());
+    const Eigen::Matrix3d r = c.orientation.normalized().toRotationMatrix();
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::Vector3d axis = r.col(k);  // principal axis k in the lab frame (unit)
+      axes[k]->SetTuple(i, axis.data());
+    }
+    cells->InsertNextCell(1, &i);
+  }
+  vtkNew<vtkUnstructuredGrid> g;
+  g->SetPoints(pts);
+  g->SetCells(VTK_VERTEX, cells);
+  auto* pd = g->GetPointData();
+  for (vtkAbstractArray* a :
+       std::initializer_list<vtkAbstractArray*>{id, tpl, vel, av, ori, mass, inertia, a1, a2, a3})
+    pd->AddArray(a);
+  pd->SetActiveScalars("mass");
+  auto* fd = g->GetFieldData();
+  add_field(fd, "TimeValue", {f.time});
+  fd->AddArray(names);
+  vtkNew<vtkXMLUnstructuredGridWriter> w;
+  w->SetInputData(g);
+  write_xml(w.Get(), path);
+}
+
+std::filesystem::path clumps_sibling(const std::filesystem::path& path) {
+  auto p = path.parent_path() / (path.stem().string() + "_clumps");
+  p += path.extension();
+  return p;
+}
+
 namespace {
 
 void write_pvd_file(const std::filesystem::path& path,
@@ -186,6 +252,9 @@ void write_pvd_series(const std::filesystem::path& pvd_path, const Trajectory& t
   const auto dir_name = pvd_path.stem().string() + "_files";
   const auto dir = pvd_path.parent_path() / dir_name;
   auto contacts_pvd = pvd_path.parent_path() / (pvd_path.stem().string() + "_contacts.pvd");
+  const auto clumps_pvd = clumps_sibling(pvd_path);
+  bool any_clumps = false;
+  for (const auto& f : t.frames) any_clumps = any_clumps || !f.clumps.empty();
   AtomicOutput tmp_dir(dir);
   std::error_code ec;
   std::filesystem::create_directory(tmp_dir.temp_path(), ec);
@@ -198,7 +267,7 @@ void write_pvd_series(const std::filesystem::path& pvd_path, const Trajectory& t
       if (armed) std::filesystem::remove_all(p, e);
     }
   } cleanup{tmp_dir.temp_path()};
-  std::vector<std::pair<double, std::string>> pe, ce;
+  std::vector<std::pair<double, std::string>> pe, ce, ke;
   char name[64];
   for (std::size_t i = 0; i < t.frames.size(); ++i) {
     std::snprintf(name, sizeof name, "particles_%06zu.vtu", i);
@@ -207,11 +276,19 @@ void write_pvd_series(const std::filesystem::path& pvd_path, const Trajectory& t
     std::snprintf(name, sizeof name, "contacts_%06zu.vtp", i);
     write_vtp_contacts(tmp_dir.temp_path() / name, t.frames[i]);
     ce.emplace_back(t.frames[i].time, dir_name + "/" + name);
+    if (!any_clumps) continue;
+    std::snprintf(name, sizeof name, "clumps_%06zu.vtu", i);
+    write_vtu_clumps(tmp_dir.temp_path() / name, t.frames[i]);
+    ke.emplace_back(t.frames[i].time, dir_name + "/" + name);
   }
   std::filesystem::remove_all(dir, ec);
   tmp_dir.commit();
   cleanup.armed = false;
   write_pvd_file(contacts_pvd, ce);
+  if (any_clumps)
+    write_pvd_file(clumps_pvd, ke);
+  else
+    std::filesystem::remove(clumps_pvd, ec);  // a stale series would name files just replaced
   write_pvd_file(pvd_path, pe);
 }
 

@@ -183,4 +183,103 @@ TEST(Fabric, ClumpOrientation) {
   EXPECT_EQ(ga::orientation_fabric(gs::Frame{}).bodies, 0u);
 }
 
+// A clump body whose long axis (the principal axis of its smallest moment, body x) points along
+// `axis` in the lab frame: a two-sphere clump's inertia ordering, I_x < I_y = I_z.
+gs::Clump body_along(std::int64_t id, const Eigen::Vector3d& axis,
+                     const Eigen::Vector3d& centre = Eigen::Vector3d::Zero()) {
+  gs::Clump c;
+  c.id = id;
+  c.template_name = "dimer";
+  c.position = centre;
+  c.orientation = Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitX(), axis);
+  c.mass = 1e-5;
+  c.principal_inertia = {2e-12, 5e-12, 5e-12};
+  return c;
+}
+
+// Seed 003 §4.3 (D^p by eq 20–21 over the bodies' long axes): all long axes along x give
+// Phi = diag(1, 0, 0) and D^p = 15/2 (Phi - I/3) = diag(5, -2.5, -2.5) exactly, |D^p| =
+// sqrt(37.5); in 2D 4 (Phi - I/2) = diag(2, -2). Axes equally along x, y and z (the discrete
+// isotropic set) give Phi = I/3 and D^p = 0. A body whose smallest moment is not distinct (one
+// sphere) has no long axis and is left out.
+TEST(Fabric, ClumpBodyOrientationExactValues) {
+  std::vector<gs::Clump> aligned;
+  for (int i = 0; i < 6; ++i) {
+    const double sign = i % 2 ? -1.0 : 1.0;  // m and -m are the same orientation
+    aligned.push_back(body_along(i, sign * Eigen::Vector3d::UnitX()));
+  }
+  gs::Clump round = body_along(99, Eigen::Vector3d::UnitY());
+  round.principal_inertia = {4e-12, 4e-12, 4e-12};
+  aligned.push_back(round);
+  EXPECT_FALSE(ga::clump_long_axis(round).has_value());
+  const auto o = ga::body_orientation_fabric(aligned, 3);
+  EXPECT_EQ(o.source, ga::OrientationSource::Bodies);
+  ASSERT_EQ(o.bodies, 6u);
+  const Eigen::Matrix3d want = Eigen::Vector3d(5.0, -2.5, -2.5).asDiagonal();
+  EXPECT_LT((o.D - want).norm(), 1e-14) << o.D;
+  EXPECT_NEAR(o.D_norm, std::sqrt(37.5), 1e-14);
+  EXPECT_NEAR(o.Phi.trace(), 1.0, 1e-15);
+  const auto o2 = ga::body_orientation_fabric(aligned, 2);
+  const Eigen::Matrix3d want2 = Eigen::Vector3d(2.0, -2.0, 0.0).asDiagonal();
+  EXPECT_LT((o2.D - want2).norm(), 1e-14) << o2.D;
+
+  std::vector<gs::Clump> iso;
+  const Eigen::Vector3d dirs[3] = {Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitY(),
+                                   Eigen::Vector3d::UnitZ()};
+  for (int i = 0; i < 9; ++i) iso.push_back(body_along(i, dirs[i % 3]));
+  const auto oi = ga::body_orientation_fabric(iso, 3);
+  ASSERT_EQ(oi.bodies, 9u);
+  EXPECT_LT(oi.D.norm(), 1e-14) << oi.D;
+  EXPECT_LT((oi.Phi - Eigen::Matrix3d::Identity() / 3.0).norm(), 1e-15);
+  // The long axis is the body's principal axis of the smallest moment, whichever column it is.
+  gs::Clump z = body_along(5, Eigen::Vector3d::UnitX());
+  z.principal_inertia = {5e-12, 5e-12, 2e-12};  // body z the long axis -> lab z
+  z.orientation = Eigen::Quaterniond::Identity();
+  EXPECT_LT((ga::clump_long_axis(z).value() - Eigen::Vector3d::UnitZ()).norm(), 1e-15);
+}
+
+// For two-sphere clumps (seed 003 §2.4: centre distance 1.4 r) the body path (smallest principal
+// moment) and the member path (largest volume second moment) give the same axes and the same
+// D^p, for 50 random orientations; orientation_fabric prefers the bodies when the frame has them.
+TEST(Fabric, ClumpBodyAndMemberOrientationAgreeForTwoSphereClumps) {
+  std::mt19937_64 rng(14);
+  std::normal_distribution<double> g(0.0, 1.0);
+  gs::Frame f;
+  const double r = 1e-3;
+  for (int c = 0; c < 50; ++c) {
+    const Eigen::Vector3d axis = Eigen::Vector3d(g(rng), g(rng), g(rng)).normalized();
+    const Eigen::Vector3d centre = Eigen::Vector3d(0.01 * c, 0.002 * (c % 7), 0.0);
+    gs::Clump body = body_along(1000 + c, axis, centre);
+    // A dimer's inertia: about its axis 2 * 2/5 m r^2; across it that plus 2 m (0.7 r)^2.
+    const double m = 0.5 * body.mass;
+    body.principal_inertia = {2 * 0.4 * m * r * r, 2 * 0.4 * m * r * r + 2 * m * 0.49 * r * r,
+                              2 * 0.4 * m * r * r + 2 * m * 0.49 * r * r};
+    f.clumps.push_back(body);
+    for (int k = 0; k < 2; ++k) {
+      gs::Particle p;
+      p.id = 2 * c + k;
+      p.radius = r;
+      p.clump_id = body.id;
+      p.position = centre + (k ? 0.7 : -0.7) * r * axis;
+      f.particles.push_back(p);
+    }
+  }
+  const auto bodies = ga::orientation_fabric(f);
+  EXPECT_EQ(bodies.source, ga::OrientationSource::Bodies);
+  const auto members = ga::member_orientation_fabric(f);
+  EXPECT_EQ(members.source, ga::OrientationSource::Members);
+  ASSERT_EQ(bodies.bodies, 50u);
+  ASSERT_EQ(members.bodies, 50u);
+  for (std::size_t i = 0; i < 50; ++i) {
+    EXPECT_EQ(bodies.clump[i], members.clump[i]);
+    EXPECT_NEAR(std::abs(bodies.axis[i].dot(members.axis[i])), 1.0, 1e-12) << i;
+    EXPECT_LT((bodies.centroid[i] - members.centroid[i]).norm(), 1e-15) << i;
+  }
+  EXPECT_LT((bodies.D - members.D).norm(), 1e-11) << bodies.D << "\n" << members.D;
+  EXPECT_GT(bodies.D_norm, 0.0);
+  f.clumps.clear();  // imported data: clump_id without bodies
+  EXPECT_EQ(ga::orientation_fabric(f).source, ga::OrientationSource::Members);
+  EXPECT_EQ(ga::orientation_fabric(gs::Frame{}).source, ga::OrientationSource::None);
+}
+
 }  // namespace

@@ -16,6 +16,7 @@
 using namespace gs;
 using gs::test::random_frame;
 using gs::test::ScratchDir;
+using gs::test::with_clump_bodies;
 
 namespace {
 
@@ -41,9 +42,11 @@ TEST(Hdf5Trajectory, RoundTripsEveryFieldExactly) {
   ScratchDir dir("h5rt");
   Trajectory t;
   t.metadata = meta();
-  // Frames with different particle and contact counts, and an empty contact list.
-  t.frames = {random_frame(50, 80, 1, 0.0), random_frame(37, 0, 2, 0.5),
-              random_frame(61, 12, 3, 1.0)};
+  // Frames with different particle and contact counts, and an empty contact list; clump bodies
+  // in the first and last frame only.
+  t.frames = {with_clump_bodies(random_frame(50, 80, 1, 0.0), 1), random_frame(37, 0, 2, 0.5),
+              with_clump_bodies(random_frame(61, 12, 3, 1.0), 3)};
+  ASSERT_EQ(t.frames[0].clumps.size(), 13u);
   const auto path = dir / "run.h5";
   write_hdf5_trajectory(path, t);
   EXPECT_FALSE(std::filesystem::exists(partial_path(path)));
@@ -57,6 +60,84 @@ TEST(Hdf5Trajectory, RoundTripsEveryFieldExactly) {
   EXPECT_EQ(reader.particle_count(1), 37u);
   EXPECT_EQ(reader.contact_count(0), 80u);
   EXPECT_EQ(reader.time(2), 1.0);
+  EXPECT_EQ(reader.clump_count(0), 13u);
+  EXPECT_EQ(reader.clump_count(1), 0u);
+  EXPECT_EQ(reader.clump_count(2), 16u);
+  EXPECT_EQ(reader.schema_version(), kTrajectorySchemaVersion);
+}
+
+// tests/data/trajectory_v1.h5 was written by the schema_version 1 writer
+// (tests/data/make_trajectory_v1.sh): it reads as before, with no clump bodies (its members keep
+// their clump_id, as imported data), and resuming into it upgrades it to the current version.
+TEST(Hdf5Trajectory, SchemaVersion1FilesReadWithoutClumpsAndUpgradeOnResume) {
+  const auto v1 = std::filesystem::path(GS_TEST_DATA_DIR) / "trajectory_v1.h5";
+  {
+    TrajectoryReader r(v1);
+    EXPECT_EQ(r.schema_version(), 1);
+    ASSERT_EQ(r.frame_count(), 2u);
+    EXPECT_EQ(r.clump_count(1), 0u);
+    const Frame f = r.frame(1);
+    EXPECT_EQ(f.time, 0.5);
+    EXPECT_EQ(f.step, 1000);
+    ASSERT_EQ(f.particles.size(), 3u);
+    EXPECT_EQ(f.particles[1].position, Eigen::Vector3d(0.002, 0.001, 0.003));
+    EXPECT_EQ(f.particles[1].clump_id, 7);
+    EXPECT_EQ(f.particles[2].clump_id, -1);
+    ASSERT_EQ(f.contacts.size(), 1u);
+    EXPECT_EQ(f.contacts[0].normal_force, Eigen::Vector3d(0.25, 0, 0));
+    ASSERT_EQ(f.walls.size(), 1u);
+    EXPECT_TRUE(f.clumps.empty());
+    EXPECT_EQ(r.metadata().provenance, "schema_version 1 fixture");
+  }
+  ScratchDir dir("h5v1");
+  const auto path = dir / "run.h5";
+  std::filesystem::copy_file(v1, partial_path(path));
+  Frame extra = read_hdf5_trajectory(v1).frames[1];
+  extra.time = 1.0;
+  extra.particles[2].clump_id = 9;  // a second clump, of one sphere
+  Clump a, b;
+  a.id = 7;
+  a.template_name = "dimer";
+  a.mass = 2e-5;
+  a.principal_inertia = {1e-12, 3e-12, 3e-12};
+  b.id = 9;
+  b.template_name = "single";
+  b.mass = 1e-5;
+  b.principal_inertia = {4e-12, 4e-12, 4e-12};
+  extra.clumps = {a, b};
+  {
+    auto w = TrajectoryWriter::resume(path, 1, {.discard_unfinished = false});
+    EXPECT_EQ(w.frames_written(), 1u);
+    w.append(extra);
+    w.finish();
+  }
+  TrajectoryReader r(path);
+  EXPECT_EQ(r.schema_version(), kTrajectorySchemaVersion);
+  ASSERT_EQ(r.frame_count(), 2u);
+  EXPECT_EQ(r.clump_count(0), 0u);
+  gs::test::expect_same_frame(read_hdf5_trajectory(v1).frames[0], r.frame(0));
+  gs::test::expect_same_frame(extra, r.frame(1));
+}
+
+TEST(Hdf5Trajectory, ResumeKeepsTheClumpRowsOfTheKeptFrames) {
+  ScratchDir dir("h5resume_clumps");
+  const auto path = dir / "run.h5";
+  std::vector<Frame> frames;
+  for (unsigned i = 0; i < 4; ++i)
+    frames.push_back(with_clump_bodies(random_frame(20 + i, 5, i + 1, 0.1 * i), i + 1));
+  {
+    TrajectoryWriter w(path, meta(), {.discard_unfinished = false});
+    for (const auto& f : frames) w.append(f);
+  }
+  {
+    auto w = TrajectoryWriter::resume(path, 2, {.discard_unfinished = false});
+    w.append(frames[2]);
+    w.append(frames[3]);
+    w.finish();
+  }
+  const Trajectory r = read_hdf5_trajectory(path);
+  ASSERT_EQ(r.frames.size(), 4u);
+  for (std::size_t i = 0; i < 4; ++i) gs::test::expect_same_frame(frames[i], r.frames[i]);
 }
 
 TEST(Hdf5Trajectory, UnfinishedWriterKeepsCompletedFramesAndDiscardsWhenAsked) {
@@ -223,6 +304,21 @@ TEST(Hdf5Trajectory, WriterRejectsInvalidFrames) {
   f = random_frame(5, 2, 1);
   f.particles[3].id = f.particles[1].id;
   EXPECT_THROW(w.append(f), InputError);
+  // Clump bodies: a template name over 64 bytes, a member without its body, a body without
+  // members. Nothing is written.
+  f = with_clump_bodies(random_frame(5, 2, 1), 1);
+  f.clumps[0].template_name = std::string(65, 'x');
+  EXPECT_EQ(error_of([&] { w.append(f); }), (dir / "x.h5").string() +
+                                                ": clump template name longer than 64 bytes (" +
+                                                std::string(65, 'x') + ")");
+  f = with_clump_bodies(random_frame(5, 2, 1), 1);
+  f.clumps.pop_back();
+  EXPECT_THROW(w.append(f), InputError);
+  f = with_clump_bodies(random_frame(5, 2, 1), 1);
+  f.clumps.push_back(f.clumps[0]);
+  f.clumps.back().id = 1000;
+  EXPECT_EQ(error_of([&] { w.append(f); }),
+            (dir / "x.h5").string() + ": clump has no member particle (1000)");
   EXPECT_EQ(w.frames_written(), 0u);
 }
 
@@ -232,7 +328,7 @@ TEST(Hdf5Trajectory, ReadableByH5py) {
   const auto path = dir / "run.h5";
   Trajectory t;
   t.metadata = meta();
-  t.frames = {random_frame(12, 4, 1), random_frame(9, 3, 2)};
+  t.frames = {with_clump_bodies(random_frame(12, 4, 1), 1), random_frame(9, 3, 2)};
   write_hdf5_trajectory(path, t);
   const char* py_env = std::getenv("GRANOSCOPE_PYTHON");
   const std::string py = py_env && *py_env ? py_env : "/usr/bin/python3";
@@ -246,7 +342,10 @@ TEST(Hdf5Trajectory, ReadableByH5py) {
       "e = f['frames/end'][:]\n"
       "print(len(e), int(e[-1][0]), int(e[-1][1]))\n"
       "print(repr(float(f['particles/position'][13][1])), "
-      "repr(float(f['particles/radius'][20])))\n";
+      "repr(float(f['particles/radius'][20])))\n"
+      "k = f['clumps/template']\n"
+      "print(k[0].decode(), len(k[2]), int(f['frames/clump_end'][-1]), "
+      "repr(float(f['clumps/mass'][2])))\n";
   std::ofstream(dir / "read.py") << script;
   const std::string cmd =
       py + " " + (dir / "read.py").string() + " " + path.string() + " > " + out.string();
@@ -256,7 +355,9 @@ TEST(Hdf5Trajectory, ReadableByH5py) {
   int schema = 0, frames = 0;
   long long pend = 0, cend = 0;
   std::string y, r;
-  in >> fmt >> schema >> frames >> pend >> cend >> y >> r;
+  std::string name0, kmass;
+  int len2 = 0, kend = 0;
+  in >> fmt >> schema >> frames >> pend >> cend >> y >> r >> name0 >> len2 >> kend >> kmass;
   EXPECT_EQ(fmt, "granoscope-trajectory");
   EXPECT_EQ(schema, kTrajectorySchemaVersion);
   EXPECT_EQ(frames, 2);
@@ -264,6 +365,10 @@ TEST(Hdf5Trajectory, ReadableByH5py) {
   EXPECT_EQ(cend, 7);
   EXPECT_EQ(std::stod(y), t.frames[1].particles[1].position.y());
   EXPECT_EQ(std::stod(r), t.frames[1].particles[8].radius);
+  EXPECT_EQ(name0, "dimer");
+  EXPECT_EQ(len2, 64);  // the longest template name fills the fixed-length string
+  EXPECT_EQ(kend, 3);   // three clumps in frame 0, none in frame 1
+  EXPECT_EQ(std::stod(kmass), t.frames[0].clumps[2].mass);
 }
 
 namespace {
@@ -277,8 +382,12 @@ const std::vector<std::pair<std::string, std::vector<std::string>>> kDocumentedD
      {"id1", "id2", "point", "normal", "normal_force", "shear_force", "bending_moment",
       "twisting_moment", "overlap"}},
     {"walls", {"id", "kind", "a", "b", "force", "torque"}},
+    {"clumps",
+     {"id", "template", "position", "orientation", "velocity", "angular_velocity", "mass",
+      "principal_inertia"}},
     {"frames",
-     {"time", "step", "dt", "two_d", "domain_lo", "domain_hi", "periodic", "cell", "end"}},
+     {"time", "step", "dt", "two_d", "domain_lo", "domain_hi", "periodic", "cell", "clump_end",
+      "end"}},
 };
 
 }  // namespace
@@ -292,7 +401,7 @@ TEST(Hdf5Trajectory, EveryDatasetIsChunkedShuffledDeflatedAndChecksummed) {
   const auto path = dir / "run.h5";
   Trajectory t;
   t.metadata = meta();
-  t.frames = {random_frame(40, 30, 1), random_frame(41, 20, 2)};
+  t.frames = {with_clump_bodies(random_frame(40, 30, 1), 1), random_frame(41, 20, 2)};
   write_hdf5_trajectory(path, t);
   hid_t f = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
   ASSERT_GE(f, 0);
@@ -329,7 +438,7 @@ TEST(Hdf5Trajectory, EveryDatasetIsChunkedShuffledDeflatedAndChecksummed) {
       ++checked;
     }
   }
-  EXPECT_EQ(checked, 34);
+  EXPECT_EQ(checked, 43);
   H5Fclose(f);
 }
 

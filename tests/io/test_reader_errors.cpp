@@ -7,6 +7,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <set>
 #include <string>
 #include <vector>
@@ -242,6 +243,77 @@ TEST(ReaderErrors, Hdf5NegativeMassNonUnitNormalsDuplicateIds) {
     EXPECT_EQ(error_of(bad), msg);
     expect_cli_rejects(bad, msg, dir);
   }
+}
+
+// Clump bodies (schema_version 2): a NaN in a clump dataset, a non-unit orientation, a mass of
+// zero, a member naming a missing clump, a clump left without members. Each gives its one line
+// through the library, `info`, `convert` and `analyze fabric` (exit 2).
+TEST(ReaderErrors, Hdf5ClumpBodiesNaNBadOrientationMassAndMissingClumps) {
+  ScratchDir dir("rerr_h5_clumps");
+  Trajectory t = small_run();
+  auto& f = t.frames[0];
+  f.particles[0].clump_id = f.particles[1].clump_id = 10;  // particles 1 and 2: clump 10
+  Clump c;
+  c.id = 10;
+  c.template_name = "dimer";
+  c.position = {0.001, 0, 0};
+  c.mass = 2e-5;
+  c.principal_inertia = {1e-12, 3e-12, 3e-12};
+  f.clumps = {c};
+  write_hdf5_trajectory(dir / "good.h5", t);
+  ASSERT_EQ(read_snapshots(dir / "good.h5").frames.at(0).clumps.size(), 1u);
+  struct Case {
+    const char* file;
+    const char* dataset;
+    hsize_t row;
+    std::vector<double> f64;
+    std::vector<std::int64_t> i64;
+    std::string what;
+  };
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const std::vector<Case> cases = {
+      {"nan_mass.h5", "/clumps/mass", 0, {nan}, {}, "clump 10 mass is not finite (nan)"},
+      {"nan_pos.h5",
+       "/clumps/position",
+       0,
+       {0, nan, 0},
+       {},
+       "clump 10 position is not finite (nan)"},
+      {"ori.h5",
+       "/clumps/orientation",
+       0,
+       {2, 0, 0, 0},
+       {},
+       "clump 10 orientation is not a unit quaternion, |q| (2)"},
+      {"mass0.h5", "/clumps/mass", 0, {0}, {}, "clump 10 mass is not positive (0)"},
+      {"missing.h5", "/particles/clump_id", 2, {}, {11}, "particle 3 names a missing clump (11)"},
+      {"orphan.h5", "/clumps/id", 0, {}, {11}, "particle 1 names a missing clump (10)"},
+  };
+  for (const auto& k : cases) {
+    const auto bad = dir / k.file;
+    fs::copy_file(dir / "good.h5", bad);
+    if (k.i64.empty())
+      patch_row(bad, k.dataset, k.row, k.f64);
+    else
+      patch_row(bad, k.dataset, k.row, k.i64);
+    const std::string msg = bad.string() + " frame 0: " + k.what;
+    EXPECT_EQ(error_of(bad), msg);
+    expect_cli_rejects(bad, msg, dir);
+    const auto log = dir / "log";
+    const auto fab = gs::test::run_cli(
+        "analyze fabric " + bad.string() + " -o " + (dir / "fabric.h5").string(), log);
+    EXPECT_EQ(fab.rc, 2) << fab.err;
+    EXPECT_EQ(fab.err, "error: " + msg + "\n");
+    EXPECT_FALSE(fs::exists(dir / "fabric.h5"));
+  }
+  // A clump without members: the members of clump 10 leave it (clump_id -1).
+  const auto orphan = dir / "no_members.h5";
+  fs::copy_file(dir / "good.h5", orphan);
+  patch_row(orphan, "/particles/clump_id", 0, std::vector<std::int64_t>{-1});
+  patch_row(orphan, "/particles/clump_id", 1, std::vector<std::int64_t>{-1});
+  const std::string msg = orphan.string() + " frame 0: clump has no member particle (10)";
+  EXPECT_EQ(error_of(orphan), msg);
+  expect_cli_rejects(orphan, msg, dir);
 }
 
 TEST(ReaderErrors, VtuVtpNegativeMassNonUnitNormalDuplicateAndFractionalIds) {

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <random>
 #include <string>
@@ -82,6 +83,46 @@ inline Frame random_frame(std::size_t np, std::size_t nc, unsigned seed, double 
   return f;
 }
 
+/// Gives every clump_id of the frame a clump body (distinct, non-round values; template names of
+/// different lengths, up to the 64-byte limit).
+inline Frame with_clump_bodies(Frame f, unsigned seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(0.5, 1.5);
+  std::vector<std::int64_t> ids;
+  for (const auto& p : f.particles)
+    if (p.clump_id >= 0 && std::find(ids.begin(), ids.end(), p.clump_id) == ids.end())
+      ids.push_back(p.clump_id);
+  const std::string names[3] = {"dimer", "", std::string(64, 't')};
+  for (const auto id : ids) {
+    Clump c;
+    c.id = id;
+    c.template_name = names[static_cast<std::size_t>(id) % 3];
+    c.position = Eigen::Vector3d(u(rng), u(rng), u(rng)) * 0.01;
+    c.orientation = Eigen::Quaterniond(u(rng), -u(rng), u(rng), u(rng) - 1.0).normalized();
+    c.velocity = Eigen::Vector3d(u(rng), -u(rng), u(rng));
+    c.angular_velocity = Eigen::Vector3d(u(rng), u(rng), -u(rng)) * 10;
+    c.mass = 1e-5 * u(rng);
+    c.principal_inertia = Eigen::Vector3d(u(rng), 2 * u(rng), 2 * u(rng)) * 1e-11;
+    f.clumps.push_back(c);
+  }
+  return f;
+}
+
+inline void expect_same_clumps(const Frame& a, const Frame& b) {
+  ASSERT_EQ(a.clumps.size(), b.clumps.size());
+  for (std::size_t i = 0; i < a.clumps.size(); ++i) {
+    const auto &c = a.clumps[i], &d = b.clumps[i];
+    EXPECT_EQ(c.id, d.id);
+    EXPECT_EQ(c.template_name, d.template_name);
+    EXPECT_EQ(c.position, d.position);
+    EXPECT_EQ(c.orientation.coeffs(), d.orientation.coeffs());
+    EXPECT_EQ(c.velocity, d.velocity);
+    EXPECT_EQ(c.angular_velocity, d.angular_velocity);
+    EXPECT_EQ(c.mass, d.mass);
+    EXPECT_EQ(c.principal_inertia, d.principal_inertia);
+  }
+}
+
 inline void expect_same_frame(const Frame& a, const Frame& b, bool with_walls = true) {
   ASSERT_EQ(a.particles.size(), b.particles.size());
   ASSERT_EQ(a.contacts.size(), b.contacts.size());
@@ -118,6 +159,7 @@ inline void expect_same_frame(const Frame& a, const Frame& b, bool with_walls = 
     EXPECT_EQ(c.twisting_moment, d.twisting_moment);
     EXPECT_EQ(c.overlap, d.overlap);
   }
+  expect_same_clumps(a, b);
   if (!with_walls) return;
   ASSERT_EQ(a.walls.size(), b.walls.size());
   for (std::size_t i = 0; i < a.walls.size(); ++i) {

@@ -1,7 +1,15 @@
 #include <gtest/gtest.h>
+#include <vtkDataArray.h>
+#include <vtkFieldData.h>
+#include <vtkNew.h>
+#include <vtkPointData.h>
+#include <vtkStringArray.h>
+#include <vtkUnstructuredGrid.h>
+#include <vtkXMLUnstructuredGridReader.h>
 
 #include <fstream>
 
+#include "../apps/cli_util.hpp"
 #include "errors.hpp"
 #include "hdf5_trajectory.hpp"
 #include "test_util.hpp"
@@ -64,4 +72,83 @@ TEST(VtkIo, PackingCsvRoundTripIsExact) {
     EXPECT_EQ(r.particles[i].position, t.frames[0].particles[i].position);
     EXPECT_EQ(r.particles[i].radius, t.frames[0].particles[i].radius);
   }
+}
+
+// Clump bodies go to `<stem>_clumps.vtu` beside the particles (as the contacts go to the .vtp):
+// exact round trip of every field; axis_1..3 are the columns of the orientation's rotation
+// matrix (unit), the template index names the field-data template_names; a frame without bodies
+// removes a stale clumps file instead of leaving it to be read back with the wrong frame.
+TEST(VtkIo, ClumpBodiesRoundTripBesideTheParticlesWithTheirPrincipalAxes) {
+  ScratchDir dir("vtk_clumps");
+  Trajectory t;
+  t.frames = {gs::test::with_clump_bodies(random_frame(40, 25, 4), 4)};
+  t.frames[0].walls.clear();
+  ASSERT_EQ(t.frames[0].clumps.size(), 10u);
+  write_snapshots(dir / "p.vtu", t);
+  ASSERT_TRUE(std::filesystem::exists(dir / "p_clumps.vtu"));
+  gs::test::expect_same_frame(t.frames[0], read_snapshots(dir / "p.vtu").frames.at(0));
+
+  vtkNew<vtkXMLUnstructuredGridReader> r;
+  r->SetFileName((dir / "p_clumps.vtu").c_str());
+  r->Update();
+  vtkUnstructuredGrid* g = r->GetOutput();
+  ASSERT_EQ(g->GetNumberOfPoints(), 10);
+  auto* names = vtkStringArray::SafeDownCast(g->GetFieldData()->GetAbstractArray("template_names"));
+  ASSERT_NE(names, nullptr);
+  vtkDataArray* tpl = g->GetPointData()->GetArray("template");
+  ASSERT_NE(tpl, nullptr);
+  for (vtkIdType i = 0; i < 10; ++i) {
+    const auto& c = t.frames[0].clumps[static_cast<std::size_t>(i)];
+    const Eigen::Matrix3d rot = c.orientation.toRotationMatrix();
+    for (int k = 0; k < 3; ++k) {
+      vtkDataArray* a = g->GetPointData()->GetArray(("axis_" + std::to_string(k + 1)).c_str());
+      ASSERT_NE(a, nullptr);
+      double v[3];
+      a->GetTuple(i, v);
+      const Eigen::Vector3d axis(v[0], v[1], v[2]);
+      EXPECT_LT((axis - rot.col(k)).norm(), 1e-14) << i << " axis " << k;
+      EXPECT_NEAR(axis.norm(), 1.0, 1e-14);
+    }
+    const auto k = static_cast<vtkIdType>(tpl->GetComponent(i, 0));
+    EXPECT_EQ(names->GetValue(k), c.template_name);
+  }
+
+  Trajectory plain;
+  plain.frames = {random_frame(10, 3, 2)};
+  plain.frames[0].walls.clear();
+  write_snapshots(dir / "p.vtu", plain);
+  EXPECT_FALSE(std::filesystem::exists(dir / "p_clumps.vtu"));
+  EXPECT_TRUE(read_snapshots(dir / "p.vtu").frames.at(0).clumps.empty());
+}
+
+// `granoscope convert` carries the bodies HDF5 -> .pvd (`<stem>_clumps.pvd`) -> HDF5, exactly;
+// a frame of the series without bodies has an empty clumps file.
+TEST(VtkIo, ConvertCarriesClumpBodiesThroughPvdSeries) {
+  ScratchDir dir("pvd_clumps");
+  Trajectory t;
+  t.metadata.provenance = "test";
+  t.frames = {gs::test::with_clump_bodies(random_frame(10, 4, 1, 0.0), 1),
+              random_frame(12, 5, 2, 0.5),
+              gs::test::with_clump_bodies(random_frame(8, 0, 3, 1.5), 3)};
+  for (auto& f : t.frames) f.walls.clear();
+  write_snapshots(dir / "a.h5", t);
+  const auto log = dir / "log";
+  std::filesystem::create_directories(log);
+  auto r = gs::test::run_cli(
+      "convert " + (dir / "a.h5").string() + " " + (dir / "run.pvd").string(), log);
+  ASSERT_EQ(r.rc, 0) << r.err;
+  EXPECT_TRUE(std::filesystem::exists(dir / "run_clumps.pvd"));
+  r = gs::test::run_cli("convert " + (dir / "run.pvd").string() + " " + (dir / "b.h5").string(),
+                        log);
+  ASSERT_EQ(r.rc, 0) << r.err;
+  const Trajectory back = read_snapshots(dir / "b.h5");
+  ASSERT_EQ(back.frames.size(), 3u);
+  for (std::size_t i = 0; i < 3; ++i) gs::test::expect_same_frame(t.frames[i], back.frames[i]);
+  // Written again without bodies: the stale clump series goes.
+  Trajectory plain;
+  plain.frames = {random_frame(10, 4, 1)};
+  plain.frames[0].walls.clear();
+  write_snapshots(dir / "run.pvd", plain);
+  EXPECT_FALSE(std::filesystem::exists(dir / "run_clumps.pvd"));
+  EXPECT_TRUE(read_snapshots(dir / "run.pvd").frames.at(0).clumps.empty());
 }
