@@ -189,11 +189,11 @@ void run(const Args& a) {
   // Where the run stops at the latest: --steps, or a plain scene's own number of steps.
   std::optional<std::int64_t> stop_at;
   if (a.steps >= 0) stop_at = a.steps;
-  if (scene.test.empty()) {
+  if (scene.test.empty() && !scene.fill) {
     if (!stop_at) stop_at = scene.steps;
     programmes.clear();
     programmes.push_back(std::make_unique<solver::FixedSteps>(*stop_at, scene.output.every));
-  }
+  }  // (with a [fill]: the filling, then `steps` more; --steps stops at that step)
   const fs::path out = a.out.empty() ? fs::path("out") / scene.name : fs::path(a.out);
   std::error_code ec;
   fs::create_directories(out, ec);
@@ -374,6 +374,9 @@ void run(const Args& a) {
         }
       }
     }
+  } catch (const solver::FillError& e) {
+    history.flush();
+    throw InputError(a.scene, e.what());
   } catch (const solver::BlowUp& e) {
     history.flush();
     throw InputError(a.scene, std::string("blow-up: ") + e.what() +

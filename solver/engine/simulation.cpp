@@ -183,6 +183,28 @@ void Simulation::remove_outflow() {
   if (any) invalidate_neighbors();  // (its pairs go with the rebuild before the next step)
 }
 
+void Simulation::set_pending(const std::vector<std::uint32_t>& indices) {
+  for (const std::uint32_t i : indices) {
+    if (i >= p_.size()) throw std::invalid_argument("no particle " + std::to_string(i));
+    if (p_.clump[i] >= 0 || p_.removed[i] == 1)
+      throw std::invalid_argument("particle " + std::to_string(i) + " cannot wait for insertion");
+    p_.removed[i] = 2;
+    p_.fixed[i] = 1;
+    p_.vel[i].setZero();
+    p_.angvel[i].setZero();
+  }
+  invalidate_neighbors();
+}
+
+void Simulation::insert_particle(std::uint32_t i, const Eigen::Vector3d& position) {
+  if (i >= p_.size() || p_.removed[i] != 2)
+    throw std::invalid_argument("particle " + std::to_string(i) + " is not waiting for insertion");
+  p_.removed[i] = 0;
+  p_.fixed[i] = 0;
+  p_.pos[i] = position;
+  invalidate_neighbors();
+}
+
 void Simulation::rebuild_neighbors() {
   std::vector<ContactHistory> old = std::move(hist_);
   nl_.build(p_, walls_);
@@ -683,12 +705,17 @@ double Simulation::kinetic_energy() const {
 }
 
 double Simulation::inertial_number() const {
-  const std::size_t n = p_.size();
+  // Over the particles in the scene (not those removed or waiting to be inserted).
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < p_.size(); ++i) n += p_.removed[i] == 0;
   if (n < 4) return std::numeric_limits<double>::quiet_NaN();
   // Affine fit v ≈ v0 + L·(x − x̄): L = (Σ v'x'ᵀ)(Σ x'x'ᵀ)⁻¹.
   Eigen::Vector3d xm = Eigen::Vector3d::Zero(), vm = Eigen::Vector3d::Zero();
   double dsum = 0;
-  for (std::size_t i = 0; i < n; ++i) {
+  std::size_t first = p_.size();
+  for (std::size_t i = 0; i < p_.size(); ++i) {
+    if (p_.removed[i]) continue;
+    first = std::min(first, i);
     xm += p_.pos[i];
     vm += p_.vel[i];
     dsum += 2 * p_.radius[i];
@@ -696,8 +723,9 @@ double Simulation::inertial_number() const {
   xm /= static_cast<double>(n);
   vm /= static_cast<double>(n);
   Eigen::Matrix3d xx = Eigen::Matrix3d::Zero(), vx = Eigen::Matrix3d::Zero();
-  Eigen::Vector3d lo = p_.pos[0], hi = p_.pos[0];
-  for (std::size_t i = 0; i < n; ++i) {
+  Eigen::Vector3d lo = p_.pos[first], hi = p_.pos[first];
+  for (std::size_t i = 0; i < p_.size(); ++i) {
+    if (p_.removed[i]) continue;
     const Eigen::Vector3d x = p_.pos[i] - xm, v = p_.vel[i] - vm;
     xx += x * x.transpose();
     vx += v * x.transpose();

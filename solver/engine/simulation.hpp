@@ -125,6 +125,13 @@ class Simulation {
   void set_facet_forces(bool on);
   bool facet_forces() const { return facet_forces_; }
 
+  /// Filling (seed 004 §5.2): the particles `indices` are not yet in the scene — frozen, in no
+  /// contact, not in frames — until insert_particle places one (at rest). Their state is kept
+  /// in checkpoints (ParticleState::removed = 2).
+  void set_pending(const std::vector<std::uint32_t>& indices);
+  void insert_particle(std::uint32_t i, const Eigen::Vector3d& position);
+  bool pending(std::size_t i) const { return p_.removed[i] == 2; }
+
   /// Forces a neighbour-list rebuild before the next step.
   void invalidate_neighbors() { nl_.ref_pos.clear(); }
 

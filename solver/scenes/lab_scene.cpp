@@ -10,7 +10,7 @@
 namespace gs::solver {
 
 double FixedSteps::progress(const Simulation& sim) const {
-  const auto span = std::max<std::int64_t>(1, steps_ - first_);
+  const auto span = std::max<std::int64_t>(1, relative_ ? steps_ : steps_ - first_);
   return std::clamp(static_cast<double>(sim.step_count() - first_) / static_cast<double>(span), 0.0,
                     1.0);
 }
@@ -52,7 +52,10 @@ std::vector<Particle> generate(const Scene& s, const Eigen::Vector3d& cloud) {
 std::vector<std::unique_ptr<LoadingProgramme>> scene_programmes(Scene& s) {
   std::vector<std::unique_ptr<LoadingProgramme>> out;
   if (s.test.empty()) {
-    out.push_back(std::make_unique<FixedSteps>(s.steps, s.output.every));
+    if (s.fill)
+      out.push_back(std::make_unique<LayeredFilling>(*s.fill, s.fill_first, s.fill_layers,
+                                                     s.output.every, s.open_after_fill));
+    out.push_back(std::make_unique<FixedSteps>(s.steps, s.output.every, s.fill.has_value()));
     return out;
   }
   const double test_friction = s.config.material.friction_deg;

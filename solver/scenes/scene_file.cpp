@@ -325,6 +325,68 @@ void read_clumps(const Reader& r, const toml::table& root, const std::filesystem
     for (const auto i : c.members) s.particles[i].clump_id = c.id;
 }
 
+/// [fill]: layers of a grading inserted into a region (layered_filling.hpp). The particles are
+/// appended to the scene's (ids after every particle and clump), waiting for insertion; the
+/// first layer is placed here already, so that a region too small for it is an error now.
+void read_fill(const Reader& r, Scene& s) {
+  const auto* t = r.table("fill", false);
+  if (!t) return;
+  if (!s.test.empty()) r.fail("[fill]", "a laboratory test makes its own specimen; remove [fill]");
+  r.only(t, "fill",
+         {"region_lo_m", "region_hi_m", "layers", "count", "dmin_m", "dmax_m", "distribution",
+          "seed", "kinetic_ratio", "min_steps", "max_steps", "max_attempts"});
+  FillSpec f;
+  f.region_lo_m = r.vec3(t, "fill", "region_lo_m", true, {});
+  f.region_hi_m = r.vec3(t, "fill", "region_hi_m", true, {});
+  if (!(f.region_lo_m.array() < f.region_hi_m.array()).all())
+    r.fail("fill.region_hi_m", "must exceed region_lo_m on every axis");
+  f.layers = static_cast<int>(r.integer(t, "fill", "layers", false, 6, 1));
+  f.count = r.integer(t, "fill", "count", true, 0, f.layers);
+  if (f.count > 20000000) r.fail("fill.count", "more than 20 million", std::to_string(f.count));
+  f.sizes.dmin_m = r.positive(t, "fill", "dmin_m", true, 0);
+  f.sizes.dmax_m = r.positive(t, "fill", "dmax_m", true, 0);
+  if (f.sizes.dmax_m < f.sizes.dmin_m)
+    r.fail("fill.dmax_m", "smaller than dmin_m", value_str(f.sizes.dmax_m));
+  const std::string dist = r.string(t, "fill", "distribution", false, "uniform");
+  if (dist == "linear")
+    f.sizes.distribution = SizeDistribution::Linear;
+  else if (dist != "uniform")
+    r.fail("fill.distribution", "expected \"uniform\" or \"linear\"", dist);
+  f.seed = static_cast<std::uint64_t>(r.integer(t, "fill", "seed", false, 1, 0));
+  f.kinetic_ratio = r.positive(t, "fill", "kinetic_ratio", false, f.kinetic_ratio);
+  f.min_steps = r.integer(t, "fill", "min_steps", false, f.min_steps, 1);
+  f.max_steps = r.integer(t, "fill", "max_steps", false, f.max_steps, f.min_steps);
+  f.max_attempts = static_cast<int>(r.integer(t, "fill", "max_attempts", false, 20000, 1));
+  if (!(s.config.gravity.norm() > 0)) r.fail("solver.gravity_m_s2", "[fill] needs gravity");
+  std::int64_t next_id = 0;
+  for (const auto& p : s.particles) next_id = std::max(next_id, p.id + 1);
+  for (const auto& c : s.clumps) next_id = std::max(next_id, c.id + 1);
+  FillParticles fp;
+  try {
+    fp = fill_particles(f, next_id);
+  } catch (const std::invalid_argument& e) {
+    r.fail("[fill]", e.what());
+  }
+  // The first layer must fit among what is there at the start.
+  {
+    const Simulation probe(s.config, s.particles, s.walls);
+    std::vector<double> radii;
+    for (const auto k : fp.layers[0]) radii.push_back(fp.particles[k].radius);
+    const auto placed = place_in_region(probe, radii, f.region_lo_m, f.region_hi_m,
+                                        f.seed + 0x9e3779b97f4a7c15ull, f.max_attempts);
+    if (placed.size() < radii.size())
+      r.fail("fill.region_hi_m",
+             "the region takes " + std::to_string(placed.size()) + " of the " +
+                 std::to_string(radii.size()) + " particles of a layer (enlarge it, use more " +
+                 "layers or fewer particles)",
+             std::to_string(f.count));
+  }
+  s.fill_first = static_cast<std::uint32_t>(s.particles.size());
+  s.fill_layers = fp.layers;
+  for (auto& p : fp.particles) s.particles.push_back(p);
+  s.fill = f;
+}
+
 }  // namespace
 
 Scene load_scene(const std::filesystem::path& path) {
@@ -346,7 +408,7 @@ Scene load_scene(const std::filesystem::path& path) {
     static const char* sections[] = {"scene",          "material",     "solver",      "output",
                                      "walls",          "specimen",     "preparation", "triaxial",
                                      "plane_strain",   "direct_shear", "mesh",        "outlet",
-                                     "clump_template", "clumps"};
+                                     "clump_template", "clumps",       "fill"};
     if (std::find(std::begin(sections), std::end(sections), k.str()) == std::end(sections))
       r.fail("[" + std::string(k.str()) + "]", "unknown section");
   }
@@ -359,7 +421,9 @@ Scene load_scene(const std::filesystem::path& path) {
     r.fail("scene.test", "expected \"triaxial\", \"plane_strain\" or \"direct_shear\"", s.test);
   const auto* specimen = r.table("specimen", false);
   const bool has_packing = scene->contains("packing");
-  if (s.test.empty() || has_packing || !specimen) {
+  // A plain scene may start empty when clumps or a filling bring its particles.
+  const bool brought = root.contains("fill") || root.contains("clumps");
+  if (has_packing || (!specimen && !brought)) {
     const std::string packing = r.string(scene, "scene", "packing", true, "");
     const auto packing_path = path.parent_path() / packing;
     std::error_code missing;
@@ -435,10 +499,13 @@ Scene load_scene(const std::filesystem::path& path) {
   for (const auto& p : s.particles) radii.push_back(p.radius);
   if (s.specimen) radii.push_back(0.5 * s.specimen->sizes.dmin_m);
   s.dt_pwave = pwave_timestep(radii, m.density, m.young_ec);
+  double auto_dt_safety = 0;  // "auto": set again below, once clumps and fillings are in
   if (sol->contains("dt_s") && (*sol)["dt_s"].is_string()) {
     if (r.string(sol, "solver", "dt_s", true, "") != "auto")
       r.fail("solver.dt_s", "expected a number or \"auto\"");
-    s.config.dt = r.positive(sol, "solver", "dt_safety", false, 0.3) * s.dt_pwave;
+    auto_dt_safety = r.positive(sol, "solver", "dt_safety", false, 0.3);
+    s.config.dt = auto_dt_safety * pwave_timestep(radii, m.density, m.young_ec);
+    if (!std::isfinite(s.config.dt)) s.config.dt = 1;  // (no particles yet: set below)
   } else {
     s.config.dt = r.positive(sol, "solver", "dt_s", true, 0);
   }
@@ -469,9 +536,9 @@ Scene load_scene(const std::filesystem::path& path) {
   s.output.specimen = r.string(out, "output", "specimen", false, s.output.specimen);
   s.output.preparation = r.string(out, "output", "preparation", false, s.output.preparation);
   if (out && out->contains("facet_forces")) {
-    const auto v = (*out)["facet_forces"].value<bool>();
+    const auto* v = (*out)["facet_forces"].as_boolean();
     if (!v) r.fail("output.facet_forces", "expected true or false");
-    s.output.facet_forces = *v;
+    s.output.facet_forces = v->get();
   }
   read_lab_sections(r, root, s);
 
@@ -526,9 +593,10 @@ Scene load_scene(const std::filesystem::path& path) {
       const auto* m = (*meshes)[i].as_table();
       const std::string sec = "mesh[" + std::to_string(i) + "]";
       if (!m) r.fail(sec, "expected a table");
-      r.only(m, sec,
-             {"file", "scale", "contact", "velocity_m_s", "friction_deg", "name",
-              "angular_velocity_rad_s", "rotation_center_m", "servo", "off_at_s"});
+      r.only(
+          m, sec,
+          {"file", "scale", "contact", "velocity_m_s", "friction_deg", "name",
+           "angular_velocity_rad_s", "rotation_center_m", "servo", "off_at_s", "off_after_fill"});
       const std::string file_name = r.string(m, sec, "file", true, "");
       const auto mesh_path = path.parent_path() / file_name;
       std::error_code missing;
@@ -574,6 +642,12 @@ Scene load_scene(const std::filesystem::path& path) {
         servo.normal = r.vec3(sv, ss, "axis", true, {});
         if (!(servo.normal.norm() > 0)) r.fail(ss + ".axis", "must not be zero");
       }
+      bool off_after_fill = false;
+      if (m->contains("off_after_fill")) {
+        const auto* v = (*m)["off_after_fill"].as_boolean();
+        if (!v) r.fail(sec + ".off_after_fill", "expected true or false");
+        off_after_fill = v->get();
+      }
       const int body = static_cast<int>(i);
       try {
         for (auto& w :
@@ -590,6 +664,7 @@ Scene load_scene(const std::filesystem::path& path) {
           w.servo_gain = servo.servo_gain;
           w.servo_max_velocity = servo.servo_max_velocity;
           w.normal = servo.normal;
+          if (off_after_fill) s.open_after_fill.push_back(s.walls.size());
           s.walls.push_back(std::move(w));
         }
       } catch (const std::invalid_argument& e) {
@@ -606,6 +681,16 @@ Scene load_scene(const std::filesystem::path& path) {
       r.fail("outlet.keep_hi_m", "must exceed keep_lo_m on every axis");
     s.outlet = std::make_pair(lo, hi);
   }
+  read_fill(r, s);
+  {
+    std::vector<double> all;
+    for (const auto& p : s.particles) all.push_back(p.radius);
+    if (s.specimen) all.push_back(0.5 * s.specimen->sizes.dmin_m);
+    s.dt_pwave = pwave_timestep(all, s.config.material.density, s.config.material.young_ec);
+    if (auto_dt_safety > 0) s.config.dt = auto_dt_safety * s.dt_pwave;
+  }
+  if (!s.open_after_fill.empty() && !s.fill)
+    r.fail("[[mesh]].off_after_fill", "there is no [fill] section");
   std::ostringstream flat;
   flat << root;
   s.parameters.emplace_back("scene.toml", flat.str());

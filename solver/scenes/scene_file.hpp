@@ -11,6 +11,7 @@
 #include <optional>
 
 #include "direct_shear.hpp"
+#include "layered_filling.hpp"
 #include "loading_programme.hpp"
 #include "plane_strain_compression.hpp"
 #include "simulation.hpp"
@@ -55,6 +56,13 @@ struct Scene {
   std::vector<ClumpBody> clumps;
   /// [outlet]: particles leaving [keep_lo, keep_hi] are removed (Simulation::set_outlet).
   std::optional<std::pair<Eigen::Vector3d, Eigen::Vector3d>> outlet;
+  /// [fill]: layers inserted into a region before the `steps` run (LayeredFilling); the fill
+  /// particles are `particles` from fill_first on, waiting for insertion; the walls
+  /// open_after_fill are switched off when the filling ends.
+  std::optional<FillSpec> fill;
+  std::uint32_t fill_first = 0;
+  std::vector<std::vector<std::uint32_t>> fill_layers;
+  std::vector<std::size_t> open_after_fill;
   std::int64_t steps = 0;
   OutputSpec output;
   std::vector<std::pair<std::string, std::string>> parameters;  // flattened, for run metadata
@@ -79,11 +87,15 @@ std::vector<std::unique_ptr<LoadingProgramme>> scene_programmes(Scene& scene);
 /// A plain run: `steps` steps, a frame every `every` steps.
 class FixedSteps final : public LoadingProgramme {
  public:
-  FixedSteps(std::int64_t steps, std::int64_t every) : steps_(steps), every_(every) {}
+  /// `relative`: `steps` counted from where the programme starts (after a filling), not from 0.
+  FixedSteps(std::int64_t steps, std::int64_t every, bool relative = false)
+      : steps_(steps), every_(every), relative_(relative) {}
   std::string name() const override { return "steps"; }
   void start(Simulation& sim) override { first_ = sim.step_count(); }
   void control(Simulation&) override {}
-  bool finished(const Simulation& sim) const override { return sim.step_count() >= steps_; }
+  bool finished(const Simulation& sim) const override {
+    return sim.step_count() >= (relative_ ? first_ : 0) + steps_;
+  }
   double progress(const Simulation& sim) const override;
   std::string curve_header() const override { return {}; }
   std::string curve_row(const Simulation&) const override { return {}; }
@@ -95,7 +107,9 @@ class FixedSteps final : public LoadingProgramme {
   void load_state(const std::string& state) override;
 
  private:
-  std::int64_t steps_, every_, first_ = 0;
+  std::int64_t steps_, every_;
+  bool relative_ = false;
+  std::int64_t first_ = 0;
 };
 
 /// Reads and checks a scene file. Throws InputError "FILE: key: what (value)".

@@ -450,3 +450,174 @@ TEST(Simulate, BadClumpsNameTheFieldAndValue) {
        "clumps.mass: expected \"member_sum\" or \"union\" (heavy)"}};
   expect_one_line_errors(dir.path, base, cases);
 }
+
+// Filling in layers, then the outlet opened (seed 004 §5.2's preparation and discharge): 3
+// layers of 40 spheres fall onto a square mesh floor inside plane walls; the floor is switched
+// off once the last layer has settled and every sphere then leaves through the outlet below it.
+// The frames show the layers arriving (40, 80, 120 spheres in the scene), the history counts
+// all 120 removed with their mass, and the filling ends before the discharge starts.
+TEST(Simulate, FillInLayersThenOpenTheFloorAndDischargeEverything) {
+  gs::test::ScratchDir dir("sim_fill");
+  write_text(dir / "floor.stl",
+             "solid floor\nfacet normal 0 0 1\n outer loop\n  vertex 0 0 0\n  vertex 10 0 0\n  "
+             "vertex 10 10 0\n endloop\nendfacet\nfacet normal 0 0 1\n outer loop\n  vertex 0 0 "
+             "0\n  vertex 10 10 0\n  vertex 0 10 0\n endloop\nendfacet\nendsolid floor\n");
+  std::string walls;
+  for (const char* w : {"point_m = [0.0, 0.0, 0.0]\nnormal = [1.0, 0.0, 0.0]",
+                        "point_m = [0.01, 0.0, 0.0]\nnormal = [-1.0, 0.0, 0.0]",
+                        "point_m = [0.0, 0.0, 0.0]\nnormal = [0.0, 1.0, 0.0]",
+                        "point_m = [0.0, 0.01, 0.0]\nnormal = [0.0, -1.0, 0.0]"})
+    walls += std::string("[[walls]]\nshape = \"plane\"\n") + w + "\n";
+  write_text(dir / "scene.toml", R"([scene]
+name = "fill"
+[material]
+young_Pa = 1.0e6
+stiffness_ratio = 0.3
+friction_deg = 25.0
+density_kg_m3 = 2550.0
+[solver]
+dt_s = 1.0e-5
+damping = 0.3
+gravity_m_s2 = [0.0, 0.0, -9.81]
+steps = 20000
+[output]
+trajectory = "fill.h5"
+every = 1000
+history_every = 1000
+checkpoint_every = 100000
+[[mesh]]
+file = "floor.stl"
+scale = 0.001
+off_after_fill = true
+[fill]
+region_lo_m = [0.0, 0.0, 0.006]
+region_hi_m = [0.01, 0.01, 0.012]
+layers = 3
+count = 120
+dmin_m = 0.0012
+dmax_m = 0.0016
+seed = 2
+[outlet]
+keep_lo_m = [-1.0, -1.0, -0.02]
+keep_hi_m = [1.0, 1.0, 1.0]
+)" + walls);
+  std::string err;
+  ASSERT_EQ(
+      run("simulate " + (dir / "scene.toml").string() + " -q -o " + (dir / "out").string(), &err),
+      0)
+      << err;
+  const auto t = gs::read_hdf5_trajectory(dir / "out" / "fill.h5");
+  std::vector<std::size_t> counts;
+  for (const auto& f : t.frames)
+    if (counts.empty() || counts.back() != f.particles.size()) counts.push_back(f.particles.size());
+  ASSERT_GE(counts.size(), 4u);
+  EXPECT_EQ(counts[0], 40u);
+  EXPECT_EQ(counts[1], 80u);
+  EXPECT_EQ(counts[2], 120u);
+  EXPECT_EQ(t.frames.back().particles.size(), 0u);  // all discharged
+  const double removed = last_history_value(dir / "out" / "history.csv", "removed");
+  EXPECT_EQ(removed, 120.0);
+  double mass = 0;
+  for (const auto& f : t.frames)
+    if (f.particles.size() == 120u) {
+      for (const auto& p : f.particles) mass += p.mass;
+      break;
+    }
+  EXPECT_NEAR(last_history_value(dir / "out" / "history.csv", "removed_mass_kg"), mass,
+              1e-12 * mass);
+}
+
+// A [fill] whose region cannot take a layer: one line saying how many fitted, exit 2.
+TEST(Simulate, FillRegionTooSmallSaysHowManyFitted) {
+  gs::test::ScratchDir dir("sim_fill_bad");
+  write_text(dir / "floor.stl", slotted_floor_stl());
+  const std::string base =
+      "[scene]\nname = \"b\"\n[material]\nyoung_Pa = 1e7\n"
+      "stiffness_ratio = 0.3\nfriction_deg = 30.0\ndensity_kg_m3 = 2500.0\n"
+      "[solver]\ndt_s = 1e-6\nsteps = 10\ngravity_m_s2 = [0.0, 0.0, -9.81]\n";
+  const std::string fill =
+      "[fill]\nregion_lo_m = [0.0, 0.0, 0.0]\nregion_hi_m = [0.01, 0.01, 0.0025]\nlayers = 2\n"
+      "dmin_m = 0.002\ndmax_m = 0.002\nmax_attempts = 500\n";
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {fill + "count = 400\n", "fill.region_hi_m: the region takes "},
+      {fill + "count = 400\n", " of the 200 particles of a layer"},
+      {fill + "count = 1\n", "fill.count: must be at least 2 (1)"},
+      {"[fill]\nregion_lo_m = [0.0, 0.0, 0.0]\nregion_hi_m = [0.01, 0.01, 0.0]\ncount = 10\n"
+       "dmin_m = 0.001\ndmax_m = 0.001\n",
+       "fill.region_hi_m: must exceed region_lo_m"},
+      {fill + "count = 4\n[[mesh]]\nfile = \"floor.stl\"\noff_after_fill = 1\n",
+       "mesh[0].off_after_fill: expected true or false"}};
+  expect_one_line_errors(dir.path, base, cases);
+}
+
+// Per-facet forces on request: the history gets a column triple per triangle, and the
+// triangles' forces add up to their group's (the six spheres resting on the two strips).
+TEST(Simulate, PerFacetForcesInTheHistoryAddUpToTheGroupForce) {
+  gs::test::ScratchDir dir("sim_facet_forces");
+  write_text(dir / "floor.stl", slotted_floor_stl());
+  std::ostringstream packing;
+  packing << "id,x,y,z,r\n";
+  for (int i = 0; i < 6; ++i)
+    packing << i << "," << (i < 3 ? 0.0015 : 0.0085) << "," << 0.002 + 0.003 * (i % 3)
+            << ",0.001,0.0008\n";
+  write_text(dir / "packing.csv", packing.str());
+  write_text(dir / "scene.toml", R"([scene]
+name = "ff"
+packing = "packing.csv"
+[material]
+young_Pa = 1.0e7
+stiffness_ratio = 0.3
+friction_deg = 30.0
+density_kg_m3 = 2500.0
+[solver]
+dt_s = 2.0e-6
+damping = 0.3
+gravity_m_s2 = [0.0, 0.0, -9.81]
+steps = 20000
+[output]
+every = 20000
+history_every = 1000
+checkpoint_every = 20000
+facet_forces = true
+[[mesh]]
+file = "floor.stl"
+scale = 0.001
+)");
+  std::string err;
+  ASSERT_EQ(
+      run("simulate " + (dir / "scene.toml").string() + " -q -o " + (dir / "out").string(), &err),
+      0)
+      << err;
+  const auto h = dir / "out" / "history.csv";
+  double sum = 0;
+  for (const char* w : {"floor:0.0", "floor:0.1", "floor:1.0", "floor:1.1"})
+    sum += last_history_value(h, std::string(w) + "_fz_N");
+  const double group = last_history_value(h, "floor_fz_N");
+  const double m = 2500.0 * 4.0 / 3.0 * M_PI * std::pow(0.0008, 3);
+  EXPECT_NEAR(group, -6 * m * 9.81, 1e-6 * 6 * m * 9.81);
+  EXPECT_NEAR(sum, group, 1e-12 * std::abs(group));
+  // The group's torque about the centre of the floor's bounding box (5, 5, 0) mm: the strips
+  // carry three spheres each, symmetric about y = 5 mm and x = 5 mm: no net torque.
+  EXPECT_NEAR(last_history_value(h, "floor_tx_Nm"), 0, 1e-9 * 6 * m * 9.81 * 0.005);
+  EXPECT_NEAR(last_history_value(h, "floor_ty_Nm"), 0, 1e-9 * 6 * m * 9.81 * 0.005);
+}
+
+// Bad mesh motion keys: one line naming the key and value.
+TEST(Simulate, BadMeshMotionNamesTheKey) {
+  gs::test::ScratchDir dir("sim_mesh_motion_bad");
+  write_text(dir / "floor.stl", slotted_floor_stl());
+  write_text(dir / "packing.csv", "id,x,y,z,r\n0,0.005,0.005,0.003,0.0008\n");
+  const std::string base =
+      "[scene]\nname = \"b\"\npacking = \"packing.csv\"\n[material]\nyoung_Pa = 1e7\n"
+      "stiffness_ratio = 0.3\nfriction_deg = 30.0\ndensity_kg_m3 = 2500.0\n"
+      "[solver]\ndt_s = 1e-6\nsteps = 10\n[[mesh]]\nfile = \"floor.stl\"\n";
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"off_at_s = -1.0\n", "mesh[0].off_at_s: must be >= 0 (-1)"},
+      {"servo = { stress_Pa = 1e3, area_m2 = 1e-4, gain_m_s_per_Pa = 1e-6, max_velocity_m_s = "
+       "0.1, axis = [0.0, 0.0, 0.0] }\n",
+       "mesh[0].servo.axis: must not be zero"},
+      {"angular_velocity_rad_s = [0.0, 1.0]\n", "mesh[0].angular_velocity_rad_s"},
+      {"off_after_fill = true\n", "[[mesh]].off_after_fill: there is no [fill] section"},
+      {"[output]\nfacet_forces = \"yes\"\n", "output.facet_forces: expected true or false"}};
+  expect_one_line_errors(dir.path, base, cases);
+}

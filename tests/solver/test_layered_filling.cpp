@@ -1,0 +1,200 @@
+// Filling in layers (seed 004 §5.2): each layer inserted once the kinetic energy is negligible,
+// without overlaps with the particles and walls already there; a region that cannot take a
+// layer says how many particles fitted; a filling resumes from a checkpoint bit for bit.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+
+#include "layered_filling.hpp"
+#include "mesh_walls.hpp"
+#include "simulation.hpp"
+
+using namespace gs;
+using solver::FillSpec;
+
+namespace {
+
+solver::SimulationConfig config() {
+  solver::SimulationConfig c;
+  c.material.young_ec = 1e6;
+  c.material.stiffness_ratio = 0.3;
+  c.material.friction_deg = 25;
+  c.material.density = 2550;
+  c.dt = 1e-5;
+  c.damping = 0.3;
+  c.gravity = Eigen::Vector3d(0, 0, -9.81);
+  return c;
+}
+
+solver::WallSpec plane(const Eigen::Vector3d& point, const Eigen::Vector3d& normal) {
+  solver::WallSpec w;
+  w.shape = solver::WallShape::Plane;
+  w.center = point;
+  w.normal = normal;
+  return w;
+}
+
+/// A 12 mm square box of plane walls, open at the top.
+std::vector<solver::WallSpec> box() {
+  const double a = 0.012;
+  return {plane({0, 0, 0}, {0, 0, 1}), plane({0, 0, 0}, {1, 0, 0}), plane({a, 0, 0}, {-1, 0, 0}),
+          plane({0, 0, 0}, {0, 1, 0}), plane({0, a, 0}, {0, -1, 0})};
+}
+
+FillSpec spec() {
+  FillSpec f;
+  f.region_lo_m = Eigen::Vector3d(0, 0, 0.012);
+  f.region_hi_m = Eigen::Vector3d(0.012, 0.012, 0.02);
+  f.layers = 3;
+  f.count = 240;
+  f.sizes.dmin_m = 1.2e-3;
+  f.sizes.dmax_m = 1.8e-3;
+  f.seed = 5;
+  return f;
+}
+
+struct Filled {
+  solver::FillParticles fp;
+  solver::Simulation sim;
+  solver::LayeredFilling fill;
+  explicit Filled(const FillSpec& f = spec())
+      : fp(solver::fill_particles(f, 0)),
+        sim(config(), fp.particles, box()),
+        fill(f, 0, fp.layers, 1000) {}
+};
+
+std::size_t in_scene(const solver::Simulation& sim) {
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < sim.particles().size(); ++i) n += sim.particles().removed[i] == 0;
+  return n;
+}
+
+/// Smallest gap (m) between particle i and every other particle in the scene and the box walls.
+double smallest_gap(const solver::Simulation& sim, std::size_t i) {
+  const auto& p = sim.particles();
+  double gap = HUGE_VAL;
+  for (std::size_t j = 0; j < p.size(); ++j)
+    if (j != i && p.removed[j] == 0)
+      gap = std::min(gap, (p.pos[i] - p.pos[j]).norm() - p.radius[i] - p.radius[j]);
+  for (const auto& w : sim.walls())
+    gap = std::min(gap, (p.pos[i] - w.pos).dot(w.normal) - p.radius[i]);
+  return gap;
+}
+
+}  // namespace
+
+TEST(LayeredFilling, EachLayerFollowsOnceTheKineticEnergyIsNegligible) {
+  Filled s;
+  s.fill.start(s.sim);
+  EXPECT_EQ(in_scene(s.sim), 80u);
+  int layers = 1;
+  std::int64_t last = 0;
+  while (!s.fill.finished(s.sim)) {
+    const double ek = solver::LayeredFilling::settling_energy(s.sim),
+                 threshold = s.fill.threshold(s.sim);
+    s.fill.control(s.sim);
+    if (s.fill.layers_inserted() > layers) {
+      // Inserted only once the previous layer has fallen and come to rest.
+      EXPECT_LT(ek, threshold);
+      EXPECT_GE(s.sim.step_count() - last, 100);
+      ++layers;
+      last = s.sim.step_count();
+      EXPECT_EQ(in_scene(s.sim), 80u * static_cast<std::size_t>(layers));
+      // The new layer's particles overlap nothing (a layer at rest below, the walls).
+      double gap = HUGE_VAL;
+      for (const auto k : s.fp.layers[static_cast<std::size_t>(layers - 1)])
+        gap = std::min(gap, smallest_gap(s.sim, k));
+      EXPECT_GE(gap, 0.0);
+      std::printf("layer %d inserted at step %lld (E_k %.3g J < %.3g J), smallest gap %.3g m\n",
+                  layers, static_cast<long long>(last), ek, threshold, gap);
+    }
+    if (s.fill.finished(s.sim)) break;
+    s.sim.step();
+    ASSERT_LT(s.sim.step_count(), 300000);
+  }
+  EXPECT_EQ(layers, 3);
+  EXPECT_EQ(in_scene(s.sim), 240u);
+  EXPECT_LT(solver::LayeredFilling::settling_energy(s.sim), s.fill.threshold(s.sim));
+  // All of it came to rest inside the box, below the fill region's top.
+  for (std::size_t i = 0; i < 240; ++i) EXPECT_LT(s.sim.particles().pos[i].z(), 0.02);
+}
+
+TEST(LayeredFilling, ResumesFromACheckpointBitForBit) {
+  Filled a, b;
+  a.fill.start(a.sim);
+  auto advance = [](Filled& s, std::int64_t until) {
+    while (s.sim.step_count() < until && !s.fill.finished(s.sim)) {
+      s.fill.control(s.sim);
+      if (s.fill.finished(s.sim)) break;
+      s.sim.step();
+    }
+  };
+  // Past the second insertion, mid-fall.
+  std::int64_t k = 0;
+  while (a.fill.layers_inserted() < 2) advance(a, k += 1000);
+  advance(a, a.sim.step_count() + 777);
+  const auto ck = std::filesystem::temp_directory_path() / "gs_fill_ck.bin";
+  a.sim.save_checkpoint(ck, a.fill.save_state());
+  b.fill.load_state(b.sim.load_checkpoint(ck));
+  std::filesystem::remove(ck);
+  const std::int64_t end = a.sim.step_count() + 60000;
+  advance(a, end);
+  advance(b, end);
+  ASSERT_EQ(a.sim.step_count(), b.sim.step_count());
+  EXPECT_EQ(a.fill.layers_inserted(), 3);
+  EXPECT_EQ(b.fill.layers_inserted(), 3);
+  for (std::size_t i = 0; i < a.sim.particles().size(); ++i) {
+    EXPECT_EQ(a.sim.particles().pos[i], b.sim.particles().pos[i]) << i;
+    EXPECT_EQ(a.sim.particles().removed[i], b.sim.particles().removed[i]) << i;
+  }
+}
+
+// A region that cannot take a layer: the error says how many of its particles fitted.
+TEST(LayeredFilling, ARegionTooSmallSaysHowManyFitted) {
+  FillSpec f = spec();
+  f.region_hi_m.z() = 0.0142;  // a 2.2 mm slab: one sphere deep
+  f.max_attempts = 2000;
+  Filled s(f);
+  try {
+    s.fill.start(s.sim);
+    FAIL() << "no error";
+  } catch (const solver::FillError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("layer 1 of 3: the region took "), std::string::npos) << what;
+    EXPECT_NE(what.find(" of its 80 particles"), std::string::npos) << what;
+    const int took = std::stoi(what.substr(what.find("took ") + 5));
+    EXPECT_GT(took, 10);  // some fitted, one sphere deep
+    EXPECT_LT(took, 80);
+    std::printf("%s\n", what.c_str());
+  }
+}
+
+// Placement keeps clear of facet walls: a region cut by a tilted triangle gets spheres on both
+// sides, none closer to it than its radius.
+TEST(LayeredFilling, PlacementKeepsClearOfMeshFacets) {
+  solver::MeshTriangles m;
+  m.triangles = {{Eigen::Vector3d(-0.05, -0.05, 0.0), Eigen::Vector3d(0.05, -0.05, 0.004),
+                  Eigen::Vector3d(0.0, 0.05, 0.012)}};
+  m.group = {"ramp"};
+  solver::Simulation sim(config(), {}, solver::mesh_walls(m, solver::MeshContact::Merged));
+  std::vector<double> radii(200, 0.5e-3);
+  const auto x = solver::place_in_region(sim, radii, Eigen::Vector3d(-0.005, -0.005, 0),
+                                         Eigen::Vector3d(0.005, 0.005, 0.01), 9, 20000);
+  ASSERT_EQ(x.size(), 200u);
+  const auto& f = sim.walls()[0].facets[0];
+  const Eigen::Vector3d n = f.normal.eigen(), p0 = sim.walls()[0].pos + f.offset.eigen();
+  int above = 0;
+  double closest = HUGE_VAL;
+  for (const auto& xi : x) {
+    const double d = (xi - p0).dot(n);
+    above += d > 0;
+    closest = std::min(closest, std::abs(d));
+  }
+  std::printf("%d above, %zu below the ramp; closest centre %.4g m (radius 5e-4 m)\n", above,
+              x.size() - static_cast<std::size_t>(above), closest);
+  EXPECT_GT(above, 20);
+  EXPECT_LT(above, 180);
+  EXPECT_GE(closest, 0.5e-3);
+}
