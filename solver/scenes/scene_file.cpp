@@ -7,6 +7,7 @@
 #include <map>
 #include <sstream>
 
+#include "clump_shapes.hpp"
 #include "errors.hpp"
 #include "mesh_walls.hpp"
 #include "text_parse.hpp"
@@ -231,11 +232,25 @@ void read_clumps(const Reader& r, const toml::table& root, const std::filesystem
       const auto* t = (*ts)[i].as_table();
       const std::string sec = "clump_template[" + std::to_string(i) + "]";
       if (!t) r.fail(sec, "expected a table");
-      r.only(t, sec, {"name", "members"});
+      r.only(t, sec, {"name", "members", "shape", "diameter_m", "member_radius_m"});
       const std::string name = r.string(t, sec, "name", true, "");
+      std::vector<ClumpMember> members;
+      if (t->contains("shape")) {  // the seeds' shapes (clump_shapes.hpp)
+        if (t->contains("members")) r.fail(sec + ".members", "give either shape or members");
+        const std::string shape = r.string(t, sec, "shape", true, "");
+        if (shape == "asymmetric4") {
+          members = asymmetric_clump4(r.positive(t, sec, "diameter_m", true, 0));
+        } else if (shape == "dimer") {
+          members = dimer_clump(r.positive(t, sec, "member_radius_m", true, 0));
+        } else {
+          r.fail(sec + ".shape", "expected \"asymmetric4\" or \"dimer\"", shape);
+        }
+        if (!templates.emplace(name, members).second)
+          r.fail(sec + ".name", "template defined twice", name);
+        continue;
+      }
       const auto* ms = (*t)["members"].as_array();
       if (!ms || ms->empty()) r.fail(sec + ".members", "a clump template needs member spheres");
-      std::vector<ClumpMember> members;
       for (std::size_t k = 0; k < ms->size(); ++k) {
         const std::string key = sec + ".members[" + std::to_string(k) + "]";
         const auto* m = (*ms)[k].as_array();
@@ -258,10 +273,34 @@ void read_clumps(const Reader& r, const toml::table& root, const std::filesystem
     if (!templates.empty()) r.fail("[clumps]", "templates given but no [clumps] packing");
     return;
   }
-  r.only(clumps, "clumps", {"packing", "mass"});
+  r.only(clumps, "clumps", {"packing", "mass", "replace", "seed"});
   const std::string mass = r.string(clumps, "clumps", "mass", false, "member_sum");
   if (mass != "member_sum" && mass != "union")
     r.fail("clumps.mass", "expected \"member_sum\" or \"union\"", mass);
+  const ClumpMassModel model = mass == "union" ? ClumpMassModel::Union : ClumpMassModel::MemberSum;
+  if (clumps->contains("replace")) {
+    // Seed 003 §2.4: every sphere of the packing becomes a clump of its volume, randomly turned.
+    if (clumps->contains("packing")) r.fail("clumps.replace", "give either packing or replace");
+    const std::string name = r.string(clumps, "clumps", "replace", true, "");
+    const auto it = templates.find(name);
+    if (it == templates.end()) r.fail("clumps.replace", "unknown clump template", name);
+    if (s.particles.empty()) r.fail("clumps.replace", "the packing has no spheres to replace");
+    std::mt19937_64 rng(
+        static_cast<std::uint64_t>(r.integer(clumps, "clumps", "seed", false, 1, 0)));
+    auto rep =
+        replace_by_clumps(s.particles, it->second, s.config.material.density, model, rng, 0, 0);
+    // Members take the spheres' place (ids 0…), clumps are numbered after them.
+    s.particles = rep.members;
+    std::int64_t next = static_cast<std::int64_t>(s.particles.size());
+    for (auto& c : rep.clumps) {
+      c.id = next++;
+      c.template_name = name;
+      for (const auto i : c.members) s.particles[i].clump_id = c.id;
+    }
+    s.clumps = std::move(rep.clumps);
+    return;
+  }
+  if (clumps->contains("seed")) r.fail("clumps.seed", "only with replace");
   const auto file = path.parent_path() / r.string(clumps, "clumps", "packing", true, "");
   std::error_code missing;
   if (!std::filesystem::exists(file, missing))
@@ -313,9 +352,7 @@ void read_clumps(const Reader& r, const toml::table& root, const std::filesystem
       rad.push_back(p.radius);
       s.particles.push_back(p);
     }
-    auto body =
-        make_clump_body(index, pos, rad, s.config.material.density,
-                        mass == "union" ? ClumpMassModel::Union : ClumpMassModel::MemberSum);
+    auto body = make_clump_body(index, pos, rad, s.config.material.density, model);
     body.id = -1;  // (numbered after the particles by the scene: below)
     body.template_name = name;
     s.clumps.push_back(std::move(body));

@@ -621,3 +621,93 @@ TEST(Simulate, BadMeshMotionNamesTheKey) {
       {"[output]\nfacet_forces = \"yes\"\n", "output.facet_forces: expected true or false"}};
   expect_one_line_errors(dir.path, base, cases);
 }
+
+// Seed 003 §2.4's preparation in a scene: each sphere of the packing replaced by a clump of
+// seed 004's four-sphere shape with the sphere's volume, randomly turned: the frames hold four
+// members per sphere and the clump bodies, each weighing what its sphere weighed (true union
+// volume, to the 2e-5 of the union's quadrature), centred where the sphere was at step 0.
+TEST(Simulate, SpheresReplacedByEqualVolumeClumps) {
+  gs::test::ScratchDir dir("sim_clump_replace");
+  write_text(dir / "packing.csv",
+             "id,x,y,z,r\n0,0.000,0.0,0.002,0.0010\n1,0.004,0.0,0.002,0.0008\n"
+             "2,0.000,0.004,0.002,0.0009\n3,0.004,0.004,0.002,0.0011\n");
+  write_text(dir / "scene.toml", R"([scene]
+name = "replace"
+packing = "packing.csv"
+[material]
+young_Pa = 1.0e7
+stiffness_ratio = 0.3
+friction_deg = 30.0
+density_kg_m3 = 2650.0
+[solver]
+dt_s = 2.0e-6
+damping = 0.4
+gravity_m_s2 = [0.0, 0.0, -9.81]
+steps = 2000
+[output]
+trajectory = "r.h5"
+every = 1000
+history_every = 1000
+checkpoint_every = 2000
+[[walls]]
+name = "floor"
+shape = "plane"
+point_m = [0.0, 0.0, 0.0]
+normal = [0.0, 0.0, 1.0]
+[[clump_template]]
+name = "sand"
+shape = "asymmetric4"
+diameter_m = 0.001
+[clumps]
+replace = "sand"
+mass = "union"
+seed = 3
+)");
+  std::string err;
+  ASSERT_EQ(
+      run("simulate " + (dir / "scene.toml").string() + " -q -o " + (dir / "out").string(), &err),
+      0)
+      << err;
+  const auto t = gs::read_hdf5_trajectory(dir / "out" / "r.h5");
+  const auto& f0 = t.frames.front();
+  ASSERT_EQ(f0.particles.size(), 16u);
+  ASSERT_EQ(f0.clumps.size(), 4u);
+  const double r[4] = {0.0010, 0.0008, 0.0009, 0.0011};
+  const Eigen::Vector3d x[4] = {
+      {0, 0, 0.002}, {0.004, 0, 0.002}, {0, 0.004, 0.002}, {0.004, 0.004, 0.002}};
+  for (std::size_t c = 0; c < 4; ++c) {
+    const double m = 2650.0 * 4.0 / 3.0 * M_PI * std::pow(r[c], 3);
+    EXPECT_NEAR(f0.clumps[c].mass, m, 2e-5 * m) << c;
+    EXPECT_LT((f0.clumps[c].position - x[c]).norm(), 1e-5 * r[c]) << c;
+    EXPECT_EQ(f0.clumps[c].template_name, "sand");
+    int members = 0;
+    for (const auto& p : f0.particles) members += p.clump_id == f0.clumps[c].id;
+    EXPECT_EQ(members, 4);
+  }
+  // Different orientations.
+  EXPECT_LT(std::abs(f0.clumps[0].orientation.dot(f0.clumps[1].orientation)), 0.999);
+}
+
+TEST(Simulate, BadClumpShapesAndReplacementNameTheKey) {
+  gs::test::ScratchDir dir("sim_clump_replace_bad");
+  write_text(dir / "packing.csv", "id,x,y,z,r\n0,0.05,0.05,0.05,0.001\n");
+  write_text(dir / "ok.csv", "template,x,y,z,qw,qx,qy,qz\nsand,0,0,0.003,1,0,0,0\n");
+  const std::string base =
+      "[scene]\nname = \"b\"\npacking = \"packing.csv\"\n[material]\nyoung_Pa = 1e7\n"
+      "stiffness_ratio = 0.3\nfriction_deg = 30.0\ndensity_kg_m3 = 2500.0\n"
+      "[solver]\ndt_s = 1e-6\nsteps = 10\n";
+  const std::string sand =
+      "[[clump_template]]\nname = \"sand\"\nshape = \"asymmetric4\"\ndiameter_m = 0.001\n";
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"[[clump_template]]\nname = \"sand\"\nshape = \"potato\"\n[clumps]\nreplace = \"sand\"\n",
+       "clump_template[0].shape: expected \"asymmetric4\" or \"dimer\" (potato)"},
+      {"[[clump_template]]\nname = \"sand\"\nshape = \"asymmetric4\"\ndiameter_m = -1.0\n"
+       "[clumps]\nreplace = \"sand\"\n",
+       "clump_template[0].diameter_m: must be positive (-1)"},
+      {sand + "[clumps]\nreplace = \"gravel\"\n",
+       "clumps.replace: unknown clump template (gravel)"},
+      {sand + "[clumps]\nreplace = \"sand\"\npacking = \"ok.csv\"\n",
+       "clumps.replace: give either packing or replace"},
+      {sand + "[clumps]\npacking = \"ok.csv\"\nseed = 2\n", "clumps.seed: only with replace"}};
+  expect_one_line_errors(dir.path, base, cases);
+}
