@@ -125,6 +125,10 @@ enum Col : int {
   K_ANGVEL,
   K_MASS,
   K_INERTIA,
+  L_WALL,
+  L_FACET,
+  L_CENTROID,
+  L_FORCE,
   F_TIME,
   F_STEP,
   F_DT,
@@ -134,6 +138,7 @@ enum Col : int {
   F_PERIODIC,
   F_CELL,
   F_CLUMP_END,
+  F_FACET_END,
   F_END,
   N_COLS
 };
@@ -173,6 +178,10 @@ const std::vector<Column>& columns() {
       {"clumps", "angular_velocity", t_f64, {3}, kRowChunk, 2},
       {"clumps", "mass", t_f64, {}, kRowChunk, 2},
       {"clumps", "principal_inertia", t_f64, {3}, kRowChunk, 2},
+      {"facet_loads", "wall_id", t_i64, {}, kRowChunk, 2},
+      {"facet_loads", "facet", t_i32, {}, kRowChunk, 2},
+      {"facet_loads", "centroid", t_f64, {3}, kRowChunk, 2},
+      {"facet_loads", "force", t_f64, {3}, kRowChunk, 2},
       {"frames", "time", t_f64, {}, kFrameChunk},
       {"frames", "step", t_i64, {}, kFrameChunk},
       {"frames", "dt", t_f64, {}, kFrameChunk},
@@ -182,6 +191,7 @@ const std::vector<Column>& columns() {
       {"frames", "periodic", t_i8, {}, kFrameChunk},
       {"frames", "cell", t_f64, {3, 3}, kFrameChunk},
       {"frames", "clump_end", t_i64, {}, kFrameChunk, 2},
+      {"frames", "facet_end", t_i64, {}, kFrameChunk, 2},
       {"frames", "end", t_i64, {3}, kFrameChunk},
   };
   return cols;
@@ -418,7 +428,7 @@ struct TrajectoryWriter::Impl {
         write_string_attr(g.get(), k, v, name());
       }
     }
-    for (const char* g : {"particles", "contacts", "walls", "clumps", "frames"}) {
+    for (const char* g : {"particles", "contacts", "walls", "clumps", "facet_loads", "frames"}) {
       Hid grp(H5Gcreate2(file.get(), g, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose);
       if (!grp.valid()) throw InputError(name(), "cannot create group", g);
     }
@@ -439,13 +449,16 @@ struct TrajectoryWriter::Impl {
   /// Schema 1 -> current, before resuming: the datasets added since (empty clump rows, and a
   /// /frames/clump_end of zeros for the frames already written), then the version attribute.
   void upgrade_from_v1() {
-    Hid grp(H5Gcreate2(file.get(), "clumps", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose);
-    if (!grp.valid()) throw InputError(name(), "cannot create group", "clumps");
+    for (const char* g : {"clumps", "facet_loads"}) {
+      Hid grp(H5Gcreate2(file.get(), g, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose);
+      if (!grp.valid()) throw InputError(name(), "cannot create group", g);
+    }
     for (const auto& c : columns())
       if (c.since > 1) create_dataset(file.get(), c, options.deflate_level, name());
     open_datasets();
     const std::vector<std::int64_t> zeros(ds[F_END].rows, 0);
     ds[F_CLUMP_END].append(zeros.data(), zeros.size(), name());
+    ds[F_FACET_END].append(zeros.data(), zeros.size(), name());
     Hid a(H5Aopen(file.get(), "schema_version", H5P_DEFAULT), H5Aclose);
     const long long v = kTrajectorySchemaVersion;
     if (!a.valid() || H5Awrite(a.get(), H5T_NATIVE_LLONG, &v) < 0)
@@ -510,6 +523,13 @@ struct TrajectoryWriter::Impl {
     wr(K_INERTIA, gather<double>(nk, 3, [&](auto i, auto* o) { put3(o, K[i].principal_inertia); }),
        nk);
 
+    const auto& L = f.facet_loads;
+    const hsize_t nl = L.size();
+    wr(L_WALL, gather<std::int64_t>(nl, 1, [&](auto i, auto* o) { *o = L[i].wall_id; }), nl);
+    wr(L_FACET, gather<std::int32_t>(nl, 1, [&](auto i, auto* o) { *o = L[i].facet; }), nl);
+    wr(L_CENTROID, gather<double>(nl, 3, [&](auto i, auto* o) { put3(o, L[i].centroid); }), nl);
+    wr(L_FORCE, gather<double>(nl, 3, [&](auto i, auto* o) { put3(o, L[i].force); }), nl);
+
     const std::int8_t two_d = f.two_d ? 1 : 0, periodic = f.domain.periodic ? 1 : 0;
     double lo[3], hi[3], cell[9];
     put3(lo, f.domain.lo);
@@ -526,6 +546,8 @@ struct TrajectoryWriter::Impl {
     ds[F_CELL].append(cell, 1, n);
     const auto clump_end = static_cast<std::int64_t>(ds[K_ID].rows);
     ds[F_CLUMP_END].append(&clump_end, 1, n);
+    const auto facet_end = static_cast<std::int64_t>(ds[L_WALL].rows);
+    ds[F_FACET_END].append(&facet_end, 1, n);
     flush();
     // Commit marker: the frame exists for readers once its end offsets are on disk.
     const std::int64_t end[3] = {static_cast<std::int64_t>(ds[P_ID].rows),
@@ -591,7 +613,7 @@ TrajectoryWriter TrajectoryWriter::resume(std::filesystem::path path, std::size_
   impl->open_datasets();
   const std::size_t have = impl->ds[F_END].rows;
   const std::size_t keep = std::min(have, keep_frames);
-  std::array<std::int64_t, 4> end{0, 0, 0, 0};  // particles, contacts, walls, clumps
+  std::array<std::int64_t, 5> end{0, 0, 0, 0, 0};  // particles, contacts, walls, clumps, facets
   if (keep > 0) {
     auto read_row = [&](int col, std::int64_t* out) {
       const hsize_t w = row_width(columns()[col]);
@@ -606,15 +628,17 @@ TrajectoryWriter TrajectoryWriter::resume(std::filesystem::path path, std::size_
     };
     read_row(F_END, end.data());
     read_row(F_CLUMP_END, end.data() + 3);
+    read_row(F_FACET_END, end.data() + 4);
   }
   for (int i = 0; i < N_COLS; ++i) {
     const auto& c = columns()[i];
     const std::string g = c.group;
-    const hsize_t rows = g == "particles"  ? end[0]
-                         : g == "contacts" ? end[1]
-                         : g == "walls"    ? end[2]
-                         : g == "clumps"   ? end[3]
-                                           : keep;
+    const hsize_t rows = g == "particles"     ? end[0]
+                         : g == "contacts"    ? end[1]
+                         : g == "walls"       ? end[2]
+                         : g == "clumps"      ? end[3]
+                         : g == "facet_loads" ? end[4]
+                                              : keep;
     if (rows == impl->ds[i].rows) continue;
     std::vector<hsize_t> dims{rows};
     dims.insert(dims.end(), c.tail.begin(), c.tail.end());
@@ -680,7 +704,7 @@ struct TrajectoryReader::Impl {
   long long version = 0;
   // Per-frame tables, read once (clump_end: zeros for a version 1 file).
   std::vector<double> time, dt, lo, hi, cell;
-  std::vector<std::int64_t> step, end, clump_end;
+  std::vector<std::int64_t> step, end, clump_end, facet_end;
   std::vector<std::int8_t> two_d, periodic;
 
   bool has(int col) const { return columns()[col].since <= version; }
@@ -798,11 +822,13 @@ struct TrajectoryReader::Impl {
     cell = read_rows<double>(F_CELL, 0, n);
     end = read_rows<std::int64_t>(F_END, 0, n);
     clump_end = read_rows<std::int64_t>(F_CLUMP_END, 0, n);
-    // Row groups k = particles, contacts, walls (columns of /frames/end), clumps (clump_end).
-    const hsize_t limits[4] = {rows[P_ID], rows[C_ID1], rows[W_ID], rows[K_ID]};
-    const int first_col[4] = {P_ID, C_ID1, W_ID, K_ID};
-    const int last_col[4] = {P_MAT, C_OVERLAP, W_TORQUE, K_INERTIA};
-    for (int k = 0; k < 4; ++k) {
+    facet_end = read_rows<std::int64_t>(F_FACET_END, 0, n);
+    // Row groups k = particles, contacts, walls (columns of /frames/end), clumps (clump_end),
+    // facet loads (facet_end).
+    const hsize_t limits[5] = {rows[P_ID], rows[C_ID1], rows[W_ID], rows[K_ID], rows[L_WALL]};
+    const int first_col[5] = {P_ID, C_ID1, W_ID, K_ID, L_WALL};
+    const int last_col[5] = {P_MAT, C_OVERLAP, W_TORQUE, K_INERTIA, L_FORCE};
+    for (int k = 0; k < 5; ++k) {
       for (int c = first_col[k]; c <= last_col[k]; ++c)
         if (rows[c] != limits[k])
           throw InputError(file_name, "datasets of one group differ in length",
@@ -813,15 +839,19 @@ struct TrajectoryReader::Impl {
         if (e < prev || static_cast<hsize_t>(e) > limits[k])
           throw InputError(file_name,
                            std::string("corrupt frame index ") +
-                               (k < 3 ? "/frames/end" : "/frames/clump_end") + " at frame " +
-                               std::to_string(i),
+                               (k < 3    ? "/frames/end"
+                                : k == 3 ? "/frames/clump_end"
+                                         : "/frames/facet_end") +
+                               " at frame " + std::to_string(i),
                            std::to_string(e));
         prev = e;
       }
     }
   }
 
-  std::int64_t end_of(std::size_t i, int k) const { return k < 3 ? end[i * 3 + k] : clump_end[i]; }
+  std::int64_t end_of(std::size_t i, int k) const {
+    return k < 3 ? end[i * 3 + k] : k == 3 ? clump_end[i] : facet_end[i];
+  }
 
   std::pair<hsize_t, hsize_t> range(std::size_t i, int k) const {
     const hsize_t b = i == 0 ? 0 : static_cast<hsize_t>(end_of(i - 1, k));
@@ -970,6 +1000,21 @@ Frame TrajectoryReader::frame(std::size_t i) const {
       c.angular_velocity = get3(&av[k * 3]);
       c.mass = mass[k];
       c.principal_inertia = get3(&inertia[k * 3]);
+    }
+  }
+  {
+    const auto [b, cnt] = m.range(i, 4);
+    const auto wall = m.read_rows<std::int64_t>(L_WALL, b, cnt);
+    const auto facet = m.read_rows<std::int32_t>(L_FACET, b, cnt);
+    const auto centroid = m.read_rows<double>(L_CENTROID, b, cnt);
+    const auto force = m.read_rows<double>(L_FORCE, b, cnt);
+    f.facet_loads.resize(cnt);
+    for (hsize_t k = 0; k < cnt; ++k) {
+      auto& l = f.facet_loads[k];
+      l.wall_id = wall[k];
+      l.facet = facet[k];
+      l.centroid = get3(&centroid[k * 3]);
+      l.force = get3(&force[k * 3]);
     }
   }
   validate_frame(f, m.file_name + " frame " + std::to_string(i));

@@ -134,6 +134,17 @@ void validate_frame(const Frame& f, const std::string& source) {
                        value_str(w.b.norm()));
   }
   validate_clumps(f, source);
+  if (!f.facet_loads.empty()) {
+    std::unordered_set<std::int64_t> walls;
+    for (const auto& w : f.walls) walls.insert(w.id);
+    for (const auto& l : f.facet_loads) {
+      check_finite(source, "facet load centroid", l.centroid);
+      check_finite(source, "facet load force", l.force);
+      if (!walls.count(l.wall_id))
+        throw InputError(source, "facet load names a missing wall", value_str(l.wall_id));
+      if (l.facet < 0) throw InputError(source, "negative facet index", value_str(l.facet));
+    }
+  }
 }
 
 }  // namespace gs

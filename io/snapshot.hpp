@@ -82,6 +82,16 @@ struct Clump {
   Eigen::Vector3d principal_inertia = Eigen::Vector3d::Zero();
 };
 
+/// The force on one triangle of a mesh wall (recorded on request, for wall-stress profiles):
+/// the wall's id, the triangle's index within the wall, its incircle centre (m) and the force
+/// the particles exert on it (N).
+struct FacetLoad {
+  std::int64_t wall_id = 0;
+  std::int32_t facet = 0;
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  Eigen::Vector3d force = Eigen::Vector3d::Zero();
+};
+
 struct Frame {
   double time = 0.0;  // s
   std::int64_t step = 0;
@@ -91,7 +101,8 @@ struct Frame {
   std::vector<Particle> particles;
   std::vector<Contact> contacts;
   std::vector<Wall> walls;
-  std::vector<Clump> clumps;  // empty for a frame of free spheres
+  std::vector<Clump> clumps;           // empty for a frame of free spheres
+  std::vector<FacetLoad> facet_loads;  // empty unless per-facet forces were asked for
 };
 
 /// Run-level metadata: free-form key/value scene parameters plus provenance.

@@ -870,6 +870,18 @@ Frame Simulation::frame() const {
     wall.torque = ws.torque;
     f.walls.push_back(wall);
   }
+  if (facet_forces_)  // per-triangle forces of the facet walls, at each triangle's incircle centre
+    for (std::size_t w = 0; w < walls_.size(); ++w) {
+      const auto& ws = walls_[w];
+      for (std::size_t k = 0; k < ws.facet_force.size(); ++k) {
+        FacetLoad l;
+        l.wall_id = wall_id(w);
+        l.facet = static_cast<std::int32_t>(k);
+        l.centroid = ws.pos + ws.facets[k].offset.eigen();
+        l.force = ws.facet_force[k];
+        f.facet_loads.push_back(l);
+      }
+    }
   f.clumps.reserve(clumps_.size());
   for (const auto& c : clumps_) {
     auto& q = f.clumps.emplace_back();

@@ -600,6 +600,19 @@ scale = 0.001
   // carry three spheres each, symmetric about y = 5 mm and x = 5 mm: no net torque.
   EXPECT_NEAR(last_history_value(h, "floor_tx_Nm"), 0, 1e-9 * 6 * m * 9.81 * 0.005);
   EXPECT_NEAR(last_history_value(h, "floor_ty_Nm"), 0, 1e-9 * 6 * m * 9.81 * 0.005);
+  // The trajectory's last frame holds the same per-triangle forces, summing to each wall's.
+  const auto t = gs::read_hdf5_trajectory(dir / "out" / "trajectory.h5");
+  const auto& f = t.frames.back();
+  ASSERT_EQ(f.facet_loads.size(), 4u);
+  double fz = 0;
+  for (const auto& l : f.facet_loads) fz += l.force.z();
+  EXPECT_NEAR(fz, group, 1e-12 * std::abs(group));
+  for (const auto& w : f.walls) {
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    for (const auto& l : f.facet_loads)
+      if (l.wall_id == w.id) sum += l.force;
+    EXPECT_LT((sum - w.force).norm(), 1e-12 * 6 * m * 9.81) << w.id;
+  }
 }
 
 // Bad mesh motion keys: one line naming the key and value.

@@ -385,9 +385,10 @@ const std::vector<std::pair<std::string, std::vector<std::string>>> kDocumentedD
     {"clumps",
      {"id", "template", "position", "orientation", "velocity", "angular_velocity", "mass",
       "principal_inertia"}},
+    {"facet_loads", {"wall_id", "facet", "centroid", "force"}},
     {"frames",
      {"time", "step", "dt", "two_d", "domain_lo", "domain_hi", "periodic", "cell", "clump_end",
-      "end"}},
+      "facet_end", "end"}},
 };
 
 }  // namespace
@@ -438,7 +439,7 @@ TEST(Hdf5Trajectory, EveryDatasetIsChunkedShuffledDeflatedAndChecksummed) {
       ++checked;
     }
   }
-  EXPECT_EQ(checked, 43);
+  EXPECT_EQ(checked, 48);
   H5Fclose(f);
 }
 
@@ -541,4 +542,52 @@ TEST(Hdf5Trajectory, FlippedChunkByteIsDetectedByTheChecksum) {
   EXPECT_EQ(back, ref);
   EXPECT_EQ(error_of([&] { (void)TrajectoryReader(sum).frame(0); }),
             sum.string() + ": cannot read dataset (corrupt or truncated) (/particles/position)");
+}
+
+// Per-facet loads (docs/format.md, /facet_loads): exact round trip, frame by frame, including a
+// frame without them; a load naming a missing wall is rejected with one line.
+TEST(Hdf5Trajectory, FacetLoadsRoundTripExactly) {
+  ScratchDir dir("h5facets");
+  Trajectory t;
+  t.metadata = meta();
+  t.frames = {random_frame(10, 5, 1), random_frame(12, 4, 2), random_frame(9, 3, 3)};
+  for (int k : {0, 2}) {
+    auto& f = t.frames[static_cast<std::size_t>(k)];
+    gs::Wall w;
+    w.id = 1000 + k;
+    w.kind = gs::WallKind::Facet;
+    f.walls.push_back(w);
+    for (int j = 0; j < 3 + k; ++j) {
+      gs::FacetLoad l;
+      l.wall_id = w.id;
+      l.facet = j;
+      l.centroid = Eigen::Vector3d(0.1 * j, -0.2, 1.0 / 3.0 + k);
+      l.force = Eigen::Vector3d(std::sqrt(2.0) * j, -1e-9, M_PI * k);
+      f.facet_loads.push_back(l);
+    }
+  }
+  write_hdf5_trajectory(dir / "f.h5", t);
+  const auto r = read_hdf5_trajectory(dir / "f.h5");
+  ASSERT_EQ(r.frames.size(), 3u);
+  EXPECT_EQ(r.frames[1].facet_loads.size(), 0u);
+  for (int k : {0, 2}) {
+    const auto& a = t.frames[static_cast<std::size_t>(k)].facet_loads;
+    const auto& b = r.frames[static_cast<std::size_t>(k)].facet_loads;
+    ASSERT_EQ(a.size(), b.size());
+    for (std::size_t j = 0; j < a.size(); ++j) {
+      EXPECT_EQ(a[j].wall_id, b[j].wall_id);
+      EXPECT_EQ(a[j].facet, b[j].facet);
+      EXPECT_EQ(a[j].centroid, b[j].centroid);
+      EXPECT_EQ(a[j].force, b[j].force);
+    }
+  }
+  Frame bad = t.frames[0];
+  bad.facet_loads[1].wall_id = 77;
+  try {
+    gs::validate_frame(bad, "x.h5 frame 0");
+    FAIL() << "accepted a load on a missing wall";
+  } catch (const gs::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("facet load names a missing wall (77)"), std::string::npos)
+        << e.what();
+  }
 }

@@ -160,6 +160,13 @@ inline void expect_same_frame(const Frame& a, const Frame& b, bool with_walls = 
     EXPECT_EQ(c.overlap, d.overlap);
   }
   expect_same_clumps(a, b);
+  ASSERT_EQ(a.facet_loads.size(), b.facet_loads.size());
+  for (std::size_t i = 0; i < a.facet_loads.size(); ++i) {
+    EXPECT_EQ(a.facet_loads[i].wall_id, b.facet_loads[i].wall_id);
+    EXPECT_EQ(a.facet_loads[i].facet, b.facet_loads[i].facet);
+    EXPECT_EQ(a.facet_loads[i].centroid, b.facet_loads[i].centroid);
+    EXPECT_EQ(a.facet_loads[i].force, b.facet_loads[i].force);
+  }
   if (!with_walls) return;
   ASSERT_EQ(a.walls.size(), b.walls.size());
   for (std::size_t i = 0; i < a.walls.size(); ++i) {
