@@ -30,18 +30,43 @@ bool NeighborList::stale(const ParticleState& p, const std::vector<WallState>& w
   return dmax + wmax > skin;
 }
 
+namespace {
+
+/// Whether some point of facet f (of the wall at wpos) may lie closer than `reach` to x: the
+/// distance to the facet's plane and to the farthest edge line it is outside of bound the
+/// distance to the triangle from below (with a relative margin for the rounding).
+bool facet_near(const TriangleFacet& f, const Eigen::Vector3d& wpos, const Eigen::Vector3d& x,
+                double reach) {
+  const Eigen::Vector3d cl = x - (wpos + f.offset.eigen());
+  const Eigen::Vector3d nrm = f.normal.eigen();
+  const double l = nrm.dot(cl);
+  const Eigen::Vector3d cp = cl - l * nrm;
+  double out = 0;
+  for (int i = 0; i < 3; ++i)
+    out = std::max(out, f.edge_normal[i].eigen().dot(cp) - f.incircle_radius);
+  const double tol = 1e-9 * (reach + cl.cwiseAbs().sum());
+  return l * l + out * out < (reach + tol) * (reach + tol);
+}
+
+// The 13 forward neighbours of a cell (the other 13 see it as theirs).
+constexpr int kForward[13][3] = {{1, 0, 0},  {-1, 1, 0}, {0, 1, 0},  {1, 1, 0}, {-1, -1, 1},
+                                 {0, -1, 1}, {1, -1, 1}, {-1, 0, 1}, {0, 0, 1}, {1, 0, 1},
+                                 {-1, 1, 1}, {0, 1, 1},  {1, 1, 1}};
+
+}  // namespace
+
 void NeighborList::build(const ParticleState& p, const std::vector<WallState>& walls) {
   const std::size_t n = p.size();
   if (n >= kWallBase) throw std::invalid_argument("too many particles for the neighbour list");
   pairs.clear();
   ref_pos = p.pos;
-  wall_ref.clear();
-  wall_normal_ref.clear();
-  wall_ori_ref.clear();
-  for (const auto& w : walls) {
-    wall_ref.push_back(w.pos);
-    wall_normal_ref.push_back(w.normal);
-    wall_ori_ref.push_back(w.ori);
+  wall_ref.resize(walls.size());
+  wall_normal_ref.resize(walls.size());
+  wall_ori_ref.resize(walls.size());
+  for (std::size_t w = 0; w < walls.size(); ++w) {
+    wall_ref[w] = walls[w].pos;
+    wall_normal_ref[w] = walls[w].normal;
+    wall_ori_ref[w] = walls[w].ori;
   }
   ++builds;
   if (n == 0) return;
@@ -71,93 +96,133 @@ void NeighborList::build(const ParticleState& p, const std::vector<WallState>& w
       c[k] = std::min(dims[k] - 1, std::max(0, static_cast<int>((x[k] - lo[k]) / cell)));
     return c;
   };
-  // Counting sort of particles into cells.
-  std::vector<std::uint32_t> start(ncells + 1, 0), order(n);
-  std::vector<std::uint32_t> cell_index(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    const auto c = cell_of(p.pos[i]);
-    cell_index[i] = static_cast<std::uint32_t>((c[2] * dims[1] + c[1]) * dims[0] + c[0]);
-    ++start[cell_index[i] + 1];
-  }
-  for (std::size_t c = 0; c < ncells; ++c) start[c + 1] += start[c];
-  {
-    std::vector<std::uint32_t> fill(start.begin(), start.end() - 1);
-    for (std::size_t i = 0; i < n; ++i)
-      order[fill[cell_index[i]]++] = static_cast<std::uint32_t>(i);
-  }
-  // Facet walls are binned into the cells their bounding box (grown by the largest reach) covers,
-  // so a mesh of many facets costs what its neighbourhood costs; other walls are checked by all.
-  std::vector<std::uint32_t> plain_walls, facet_start(ncells + 1, 0), facet_of;
-  std::vector<Eigen::Vector3d> facet_lo(walls.size()), facet_hi(walls.size());
-  {
-    std::vector<std::pair<std::uint32_t, std::uint32_t>> cell_wall;  // (cell, wall)
-    for (std::size_t w = 0; w < walls.size(); ++w) {
-      const auto& wall = walls[w];
-      if (!wall.active) continue;
-      if (wall.spec.shape != WallShape::Facets) {
-        plain_walls.push_back(static_cast<std::uint32_t>(w));
-        continue;
-      }
-      Eigen::Vector3d lo_w = Eigen::Vector3d::Constant(HUGE_VAL), hi_w = -lo_w;
-      for (const auto& f : wall.facets)
-        for (const auto& v : f.vertex) {
-          const Eigen::Vector3d x = wall.pos + (f.offset + v).eigen();
-          lo_w = lo_w.cwiseMin(x);
-          hi_w = hi_w.cwiseMax(x);
-        }
-      facet_lo[w] = lo_w;
-      facet_hi[w] = hi_w;
-      const Eigen::Vector3d grow = Eigen::Vector3d::Constant(rmax + skin);
-      const auto c0 = cell_of(lo_w - grow), c1 = cell_of(hi_w + grow);
-      for (int z = c0[2]; z <= c1[2]; ++z)
-        for (int y = c0[1]; y <= c1[1]; ++y)
-          for (int x = c0[0]; x <= c1[0]; ++x)
-            cell_wall.emplace_back(static_cast<std::uint32_t>((z * dims[1] + y) * dims[0] + x),
-                                   static_cast<std::uint32_t>(w));
-    }
-    std::sort(cell_wall.begin(), cell_wall.end());
-    for (const auto& cw : cell_wall) ++facet_start[cw.first + 1];
-    for (std::size_t c = 0; c < ncells; ++c) facet_start[c + 1] += facet_start[c];
-    facet_of.reserve(cell_wall.size());
-    for (const auto& cw : cell_wall) facet_of.push_back(cw.second);
-  }
+  auto index_of = [&](int x, int y, int z) {
+    return static_cast<std::uint32_t>((z * dims[1] + y) * dims[0] + x);
+  };
+  // Counting sort of the particles in the scene into cells, copied in cell order.
+  cell_start_.assign(ncells + 1, 0);
+  cell_of_particle_.resize(n);
   for (std::size_t i = 0; i < n; ++i) {
     if (gone(i)) continue;
     const auto c = cell_of(p.pos[i]);
-    for (int dz = -1; dz <= 1; ++dz)
-      for (int dy = -1; dy <= 1; ++dy)
-        for (int dx = -1; dx <= 1; ++dx) {
-          const int cx = c[0] + dx, cy = c[1] + dy, cz = c[2] + dz;
-          if (cx < 0 || cy < 0 || cz < 0 || cx >= dims[0] || cy >= dims[1] || cz >= dims[2])
-            continue;
-          const std::size_t ci = static_cast<std::size_t>((cz * dims[1] + cy) * dims[0] + cx);
-          for (std::uint32_t k = start[ci]; k < start[ci + 1]; ++k) {
-            const std::uint32_t j = order[k];
-            if (j <= i || gone(j)) continue;
-            if (clumped && p.clump[i] >= 0 && p.clump[i] == p.clump[j]) continue;  // one clump
-            const double reach = p.radius[i] + p.radius[j] + skin;
-            if ((p.pos[j] - p.pos[i]).squaredNorm() < reach * reach)
-              pairs.emplace_back(static_cast<std::uint32_t>(i), j);
-          }
+    cell_of_particle_[i] = index_of(c[0], c[1], c[2]);
+    ++cell_start_[cell_of_particle_[i] + 1];
+  }
+  for (std::size_t c = 0; c < ncells; ++c) cell_start_[c + 1] += cell_start_[c];
+  cell_fill_.assign(cell_start_.begin(), cell_start_.end() - 1);
+  slots_.resize(cell_start_[ncells]);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (gone(i)) continue;
+    const Eigen::Vector3d& x = p.pos[i];
+    slots_[cell_fill_[cell_of_particle_[i]]++] = {
+        x[0], x[1], x[2], p.radius[i], static_cast<std::uint32_t>(i), clumped ? p.clump[i] : -1};
+  }
+  // Sphere pairs, each found once: a cell with itself and with its forward neighbours. The
+  // criterion |xj − xi| < ri + rj + skin, with a relative hair of slack (more candidates
+  // are harmless; fewer are not).
+  found_.clear();
+  auto test = [&](const Slot& a, const Slot& b) {
+    if (a.clump >= 0 && a.clump == b.clump) return;  // one clump
+    const double reach = a.r + b.r + skin;
+    const double dx = b.x - a.x, dy = b.y - a.y, dz = b.z - a.z;
+    if (dx * dx + dy * dy + dz * dz < reach * reach * (1 + 1e-12))
+      found_.emplace_back(std::min(a.index, b.index), std::max(a.index, b.index));
+  };
+  for (int cz = 0; cz < dims[2]; ++cz)
+    for (int cy = 0; cy < dims[1]; ++cy)
+      for (int cx = 0; cx < dims[0]; ++cx) {
+        const std::uint32_t ci = index_of(cx, cy, cz);
+        const std::uint32_t s0 = cell_start_[ci], s1 = cell_start_[ci + 1];
+        if (s0 == s1) continue;
+        for (std::uint32_t s = s0; s < s1; ++s)
+          for (std::uint32_t t = s + 1; t < s1; ++t) test(slots_[s], slots_[t]);
+        for (const auto& o : kForward) {
+          const int nx = cx + o[0], ny = cy + o[1], nz = cz + o[2];
+          if (nx < 0 || ny < 0 || nx >= dims[0] || ny >= dims[1] || nz >= dims[2]) continue;
+          const std::uint32_t cj = index_of(nx, ny, nz);
+          const std::uint32_t t0 = cell_start_[cj], t1 = cell_start_[cj + 1];
+          for (std::uint32_t s = s0; s < s1; ++s)
+            for (std::uint32_t t = t0; t < t1; ++t) test(slots_[s], slots_[t]);
         }
-    const std::size_t own = cell_index[i];
-    for (std::uint32_t e = facet_start[own]; e < facet_start[own + 1]; ++e) {
-      const std::uint32_t w = facet_of[e];
-      const Eigen::Vector3d h = 0.5 * (facet_hi[w] - facet_lo[w]);
-      if (box_distance(facet_lo[w] + h, h, p.pos[i]) < p.radius[i] + skin)
-        pairs.emplace_back(static_cast<std::uint32_t>(i), kWallBase + w);
+      }
+  // Facets are binned, each on its own, into the cells their bounding box (grown by the
+  // largest reach) covers, in (wall, facet) order within a cell; other walls are checked by all.
+  plain_walls_.clear();
+  facet_cell_.clear();
+  facet_entries_.clear();
+  for (std::size_t w = 0; w < walls.size(); ++w) {
+    const auto& wall = walls[w];
+    if (!wall.active) continue;
+    if (wall.spec.shape != WallShape::Facets) {
+      plain_walls_.push_back(static_cast<std::uint32_t>(w));
+      continue;
     }
-    for (const std::uint32_t w : plain_walls) {
+    for (std::size_t k = 0; k < wall.facets.size(); ++k) {
+      const auto& f = wall.facets[k];
+      Eigen::Vector3d lo_f = Eigen::Vector3d::Constant(HUGE_VAL), hi_f = -lo_f;
+      for (const auto& v : f.vertex) {
+        const Eigen::Vector3d x = wall.pos + (f.offset + v).eigen();
+        lo_f = lo_f.cwiseMin(x);
+        hi_f = hi_f.cwiseMax(x);
+      }
+      const Eigen::Vector3d grow = Eigen::Vector3d::Constant(rmax + skin);
+      const auto c0 = cell_of(lo_f - grow), c1 = cell_of(hi_f + grow);
+      for (int z = c0[2]; z <= c1[2]; ++z)
+        for (int y = c0[1]; y <= c1[1]; ++y)
+          for (int x = c0[0]; x <= c1[0]; ++x) {
+            facet_cell_.push_back(index_of(x, y, z));
+            facet_entries_.push_back(
+                {static_cast<std::uint32_t>(w), static_cast<std::uint32_t>(k)});
+          }
+    }
+  }
+  facet_start_.assign(ncells + 1, 0);
+  for (const std::uint32_t c : facet_cell_) ++facet_start_[c + 1];
+  for (std::size_t c = 0; c < ncells; ++c) facet_start_[c + 1] += facet_start_[c];
+  cell_fill_.assign(facet_start_.begin(), facet_start_.end() - 1);
+  facet_sorted_.resize(facet_entries_.size());
+  for (std::size_t e = 0; e < facet_entries_.size(); ++e)
+    facet_sorted_[cell_fill_[facet_cell_[e]]++] = facet_entries_[e];
+  for (std::size_t i = 0; i < n; ++i) {
+    if (gone(i)) continue;
+    const std::uint32_t own = cell_of_particle_[i];
+    const double reach = p.radius[i] + skin;
+    std::uint32_t last = kWallBase;  // the wall last paired with i
+    for (std::uint32_t e = facet_start_[own]; e < facet_start_[own + 1]; ++e) {
+      const FacetEntry fe = facet_sorted_[e];
+      if (fe.wall == last) continue;
+      const auto& wall = walls[fe.wall];
+      if (facet_near(wall.facets[fe.facet], wall.pos, p.pos[i], reach)) {
+        found_.emplace_back(static_cast<std::uint32_t>(i), kWallBase + fe.wall);
+        last = fe.wall;
+      }
+    }
+    for (const std::uint32_t w : plain_walls_) {
       const auto& wall = walls[w];
       const double dist = wall.spec.shape == WallShape::Box
                               ? box_distance(wall.pos, wall.spec.half_extents, p.pos[i])
                               : (p.pos[i] - wall.pos).dot(wall.normal);
       if (dist < p.radius[i] + skin)
-        pairs.emplace_back(static_cast<std::uint32_t>(i),
-                           kWallBase + static_cast<std::uint32_t>(w));
+        found_.emplace_back(static_cast<std::uint32_t>(i), kWallBase + w);
     }
   }
-  std::sort(pairs.begin(), pairs.end());
+  // Sorted by (a, b): a counting sort on a, then each particle's few partners in order.
+  first_start_.assign(n + 1, 0);
+  for (const auto& pr : found_) ++first_start_[pr.first + 1];
+  for (std::size_t i = 0; i < n; ++i) first_start_[i + 1] += first_start_[i];
+  cell_fill_.assign(first_start_.begin(), first_start_.end() - 1);
+  pairs.resize(found_.size());
+  for (const auto& pr : found_) pairs[cell_fill_[pr.first]++] = pr;
+  for (std::size_t i = 0; i < n; ++i) {
+    auto* b = pairs.data() + first_start_[i];
+    auto* e = pairs.data() + first_start_[i + 1];
+    for (auto* x = b + 1; x < e; ++x) {  // insertion sort (a handful of partners)
+      const auto v = *x;
+      auto* y = x;
+      for (; y > b && (y - 1)->second > v.second; --y) *y = *(y - 1);
+      *y = v;
+    }
+  }
 }
 
 }  // namespace gs::solver

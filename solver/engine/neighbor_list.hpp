@@ -25,6 +25,24 @@ struct NeighborList {
   /// True when some pair may have come within contact since the last build.
   bool stale(const ParticleState& p, const std::vector<WallState>& walls) const;
   void build(const ParticleState& p, const std::vector<WallState>& walls);
+
+ private:
+  // Scratch of build(), kept between builds (no allocations once sized).
+  struct Slot {
+    double x, y, z, r;
+    std::uint32_t index;
+    std::int32_t clump;
+  };
+  struct FacetEntry {
+    std::uint32_t wall, facet;
+  };
+  std::vector<std::uint32_t> cell_start_, cell_fill_, cell_of_particle_;
+  std::vector<Slot> slots_;
+  std::vector<std::uint32_t> facet_start_, facet_cell_;
+  std::vector<FacetEntry> facet_entries_, facet_sorted_;
+  std::vector<std::uint32_t> plain_walls_;
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> found_;
+  std::vector<std::uint32_t> first_start_;
 };
 
 }  // namespace gs::solver

@@ -206,28 +206,52 @@ void Simulation::insert_particle(std::uint32_t i, const Eigen::Vector3d& positio
 }
 
 void Simulation::rebuild_neighbors() {
-  std::vector<ContactHistory> old = std::move(hist_);
+  // The old histories and parameters are swapped out (their buffers are reused).
+  old_hist_.swap(hist_);
+  old_params_.swap(params_);
   nl_.build(p_, walls_);
-  attach_histories(old);
+  attach_histories(old_hist_, &old_params_);
 }
 
-void Simulation::attach_histories(const std::vector<ContactHistory>& old) {
+void Simulation::attach_histories(const std::vector<ContactHistory>& old,
+                                  const std::vector<ContactParams>* old_params) {
   // `old` is sorted by (a, b), as the pair list is. A contact whose pair left the list cannot be
   // touching (the skin guarantees it), so dropping it loses nothing.
   const std::size_t np = nl_.pairs.size();
   hist_.assign(np, ContactHistory{});
   params_.resize(np);
   if (facet_forces_) pair_facet_.assign(np, 0);
+  // A pair that stays in the list keeps its stiffnesses and limits (contact_params of the same
+  // radii and material, so the same values) when nothing they are computed from has changed;
+  // the friction is set afresh (set_friction_deg changes it for sphere pairs only).
+  const auto& mat = cfg_.material;
+  bool reuse = old_params && old_params->size() == old.size() && params_key_valid_ &&
+               params_radius_ == p_.radius && params_walls_.size() == walls_.size() &&
+               params_material_[0] == mat.young_ec && params_material_[1] == mat.stiffness_ratio &&
+               params_material_[2] == mat.rolling_beta && params_material_[3] == mat.rolling_eta &&
+               params_material_[4] == cfg_.twist_beta && params_material_[5] == cfg_.twist_eta &&
+               params_rolling_radius_ == mat.rolling_radius;
+  for (std::size_t w = 0; reuse && w < walls_.size(); ++w)
+    reuse = params_walls_[w] == (static_cast<int>(walls_[w].spec.shape) << 1 |
+                                 static_cast<int>(walls_[w].spec.plane_radii));
+  const double tan_material = std::tan(mat.friction_deg * M_PI / 180.0);
   std::size_t o = 0;
   for (std::size_t k = 0; k < np; ++k) {
     const auto pr = nl_.pairs[k];
     while (o < old.size() && std::make_pair(old[o].a, old[o].b) < pr) ++o;
-    if (o < old.size() && old[o].a == pr.first && old[o].b == pr.second) hist_[k] = old[o];
+    const bool kept = o < old.size() && old[o].a == pr.first && old[o].b == pr.second;
+    if (kept) hist_[k] = old[o];
     hist_[k].a = pr.first;
     hist_[k].b = pr.second;
+    const WallSpec* ws = pr.second >= kWallBase ? &walls_[pr.second - kWallBase].spec : nullptr;
+    if (kept && reuse) {
+      params_[k] = (*old_params)[o];
+      params_[k].tan_friction =
+          ws && ws->friction_deg >= 0 ? std::tan(ws->friction_deg * M_PI / 180.0) : tan_material;
+      continue;
+    }
     const double ra = p_.radius[pr.first];
     const double rb = pr.second >= kWallBase ? ra : p_.radius[pr.second];
-    const WallSpec* ws = pr.second >= kWallBase ? &walls_[pr.second - kWallBase].spec : nullptr;
     if (ws && ws->shape == WallShape::Facets && !ws->plane_radii)  // YADE: the facet is 2R, first
       params_[k] = contact_params(cfg_.material, 2 * ra, ra, cfg_.twist_beta, cfg_.twist_eta);
     else
@@ -237,18 +261,27 @@ void Simulation::attach_histories(const std::vector<ContactHistory>& old) {
       if (wf >= 0) params_[k].tan_friction = std::tan(wf * M_PI / 180.0);
     }
   }
+  params_key_valid_ = true;
+  params_radius_ = p_.radius;
+  params_material_ = {mat.young_ec,    mat.stiffness_ratio, mat.rolling_beta,
+                      mat.rolling_eta, cfg_.twist_beta,     cfg_.twist_eta};
+  params_rolling_radius_ = mat.rolling_radius;
+  params_walls_.resize(walls_.size());
+  for (std::size_t w = 0; w < walls_.size(); ++w)
+    params_walls_[w] =
+        static_cast<int>(walls_[w].spec.shape) << 1 | static_cast<int>(walls_[w].spec.plane_radii);
+  wall_pairs_.clear();
+  for (std::size_t k = 0; k < np; ++k)
+    if (nl_.pairs[k].second >= kWallBase) wall_pairs_.push_back(static_cast<std::uint32_t>(k));
+  if (std::max(1, cfg_.threads) == 1) return;  // (the per-particle lists serve threads only)
   // Pairs of each particle in pair order (entry = pair << 1 | 1 when the particle is the
-  // second body), and the wall pairs.
+  // second body).
   const std::size_t n = p_.size();
   pair_start_.assign(n + 1, 0);
-  wall_pairs_.clear();
   for (std::size_t k = 0; k < np; ++k) {
     const auto [a, b] = nl_.pairs[k];
     ++pair_start_[a + 1];
-    if (b < kWallBase)
-      ++pair_start_[b + 1];
-    else
-      wall_pairs_.push_back(static_cast<std::uint32_t>(k));
+    if (b < kWallBase) ++pair_start_[b + 1];
   }
   for (std::size_t i = 0; i < n; ++i) pair_start_[i + 1] += pair_start_[i];
   pair_of_.resize(pair_start_[n]);
@@ -439,19 +472,52 @@ void Simulation::accumulate_walls() {
   return true;
 }
 
+namespace {
+
+/// False only where the sphere (x, r) cannot touch the wall: what pair_geometry would find a
+/// negative penetration for (with a margin far above the rounding where the test is not the
+/// geometry's own expression).
+[[gnu::always_inline]] inline bool wall_may_touch(const WallState& w, const Eigen::Vector3d& x,
+                                                  double r) {
+  if (w.spec.shape == WallShape::Plane)  // (plane_sphere_geometry's penetration, bit for bit)
+    return !(r - dot(V3(x) - V3(w.pos), V3(w.normal)) < 0);
+  if (w.spec.shape == WallShape::Box) {
+    const Eigen::Vector3d q = ((x - w.pos).cwiseAbs() - w.spec.half_extents).cwiseMax(0.0);
+    const double tol = 1e-9 * (r + (x - w.pos).cwiseAbs().sum());
+    return !(q.squaredNorm() > (r + tol) * (r + tol));
+  }
+  // Facets: the distance to a facet is at least the distance l to its plane.
+  const V3 xv(x), wp(w.pos);
+  for (const auto& f : w.facets) {
+    const V3 cl = xv - (wp + f.offset);
+    const double l = std::abs(dot(f.normal, cl));
+    const double tol = 1e-9 * (r + std::abs(cl.x) + std::abs(cl.y) + std::abs(cl.z) + w.reach);
+    if (!(l > r + tol)) return true;
+  }
+  return false;
+}
+
+}  // namespace
+
 int Simulation::fill_batch(std::size_t& k, std::size_t end, ContactBatch& batch,
                            std::uint32_t* lane_pair, double& max_overlap_ratio) {
   // Pass 1 without branches (whether a candidate is within reach is a coin flip that the
   // branch predictor loses): candidates within reach are compacted, the others lose their
   // contact (YADE erases the interaction).
+  // Wall candidates are culled here too, where they provably do not touch: a plane by the
+  // penetration its geometry computes; a box by the distance to it; a mesh when the sphere is
+  // farther than its radius from the plane of every facet (the facet distance is at least that).
   std::uint32_t near[ContactBatch::kLanes];
   int m = 0;
   for (; k < end && m < ContactBatch::kLanes; ++k) {
     const auto [a, b] = nl_.pairs[k];
-    const bool wall = b >= kWallBase;
-    const std::uint32_t other = wall ? a : b;
-    const double reach = p_.radius[a] + p_.radius[other];
-    const bool in_reach = wall | !((p_.pos[other] - p_.pos[a]).squaredNorm() > reach * reach);
+    bool in_reach;
+    if (b < kWallBase) {
+      const double reach = p_.radius[a] + p_.radius[b];
+      in_reach = !((p_.pos[b] - p_.pos[a]).squaredNorm() > reach * reach);
+    } else {
+      in_reach = wall_may_touch(walls_[b - kWallBase], p_.pos[a], p_.radius[a]);
+    }
     hist_[k].real = hist_[k].real & in_reach;
     near[m] = static_cast<std::uint32_t>(k);
     m += in_reach;

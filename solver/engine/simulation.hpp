@@ -3,6 +3,7 @@
 // blow-up detection and bit-exact checkpoints.
 #pragma once
 
+#include <array>
 #include <filesystem>
 #include <stdexcept>
 #include <string>
@@ -143,7 +144,9 @@ class Simulation {
  private:
   void rebuild_neighbors();
   /// Re-attaches contact histories (sorted by pair) to the current pair list.
-  void attach_histories(const std::vector<ContactHistory>& old);
+  /// With `old_params` (parallel to `old`), pairs kept keep their parameters.
+  void attach_histories(const std::vector<ContactHistory>& old,
+                        const std::vector<ContactParams>* old_params = nullptr);
   /// Geometry and body motions of candidate pair k; false when the centres coincide.
   bool pair_geometry(std::size_t k, ContactGeometry& g, BodyMotion& m1, BodyMotion& m2,
                      std::uint32_t* facet = nullptr) const;
@@ -183,6 +186,15 @@ class Simulation {
   bool facet_forces_ = false;
   std::vector<std::uint32_t> pair_facet_;  // closest facet of each wall pair (facet forces on)
   std::vector<ContactParams> params_;
+  // Scratch of rebuild_neighbors (the previous list's histories and parameters), and what
+  // params_ were computed from (attach_histories reuses them only while these are unchanged).
+  std::vector<ContactHistory> old_hist_;
+  std::vector<ContactParams> old_params_;
+  bool params_key_valid_ = false;
+  std::vector<double> params_radius_;
+  std::array<double, 6> params_material_{};
+  RollingRadius params_rolling_radius_ = RollingRadius::Min;
+  std::vector<int> params_walls_;
   std::vector<ContactLoads> loads_;
   std::vector<std::uint8_t> active_;
   static constexpr std::size_t kChunk = 256, kSums = 5;
