@@ -737,9 +737,15 @@ struct TrajectoryReader::Impl {
     if (!std::filesystem::is_regular_file(path, ec)) throw InputError(file_name, "not a file");
     if (!is_hdf5_file(path)) throw InputError(file_name, "not an HDF5 file (bad signature)");
     file = Hid(H5Fopen(file_name.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose);
-    if (!file.valid())  // a file still open by (or left behind by a killed) single writer
-      file = Hid(H5Fopen(file_name.c_str(), H5F_ACC_RDONLY | H5F_ACC_SWMR_READ, H5P_DEFAULT),
-                 H5Fclose);
+    if (!file.valid()) {  // a file still open by (or left behind by a killed) single writer
+      // SWMR readers retry a metadata read whose checksum fails, sleeping 1 ns, 2 ns, 4 ns, …
+      // between tries; HDF5's default of 100 tries turns a corrupt file into a hang of 2^100 ns.
+      // 24 tries (16 ms of sleep in all) still ride out a read torn by the live writer.
+      Hid fapl(H5Pcreate(H5P_FILE_ACCESS), H5Pclose);
+      H5Pset_metadata_read_attempts(fapl.get(), 24);
+      file =
+          Hid(H5Fopen(file_name.c_str(), H5F_ACC_RDONLY | H5F_ACC_SWMR_READ, fapl.get()), H5Fclose);
+    }
     if (!file.valid()) throw InputError(file_name, "cannot open HDF5 file (corrupt or truncated)");
 
     // Root attributes.
