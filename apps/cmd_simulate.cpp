@@ -126,9 +126,11 @@ std::string history_header(const solver::Simulation& sim) {
       "step,time_s,contacts,kinetic_J,unbalanced_force,inertial_number,elastic_J,"
       "friction_dissipation_J,rolling_dissipation_J,damping_dissipation_J,gravity_work_J,"
       "wall_work_J,external_work_J,energy_residual_J";
-  for (const auto& w : sim.walls()) {
+  for (std::size_t k = 0; k < sim.walls().size(); ++k) {
+    const auto& w = sim.walls()[k];
     if (w.spec.shape == solver::WallShape::Facets) continue;  // (per mesh group, below)
-    const std::string n = w.spec.name.empty() ? "wall" : w.spec.name;
+    // An unnamed wall is named by its index, so that no two columns share a name.
+    const std::string n = w.spec.name.empty() ? "wall" + std::to_string(k) : w.spec.name;
     for (const char* c : {"_fx_N", "_fy_N", "_fz_N", "_x_m", "_y_m", "_z_m"}) h += "," + n + c;
   }
   auto groups = solver::group_forces(sim);

@@ -11,6 +11,7 @@
 #include <fstream>
 #include <limits>
 #include <map>
+#include <set>
 #include <sstream>
 #include <thread>
 #include <vector>
@@ -517,6 +518,16 @@ keep_hi_m = [1.0, 1.0, 1.0]
   EXPECT_EQ(t.frames.back().particles.size(), 0u);  // all discharged
   const double removed = last_history_value(dir / "out" / "history.csv", "removed");
   EXPECT_EQ(removed, 120.0);
+  // The four unnamed walls get columns of their own (wall0_fx_N …, by wall index).
+  {
+    std::istringstream in(slurp(dir / "out" / "history.csv"));
+    std::string header, name;
+    std::getline(in, header);
+    std::istringstream h(header);
+    std::set<std::string> names;
+    while (std::getline(h, name, ',')) EXPECT_TRUE(names.insert(name).second) << name;
+    EXPECT_TRUE(names.count("wall1_fx_N"));
+  }
   double mass = 0;
   for (const auto& f : t.frames)
     if (f.particles.size() == 120u) {
