@@ -29,6 +29,10 @@ void print_info(const std::string& file, const std::string& format, std::size_t 
   if (!last.particles.empty())
     std::printf("d50:          %.6g m (by volume, last frame)\n", analysis::d50(last));
   std::printf("walls:        %zu\n", last.walls.size());
+  if (!last.clumps.empty())
+    std::printf("clumps:       %zu bodies (last frame)\n", last.clumps.size());
+  if (!last.facet_loads.empty())
+    std::printf("facet loads:  %zu triangles (last frame)\n", last.facet_loads.size());
 }
 
 }  // namespace

@@ -99,6 +99,9 @@ mass = "union"
   ASSERT_EQ(last.clumps.size(), 4u);
   for (const auto& c : last.clumps) EXPECT_EQ(c.template_name, "dimer");
 
+  ASSERT_EQ(run("info " + traj.string(), dir / "info"), 0);
+  EXPECT_NE(text_of(dir / "info").find("clumps:       4 bodies (last frame)"), std::string::npos)
+      << text_of(dir / "info");
   ASSERT_EQ(run("analyze fabric " + traj.string() + " -o " + (dir / "f.h5").string(), dir / "log"),
             0)
       << text_of(dir / "log");
