@@ -18,7 +18,8 @@ void register_info(CLI::App& app);      // io
 void register_convert(CLI::App& app);   // io
 void register_figures(CLI::App& app);   // apps
 void register_simulate(CLI::App& app);  // solver
-void register_dic(CLI::App& app);  // dic (apps/cmd_dic.cpp)
+void register_surface(CLI::App& app);   // solver (apps/cmd_surface.cpp)
+void register_dic(CLI::App& app);       // dic (apps/cmd_dic.cpp)
 
 /// `granoscope analyze` parent; analyses register below it (analyze hhd, analyze strain, ...).
 CLI::App& analyze_command(CLI::App& app);

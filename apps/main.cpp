@@ -28,6 +28,7 @@ int main(int argc, char** argv) {
   gs::cli::register_convert(app);
   gs::cli::register_figures(app);
   gs::cli::register_simulate(app);
+  gs::cli::register_surface(app);
   gs::cli::register_dic(app);
   gs::cli::register_analyze_strain(app);
   gs::cli::register_analyze_rev(app);

@@ -19,6 +19,7 @@
 #include "../io/test_util.hpp"
 #include "cli_util.hpp"
 #include "hdf5_trajectory.hpp"
+#include "triangle_mesh.hpp"
 
 namespace {
 
@@ -734,4 +735,41 @@ TEST(Simulate, BadClumpShapesAndReplacementNameTheKey) {
        "clumps.replace: give either packing or replace"},
       {sand + "[clumps]\npacking = \"ok.csv\"\nseed = 2\n", "clumps.seed: only with replace"}};
   expect_one_line_errors(dir.path, base, cases);
+}
+
+// `granoscope surface`: seed 004 §5.2's rough silo wall (R_n = 1, d50 = 1.5 mm: h_g = 1.5 mm,
+// s_g = 6 mm, α_g = 45°) as STL, 25 teeth over 15 cm: 6 triangles a tooth (ramp, vertical back
+// face, land), tips at h_g, every normal into the material (+z side), and the area of the
+// profile W·25·(h√2 + h + s − h) exactly; bad parameters: one line naming the output, no file.
+TEST(Surface, SawToothWallAsStlForAScene) {
+  gs::test::ScratchDir dir("surface");
+  const auto stl = dir / "rough.stl";
+  std::string err;
+  ASSERT_EQ(run("surface sawtooth --length 0.15 --width 0.02 --height 0.0015 --spacing 0.006 "
+                "--group wall -o " +
+                    stl.string(),
+                &err),
+            0)
+      << err;
+  const gs::TriangleMesh m = gs::read_mesh(stl);
+  ASSERT_EQ(m.triangles.size(), 150u);
+  EXPECT_EQ(m.group_names.at(0), "wall");
+  double area = 0, top = -1;
+  for (std::size_t t = 0; t < m.triangles.size(); ++t) {
+    area += gs::triangle_area(m, t);
+    EXPECT_GE(gs::triangle_normal(m, t).z(), -1e-12) << t;
+  }
+  for (const auto& v : m.vertices) top = std::max(top, v.z());
+  const double h = 0.0015, s = 0.006;
+  EXPECT_NEAR(area, 0.02 * 25 * (h * std::sqrt(2.0) + h + s - h), 1e-12 * area);
+  EXPECT_NEAR(top, h, 1e-15);
+  ASSERT_EQ(run("surface sawtooth --length 0.15 --width 0.02 --height -0.0015 --spacing 0.006 -o " +
+                    (dir / "bad.stl").string(),
+                &err),
+            2);
+  EXPECT_NE(err.find("bad.stl: saw_tooth_wall: height_m must be finite and > 0 (-0.0015)"),
+            std::string::npos)
+      << err;
+  EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
+  EXPECT_FALSE(std::filesystem::exists(dir / "bad.stl"));
 }
