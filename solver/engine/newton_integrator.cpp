@@ -5,6 +5,7 @@
 
 #include <Eigen/Geometry>
 
+#include "rigid_clump.hpp"
 #include "simd_level.hpp"
 
 namespace gs::solver {
@@ -126,22 +127,202 @@ void integrate_batch(ParticleBatch& b, int count, V3 g, double damping, double d
   integrate_generic(b, count, g, damping, dt);
 }
 
-}  // namespace
+/// Clump bodies of one batch, one array per component, for integrate_clump_lanes.
+struct ClumpBatch {
+  static constexpr int kLanes = 16;
+  // clang-format off
+  enum Field : int {
+    FX, FY, FZ, MX, MY, MZ,  // load (inputs)
+    VX, VY, VZ, WX, WY, WZ, LX, LY, LZ, PX, PY, PZ, QW, QX, QY, QZ,  // updated in place
+    MASS, IX, IY, IZ, DAMP, NORM,
+    kFields
+  };
+  // clang-format on
 
-IntegrationSums integrate_particles(ParticleState& p, std::size_t begin, std::size_t end,
-                                    const Eigen::Vector3d& gravity, double damping, double dt) {
+  alignas(64) double v[kFields][kLanes];
+};
+
+// YADE's NewtonIntegrator for aspherical bodies (exactAsphericalRot) on lanes [0, count),
+// every expression written out in the order in which Eigen evaluates the YADE expressions it
+// replaces (quoted in the comments): YADE's Eigen reduces a 3-vector as x + (y + z) and a
+// 4-vector as (x + y) + (z + w) (its scalar unroller splits in halves); the old Eigen version
+// of this code reduced its dot products as (x + y) + z.
+[[gnu::always_inline]] inline void integrate_clump_lanes(ClumpBatch& b, int count, V3 gv,
+                                                         double damping, double dt) {
+  using F = ClumpBatch::Field;
+  const double g[3] = {gv.x, gv.y, gv.z};
+  const double half_dt = dt / 2.;
+  for (int j = 0; j < count; ++j) {
+    const double f[3] = {b.v[F::FX][j], b.v[F::FY][j], b.v[F::FZ][j]};
+    double m[3] = {b.v[F::MX][j], b.v[F::MY][j], b.v[F::MZ][j]};
+    double vel[3] = {b.v[F::VX][j], b.v[F::VY][j], b.v[F::VZ][j]};
+    const double angvel[3] = {b.v[F::WX][j], b.v[F::WY][j], b.v[F::WZ][j]};
+    const double mass = b.v[F::MASS][j];
+    // (c.vel.cwiseAbs().dot((f + c.mass * gravity).cwiseAbs()) * damping * dt) +
+    // c.angvel.cwiseAbs().dot(m.cwiseAbs()) * damping * dt
+    const double d_lin = (std::abs(vel[0]) * std::abs(f[0] + mass * g[0]) +
+                          std::abs(vel[1]) * std::abs(f[1] + mass * g[1])) +
+                         std::abs(vel[2]) * std::abs(f[2] + mass * g[2]);
+    const double d_rot =
+        (std::abs(angvel[0]) * std::abs(m[0]) + std::abs(angvel[1]) * std::abs(m[1])) +
+        std::abs(angvel[2]) * std::abs(m[2]);
+    b.v[F::DAMP][j] = damping != 0 ? (d_lin * damping * dt) + d_rot * damping * dt : 0.0;
+// Translation: as for spheres (gravity in the acceleration before damping).
+#pragma GCC unroll 4
+    for (int k = 0; k < 3; ++k) {
+      double lin = f[k] / mass + g[k];
+      lin *= cundall_factor(damping, dt, vel[k], lin);
+      vel[k] += dt * lin;
+    }
+// Rotation: first-order Cundall damping of the torque with the stored angular velocity.
+#pragma GCC unroll 4
+    for (int k = 0; k < 3; ++k) {
+      const double s = m[k] * angvel[k];
+      m[k] *= 1 - damping * static_cast<double>(static_cast<int>(s > 0) - static_cast<int>(s < 0));
+    }
+    // leapfrogAsphericalRotate, expression by expression. a = c.ori.conjugate()
+    // .toRotationMatrix() (global -> local): Eigen's formula on (w, -x, -y, -z).
+    const double q[4] = {b.v[F::QW][j], b.v[F::QX][j], b.v[F::QY][j], b.v[F::QZ][j]};
+    const double cx = -q[1], cy = -q[2], cz = -q[3], cw = q[0];
+    const double tx = 2 * cx, ty = 2 * cy, tz = 2 * cz;
+    const double twx = tx * cw, twy = ty * cw, twz = tz * cw;
+    const double txx = tx * cx, txy = ty * cx, txz = tz * cx;
+    const double tyy = ty * cy, tyz = tz * cy, tzz = tz * cz;
+    const double a[3][3] = {{1 - (tyy + tzz), txy - twz, txz + twy},
+                            {txy + twz, 1 - (txx + tzz), tyz - twx},
+                            {txz - twy, tyz + twx, 1 - (txx + tyy)}};
+    const double inertia[3] = {b.v[F::IX][j], b.v[F::IY][j], b.v[F::IZ][j]};
+    const double l0[3] = {b.v[F::LX][j], b.v[F::LY][j], b.v[F::LZ][j]};
+    // l_n = c.angmom + dt / 2. * m; w_b_n = (a·l_n) / inertia, a row as a0 v0 + (a1 v1 + a2 v2)
+    double l_n[3], w_b_n[3], angmom[3], w[3];
+#pragma GCC unroll 4
+    for (int k = 0; k < 3; ++k) l_n[k] = l0[k] + half_dt * m[k];
+#pragma GCC unroll 4
+    for (int i = 0; i < 3; ++i)
+      w_b_n[i] = (a[i][0] * l_n[0] + (a[i][1] * l_n[1] + a[i][2] * l_n[2])) / inertia[i];
+    // YADE's DotQ: dQ/dt = ½·Q ⊗ (0, ω); q_half = q + dq_n·(dt/2) on the coefficients
+    auto dot_q = [](const double* om, const double* p, double* d) {
+      d[0] = (-p[1] * om[0] - p[2] * om[1] - p[3] * om[2]) / 2;
+      d[1] = (p[0] * om[0] - p[3] * om[1] + p[2] * om[2]) / 2;
+      d[2] = (p[3] * om[0] + p[0] * om[1] - p[1] * om[2]) / 2;
+      d[3] = (-p[2] * om[0] + p[1] * om[1] + p[0] * om[2]) / 2;
+    };
+    double dq[4], q_half[4], o[4];
+    dot_q(w_b_n, q, dq);
+#pragma GCC unroll 4
+    for (int k = 0; k < 4; ++k) q_half[k] = q[k] + dq[k] * half_dt;
+#pragma GCC unroll 4
+    for (int k = 0; k < 3; ++k) angmom[k] = l0[k] + dt * m[k];
+#pragma GCC unroll 4
+    for (int i = 0; i < 3; ++i)
+      w[i] = (a[i][0] * angmom[0] + (a[i][1] * angmom[1] + a[i][2] * angmom[2])) / inertia[i];
+    dot_q(w, q_half, dq);
+#pragma GCC unroll 4
+    for (int k = 0; k < 4; ++k) o[k] = q[k] + dq[k] * dt;  // c.ori + dq_half·dt
+    // c.angvel = c.ori * w_b_half before normalising (as YADE), Eigen's _transformVector:
+    // uv = 2 (v × w); w + o_w uv + v × uv
+    const double vx = o[1], vy = o[2], vz = o[3];
+    double u0 = vy * w[2] - vz * w[1], u1 = vz * w[0] - vx * w[2], u2 = vx * w[1] - vy * w[0];
+    u0 += u0;
+    u1 += u1;
+    u2 += u2;
+    b.v[F::WX][j] = (w[0] + o[0] * u0) + (vy * u2 - vz * u1);
+    b.v[F::WY][j] = (w[1] + o[0] * u1) + (vz * u0 - vx * u2);
+    b.v[F::WZ][j] = (w[2] + o[0] * u2) + (vx * u1 - vy * u0);
+    // normalize: |q|² as (x² + y²) + (z² + w²); the square root and the division below
+    b.v[F::NORM][j] = (o[1] * o[1] + o[2] * o[2]) + (o[3] * o[3] + o[0] * o[0]);
+    b.v[F::QW][j] = o[0];
+    b.v[F::QX][j] = o[1];
+    b.v[F::QY][j] = o[2];
+    b.v[F::QZ][j] = o[3];
+#pragma GCC unroll 4
+    for (int k = 0; k < 3; ++k) {
+      b.v[F::LX + k][j] = angmom[k];
+      b.v[F::VX + k][j] = vel[k];
+      b.v[F::PX + k][j] = b.v[F::PX + k][j] + dt * vel[k];  // leapfrogTranslate
+    }
+  }
+  // (Apart: with -frounding-math GCC does not vectorise a loop with a square root.)
+  for (int j = 0; j < count; ++j) b.v[F::NORM][j] = std::sqrt(b.v[F::NORM][j]);
+  for (int j = 0; j < count; ++j) {
+    const double n = b.v[F::NORM][j];
+    b.v[F::QW][j] = b.v[F::QW][j] / n;
+    b.v[F::QX][j] = b.v[F::QX][j] / n;
+    b.v[F::QY][j] = b.v[F::QY][j] / n;
+    b.v[F::QZ][j] = b.v[F::QZ][j] / n;
+  }
+}
+
+void integrate_clumps_generic(ClumpBatch& b, int count, V3 g, double damping, double dt) {
+  integrate_clump_lanes(b, count, g, damping, dt);
+}
+
+#if GS_SIMD_X86
+__attribute__((target("avx2"))) void integrate_clumps_avx2(ClumpBatch& b, int count, V3 g,
+                                                           double damping, double dt) {
+  integrate_clump_lanes(b, count, g, damping, dt);
+}
+
+__attribute__((target("avx512f"))) void integrate_clumps_avx512(ClumpBatch& b, int count, V3 g,
+                                                                double damping, double dt) {
+  integrate_clump_lanes(b, count, g, damping, dt);
+}
+#endif
+
+void integrate_clump_batch(ClumpBatch& b, int count, V3 g, double damping, double dt) {
+#if GS_SIMD_X86
+  switch (simd_level()) {
+    case SimdLevel::Avx512:
+      return integrate_clumps_avx512(b, count, g, damping, dt);
+    case SimdLevel::Avx2:
+      return integrate_clumps_avx2(b, count, g, damping, dt);
+    case SimdLevel::Generic:
+      break;
+  }
+#endif
+  integrate_clumps_generic(b, count, g, damping, dt);
+}
+
+template <bool kMembers>
+IntegrationSums integrate_range(ParticleState& p, std::size_t begin, std::size_t end,
+                                const Eigen::Vector3d& gravity, double damping, double dt) {
   using F = ParticleBatch::Field;
   IntegrationSums sums;
   ParticleBatch b;
-  for (std::size_t i0 = begin; i0 < end; i0 += ParticleBatch::kLanes) {
-    const int count = static_cast<int>(std::min<std::size_t>(ParticleBatch::kLanes, end - i0));
+  std::size_t lane_index[ParticleBatch::kLanes];
+  for (std::size_t next = begin; next < end;) {
+    const std::size_t i0 = next;
+    int count = 0;
+    if constexpr (kMembers) {
+      // The next lanes: the particles in order, fixed clump members apart. A fixed lane keeps
+      // its velocities and adds +0 to the sums; of a member the clump update overwrites the
+      // position and orientation, so only the rotation vector and the finite check are left.
+      for (; next < end && count < ParticleBatch::kLanes; ++next) {
+        if (p.clump[next] >= 0 && p.fixed[next]) {
+          const V3 vel(p.vel[next]), angvel(p.angvel[next]);
+          add_to(p.rot[next], angvel * dt);
+          sums.finite = sums.finite && squared_norm(vel) < HUGE_VAL &&
+                        squared_norm(V3(p.pos[next]) + vel * dt) < HUGE_VAL;
+          continue;
+        }
+        lane_index[count++] = next;
+      }
+      if (count == 0) continue;
+    } else {
+      count = static_cast<int>(std::min<std::size_t>(ParticleBatch::kLanes, end - next));
+      next += static_cast<std::size_t>(count);
+    }
+    auto lane = [&](int j) {
+      if constexpr (kMembers) return lane_index[j];
+      return i0 + static_cast<std::size_t>(j);
+    };
     auto put = [&](F f, int j, const Eigen::Vector3d& x) {
       b.v[f][j] = x[0];
       b.v[f + 1][j] = x[1];
       b.v[f + 2][j] = x[2];
     };
     for (int j = 0; j < count; ++j) {
-      const std::size_t i = i0 + static_cast<std::size_t>(j);
+      const std::size_t i = lane(j);
       put(F::VX, j, p.vel[i]);
       put(F::WX, j, p.angvel[i]);
       put(F::FX, j, p.force[i]);
@@ -159,7 +340,7 @@ IntegrationSums integrate_particles(ParticleState& p, std::size_t begin, std::si
     integrate_batch(b, count, V3(gravity), damping, dt);
     auto get = [&](F f, int j) { return V3(b.v[f][j], b.v[f + 1][j], b.v[f + 2][j]); };
     for (int j = 0; j < count; ++j) {
-      const std::size_t i = i0 + static_cast<std::size_t>(j);
+      const std::size_t i = lane(j);
       sums.gravity_power += b.v[F::GRAVITY_POWER][j];
       sums.external_power += b.v[F::EXTERNAL_POWER][j];
       sums.damping += b.v[F::DAMPING][j];
@@ -183,6 +364,58 @@ IntegrationSums integrate_particles(ParticleState& p, std::size_t begin, std::si
     }
   }
   return sums;
+}
+
+}  // namespace
+
+IntegrationSums integrate_particles(ParticleState& p, std::size_t begin, std::size_t end,
+                                    const Eigen::Vector3d& gravity, double damping, double dt,
+                                    bool clump_members) {
+  return clump_members && p.clump.size() == p.size()
+             ? integrate_range<true>(p, begin, end, gravity, damping, dt)
+             : integrate_range<false>(p, begin, end, gravity, damping, dt);
+}
+
+void integrate_clump_bodies(ClumpBody* clumps, const ClumpLoad* loads, std::size_t count,
+                            const Eigen::Vector3d& gravity, double damping, double dt,
+                            double* damp) {
+  using F = ClumpBatch::Field;
+  ClumpBatch b;
+  for (std::size_t k0 = 0; k0 < count; k0 += ClumpBatch::kLanes) {
+    const int n = static_cast<int>(std::min<std::size_t>(ClumpBatch::kLanes, count - k0));
+    auto put = [&](F f, int j, const Eigen::Vector3d& x) {
+      b.v[f][j] = x[0];
+      b.v[f + 1][j] = x[1];
+      b.v[f + 2][j] = x[2];
+    };
+    for (int j = 0; j < n; ++j) {
+      const ClumpBody& c = clumps[k0 + static_cast<std::size_t>(j)];
+      const ClumpLoad& l = loads[k0 + static_cast<std::size_t>(j)];
+      put(F::FX, j, l.force);
+      put(F::MX, j, l.torque);
+      put(F::VX, j, c.vel);
+      put(F::WX, j, c.angvel);
+      put(F::LX, j, c.angmom);
+      put(F::PX, j, c.pos);
+      put(F::IX, j, c.inertia);
+      b.v[F::QW][j] = c.ori.w();
+      b.v[F::QX][j] = c.ori.x();
+      b.v[F::QY][j] = c.ori.y();
+      b.v[F::QZ][j] = c.ori.z();
+      b.v[F::MASS][j] = c.mass;
+    }
+    integrate_clump_batch(b, n, V3(gravity), damping, dt);
+    auto get = [&](F f, int j) { return Eigen::Vector3d(b.v[f][j], b.v[f + 1][j], b.v[f + 2][j]); };
+    for (int j = 0; j < n; ++j) {
+      ClumpBody& c = clumps[k0 + static_cast<std::size_t>(j)];
+      c.vel = get(F::VX, j);
+      c.angvel = get(F::WX, j);
+      c.angmom = get(F::LX, j);
+      c.pos = get(F::PX, j);
+      c.ori = Eigen::Quaterniond(b.v[F::QW][j], b.v[F::QX][j], b.v[F::QY][j], b.v[F::QZ][j]);
+      damp[k0 + static_cast<std::size_t>(j)] = b.v[F::DAMP][j];
+    }
+  }
 }
 
 }  // namespace gs::solver

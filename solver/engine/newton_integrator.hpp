@@ -29,8 +29,12 @@ struct IntegrationSums {
 /// Gravity is added to the acceleration before damping (YADE's default). The damping estimate
 /// is YADE's |v|·|F + m g|·damping·dt per component, before the update. Two passes: velocities
 /// and positions, then orientations (whose square root and division then overlap across
-/// particles instead of stalling each one).
+/// particles instead of stalling each one). Fixed clump members (p.clump[i] >= 0) keep their
+/// velocities and only advance their rotation vectors (and count in the finite check): their
+/// positions and orientations are left for the clump update (Simulation::integrate_clumps),
+/// which overwrites them. `clump_members` false: the caller knows there are none (no check).
 IntegrationSums integrate_particles(ParticleState& p, std::size_t begin, std::size_t end,
-                                    const Eigen::Vector3d& gravity, double damping, double dt);
+                                    const Eigen::Vector3d& gravity, double damping, double dt,
+                                    bool clump_members = true);
 
 }  // namespace gs::solver

@@ -218,72 +218,11 @@ ClumpBody make_clump_body(const std::vector<std::uint32_t>& member_indices,
   return c;
 }
 
-namespace {
-
-/// YADE's NewtonIntegrator::DotQ: dQ/dt = ½·Q ⊗ (0, ω), ω in the local frame.
-Eigen::Quaterniond dot_q(const Eigen::Vector3d& w, const Eigen::Quaterniond& q) {
-  Eigen::Quaterniond d;
-  d.w() = (-q.x() * w[0] - q.y() * w[1] - q.z() * w[2]) / 2;
-  d.x() = (q.w() * w[0] - q.z() * w[1] + q.y() * w[2]) / 2;
-  d.y() = (q.z() * w[0] + q.w() * w[1] - q.x() * w[2]) / 2;
-  d.z() = (-q.y() * w[0] + q.x() * w[1] + q.w() * w[2]) / 2;
-  return d;
-}
-
-/// q + s·p on the coefficients (YADE's quaternion operators).
-Eigen::Quaterniond add_scaled(const Eigen::Quaterniond& q, double s, const Eigen::Quaterniond& p) {
-  return Eigen::Quaterniond(q.coeffs() + p.coeffs() * s);
-}
-
-// YADE's Eigen reduces a 3-vector as x + (y + z) and a 4-vector as (x + y) + (z + w) (its
-// scalar unroller splits in halves); ours vectorises them in another order. The products and
-// the normalisation are written out so that the trajectories round as YADE's do.
-Eigen::Vector3d mat_vec(const Eigen::Matrix3d& a, const Eigen::Vector3d& v) {
-  Eigen::Vector3d r;
-  for (int i = 0; i < 3; ++i) r[i] = a(i, 0) * v[0] + (a(i, 1) * v[1] + a(i, 2) * v[2]);
-  return r;
-}
-
-void normalize(Eigen::Quaterniond& q) {
-  const double n2 = (q.x() * q.x() + q.y() * q.y()) + (q.z() * q.z() + q.w() * q.w());
-  const double n = std::sqrt(n2);
-  q = Eigen::Quaterniond(q.w() / n, q.x() / n, q.y() / n, q.z() / n);
-}
-
-}  // namespace
-
 double integrate_clump(ClumpBody& c, const ClumpLoad& load, const Eigen::Vector3d& gravity,
                        double damping, double dt) {
-  const Eigen::Vector3d& f = load.force;
-  Eigen::Vector3d m = load.torque;
-  const double damp = (c.vel.cwiseAbs().dot((f + c.mass * gravity).cwiseAbs()) * damping * dt) +
-                      c.angvel.cwiseAbs().dot(m.cwiseAbs()) * damping * dt;
-  // Translation: as for spheres (gravity in the acceleration before damping).
-  Eigen::Vector3d lin = f / c.mass + gravity;
-  for (int k = 0; k < 3; ++k) lin[k] *= cundall_factor(damping, dt, c.vel[k], lin[k]);
-  c.vel += dt * lin;
-  // Rotation: first-order Cundall damping of the torque with the stored angular velocity.
-  for (int k = 0; k < 3; ++k) {
-    const double s = m[k] * c.angvel[k];
-    m[k] *= 1 - damping * static_cast<double>((s > 0) - (s < 0));
-  }
-  // leapfrogAsphericalRotate, expression by expression.
-  const Eigen::Matrix3d a = c.ori.conjugate().toRotationMatrix();  // global -> local
-  const Eigen::Vector3d l_n = c.angmom + dt / 2. * m;
-  const Eigen::Vector3d l_b_n = mat_vec(a, l_n);
-  const Eigen::Vector3d w_b_n = l_b_n.cwiseQuotient(c.inertia);
-  const Eigen::Quaterniond dq_n = dot_q(w_b_n, c.ori);
-  const Eigen::Quaterniond q_half = add_scaled(c.ori, dt / 2., dq_n);
-  c.angmom += dt * m;
-  const Eigen::Vector3d l_b_half = mat_vec(a, c.angmom);
-  const Eigen::Vector3d w_b_half = l_b_half.cwiseQuotient(c.inertia);
-  const Eigen::Quaterniond dq_half = dot_q(w_b_half, q_half);
-  c.ori = add_scaled(c.ori, dt, dq_half);
-  c.angvel = c.ori * w_b_half;  // (before normalising, as YADE)
-  normalize(c.ori);
-  // leapfrogTranslate
-  c.pos += dt * c.vel;
-  return damping != 0 ? damp : 0.0;
+  double damp = 0;
+  integrate_clump_bodies(&c, &load, 1, gravity, damping, dt, &damp);
+  return damp;
 }
 
 double clump_kinetic_energy(const ClumpBody& c) {

@@ -98,7 +98,45 @@ struct ClumpLoad {
 double integrate_clump(ClumpBody& c, const ClumpLoad& load, const Eigen::Vector3d& gravity,
                        double damping, double dt);
 
+/// integrate_clump for clumps[0, count) with loads[0, count), several at a time (vectorised
+/// across clumps, the same bits as one by one); damp[k]: clump k's damping estimate.
+void integrate_clump_bodies(ClumpBody* clumps, const ClumpLoad* loads, std::size_t count,
+                            const Eigen::Vector3d& gravity, double damping, double dt,
+                            double* damp);
+
 /// Kinetic energy ½Mv² + ½ω·(R I Rᵀ)ω.
 double clump_kinetic_energy(const ClumpBody& c);
+
+/// YADE's Clump::moveMembers for member m: pos = X + q·l, ori = q·q_l, vel = V + ω × (pos − X),
+/// written out in the order in which Eigen evaluates those expressions (its _transformVector
+/// uv = 2 (v × l), l + w uv + v × uv; its SSE2 quaternion product), the same bits without the
+/// temporaries.
+inline void place_member(const ClumpBody& c, std::size_t m, Eigen::Vector3d& pos,
+                         Eigen::Quaterniond& ori, Eigen::Vector3d& vel) {
+  const double qw = c.ori.w(), qx = c.ori.x(), qy = c.ori.y(), qz = c.ori.z();
+  const Eigen::Vector3d& l = c.local_pos[m];
+  const double l0 = l[0], l1 = l[1], l2 = l[2];
+  double u0 = qy * l2 - qz * l1, u1 = qz * l0 - qx * l2, u2 = qx * l1 - qy * l0;
+  u0 += u0;
+  u1 += u1;
+  u2 += u2;
+  const double p0 = c.pos[0] + ((l0 + qw * u0) + (qy * u2 - qz * u1));
+  const double p1 = c.pos[1] + ((l1 + qw * u1) + (qz * u0 - qx * u2));
+  const double p2 = c.pos[2] + ((l2 + qw * u2) + (qx * u1 - qy * u0));
+  pos[0] = p0;
+  pos[1] = p1;
+  pos[2] = p2;
+  const Eigen::Quaterniond& b = c.local_ori[m];
+  const double bw = b.w(), bx = b.x(), by = b.y(), bz = b.z();
+  ori = Eigen::Quaterniond((qw * bw - qy * by) - (qz * bz + qx * bx),   // w
+                           (qw * bx + qy * bz) - (qz * by - qx * bw),   // x
+                           (qw * by + qy * bw) + (qz * bx - qx * bz),   // y
+                           (qw * bz - qy * bx) + (qz * bw + qx * by));  // z
+  const double d0 = p0 - c.pos[0], d1 = p1 - c.pos[1], d2 = p2 - c.pos[2];
+  const double w0 = c.angvel[0], w1 = c.angvel[1], w2 = c.angvel[2];
+  vel[0] = c.vel[0] + (w1 * d2 - w2 * d1);
+  vel[1] = c.vel[1] + (w2 * d0 - w0 * d2);
+  vel[2] = c.vel[2] + (w0 * d1 - w1 * d0);
+}
 
 }  // namespace gs::solver

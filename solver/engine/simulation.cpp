@@ -135,18 +135,18 @@ bool Simulation::integrate_clumps() {
   const double dt = cfg_.dt;
   bool finite = true;
   double gravity_power = 0, damping = 0;
+  for (const ClumpBody& c : clumps_) gravity_power += c.mass * cfg_.gravity.dot(c.vel);
+  clump_damping_.resize(clumps_.size());
+  integrate_clump_bodies(clumps_.data(), clump_loads_.data(), clumps_.size(), cfg_.gravity,
+                         cfg_.damping, dt, clump_damping_.data());
   for (std::size_t k = 0; k < clumps_.size(); ++k) {
-    ClumpBody& c = clumps_[k];
-    const ClumpLoad& load = clump_loads_[k];
-    gravity_power += c.mass * cfg_.gravity.dot(c.vel);
-    damping += integrate_clump(c, load, cfg_.gravity, cfg_.damping, dt);
+    const ClumpBody& c = clumps_[k];
+    damping += clump_damping_[k];
     finite = finite && c.pos.allFinite() && c.vel.allFinite() && c.angmom.allFinite();
     // YADE's Clump::moveMembers.
     for (std::size_t m = 0; m < c.members.size(); ++m) {
       const std::uint32_t i = c.members[m];
-      p_.pos[i] = c.pos + c.ori * c.local_pos[m];
-      p_.ori[i] = c.ori * c.local_ori[m];
-      p_.vel[i] = c.vel + c.angvel.cross(p_.pos[i] - c.pos);
+      place_member(c, m, p_.pos[i], p_.ori[i], p_.vel[i]);
       p_.angvel[i] = c.angvel;
     }
   }
@@ -700,7 +700,7 @@ void Simulation::step() {
         ro += particle_dissipation_[2 * i + 1];
       }
       const IntegrationSums sums =
-          integrate_particles(p_, begin, end, cfg_.gravity, cfg_.damping, dt);
+          integrate_particles(p_, begin, end, cfg_.gravity, cfg_.damping, dt, !clumps_.empty());
       finite = finite && sums.finite;
       chunk_sums_[kSums * c] = fr;
       chunk_sums_[kSums * c + 1] = ro;

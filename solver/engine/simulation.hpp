@@ -181,6 +181,7 @@ class Simulation {
   std::size_t removed_count_ = 0;
   double removed_mass_ = 0;
   std::vector<ClumpLoad> clump_loads_;
+  std::vector<double> clump_damping_;  // per clump, this step (integrate_clumps)
   NeighborList nl_;
   std::vector<ContactHistory> hist_;  // parallel to nl_.pairs
   bool facet_forces_ = false;
