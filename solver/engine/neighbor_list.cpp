@@ -14,6 +14,7 @@ bool NeighborList::stale(const ParticleState& p, const std::vector<WallState>& w
   for (std::size_t i = 0; i < p.size(); ++i)
     dmax2 = std::max(dmax2, (p.pos[i] - ref_pos[i]).squaredNorm());
   const double dmax = std::sqrt(dmax2);
+  moved = HUGE_VAL;  // (until known: a rebuild follows every early return)
   if (2 * dmax > skin) return true;
   double wmax = 0;
   for (std::size_t w = 0; w < walls.size(); ++w) {
@@ -27,6 +28,7 @@ bool NeighborList::stale(const ParticleState& p, const std::vector<WallState>& w
     }
     wmax = std::max(wmax, move);
   }
+  moved = dmax + wmax;
   return dmax + wmax > skin;
 }
 
@@ -60,6 +62,7 @@ void NeighborList::build(const ParticleState& p, const std::vector<WallState>& w
   if (n >= kWallBase) throw std::invalid_argument("too many particles for the neighbour list");
   pairs.clear();
   ref_pos = p.pos;
+  moved = 0;
   wall_ref.resize(walls.size());
   wall_normal_ref.resize(walls.size());
   wall_ori_ref.resize(walls.size());

@@ -21,6 +21,9 @@ struct NeighborList {
   std::vector<Eigen::Vector3d> wall_normal_ref;
   std::vector<Eigen::Quaterniond> wall_ori_ref;  // facet walls' rotations at the last build
   std::int64_t builds = 0;
+  /// Set by stale(): a bound on how far any particle and any wall point have moved since the
+  /// last build (m), i.e. on how much any pair's gap can have closed.
+  mutable double moved = 0;
 
   /// True when some pair may have come within contact since the last build.
   bool stale(const ParticleState& p, const std::vector<WallState>& walls) const;

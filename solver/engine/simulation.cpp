@@ -273,6 +273,27 @@ void Simulation::attach_histories(const std::vector<ContactHistory>& old,
   wall_pairs_.clear();
   for (std::size_t k = 0; k < np; ++k)
     if (nl_.pairs[k].second >= kWallBase) wall_pairs_.push_back(static_cast<std::uint32_t>(k));
+  // Each facet-wall pair's gap at this build: the distance from the sphere's centre to the
+  // closest of the wall's triangles, less its radius, less a margin for the rounding of that
+  // distance. Until the positions have moved by more than it (NeighborList::moved), the pair
+  // provably does not touch and the contact pass skips it: a wall of many small facets within
+  // the skin of a sphere then costs what its contacts cost, not a geometry per facet and step.
+  facet_gap_.assign(np, -HUGE_VAL);
+  for (const std::uint32_t k : wall_pairs_) {
+    const auto [a, b] = nl_.pairs[k];
+    const WallState& w = walls_[b - kWallBase];
+    if (w.spec.shape != WallShape::Facets) continue;
+    const V3 x(p_.pos[a]), wp(w.pos);
+    const double r = p_.radius[a];
+    double dist = HUGE_VAL;
+    for (const auto& f : w.facets) {
+      ContactGeometry g;
+      dist = std::min(dist, facet_sphere_geometry(f, wp, x, r, w.spec.plane_radii, g));
+    }
+    const double tol =
+        1e-9 * (r + w.reach + std::abs(x.x - wp.x) + std::abs(x.y - wp.y) + std::abs(x.z - wp.z));
+    facet_gap_[k] = dist - r - tol;
+  }
   if (std::max(1, cfg_.threads) == 1) return;  // (the per-particle lists serve threads only)
   // Pairs of each particle in pair order (entry = pair << 1 | 1 when the particle is the
   // second body).
@@ -516,7 +537,8 @@ int Simulation::fill_batch(std::size_t& k, std::size_t end, ContactBatch& batch,
       const double reach = p_.radius[a] + p_.radius[b];
       in_reach = !((p_.pos[b] - p_.pos[a]).squaredNorm() > reach * reach);
     } else {
-      in_reach = wall_may_touch(walls_[b - kWallBase], p_.pos[a], p_.radius[a]);
+      in_reach = !(facet_gap_[k] > nl_.moved) &&
+                 wall_may_touch(walls_[b - kWallBase], p_.pos[a], p_.radius[a]);
     }
     hist_[k].real = hist_[k].real & in_reach;
     near[m] = static_cast<std::uint32_t>(k);

@@ -184,6 +184,7 @@ class Simulation {
   std::vector<double> clump_damping_;  // per clump, this step (integrate_clumps)
   NeighborList nl_;
   std::vector<ContactHistory> hist_;  // parallel to nl_.pairs
+  std::vector<double> facet_gap_;     // facet-wall pairs: the gap at the last build (m)
   bool facet_forces_ = false;
   std::vector<std::uint32_t> pair_facet_;  // closest facet of each wall pair (facet forces on)
   std::vector<ContactParams> params_;
