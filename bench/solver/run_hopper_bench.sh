@@ -28,6 +28,7 @@
 # - LIGGGHTS integrates with velocity Verlet (nve/sphere), granoscope with YADE's leapfrog.
 # - Neighbour skin 0.5 mm on both sides (granoscope: half the smallest radius, YADE's default).
 set -euo pipefail
+. "$(dirname "$0")/facet_silo_scene.sh"
 here=$(cd "$(dirname "$0")" && pwd)
 root=$(cd "$here/../.." && pwd)
 build=${1:-$root/build}
@@ -47,34 +48,7 @@ sed -i "s/^thermo $steps\$/thermo $every/" "$work/lig/in.hopper"
 (cd "$work/lig" && liggghts -in in.hopper > log.txt 2>&1)
 
 for contact in yade merged; do
-  cat > "$work/hopper_$contact.toml" <<TOML
-[scene]
-name = "hopper"
-packing = "$ref/packing.csv"
-[material]
-young_Pa = 2.0e6
-stiffness_ratio = 0.3
-friction_deg = 18.0
-density_kg_m3 = 2550.0
-rolling_stiffness = 0.5
-rolling_limit = 0.2
-[solver]
-dt_s = 1.43e-5
-damping = 0.1
-gravity_m_s2 = [0.0, 0.0, -9.81]
-steps = $steps
-max_overlap_ratio = 1.0
-[output]
-every = 100000000
-history_every = $every
-checkpoint_every = 100000000
-[[mesh]]
-file = "$ref/mesh.stl"
-contact = "$contact"
-[outlet]
-keep_lo_m = [-1.0, -1.0, $zlo]
-keep_hi_m = [1.0, 1.0, 1.0]
-TOML
+  facet_silo_scene "$work/hopper_$contact.toml" "$ref" "$contact" "$steps" "$every" "$zlo"
   "$gs" simulate "$work/hopper_$contact.toml" --threads 1 -q -o "$work/run_$contact" > "$work/gs_$contact.txt"
 done
 

@@ -4,6 +4,7 @@
 # same input (our scene reads the reference's packing and its STL), in the same script.
 #   bench/solver/run_mesh_bench.sh [BUILD_DIR]     (needs: apt-get install --no-install-recommends yade)
 set -euo pipefail
+. "$(dirname "$0")/facet_silo_scene.sh"
 here=$(cd "$(dirname "$0")" && pwd)
 root=$(cd "$here/../.." && pwd)
 build=${1:-$root/build}
@@ -16,31 +17,7 @@ trap 'rm -rf "$work"' EXIT
 [ -f "$ref/mesh.stl" ] || { echo "needs ../shared/reference/yade/facets"; exit 1; }
 steps=${STEPS:-20000}
 for contact in yade merged; do
-  cat > "$work/silo_$contact.toml" <<TOML
-[scene]
-name = "silo"
-packing = "$ref/packing.csv"
-[material]
-young_Pa = 2.0e6
-stiffness_ratio = 0.3
-friction_deg = 18.0
-density_kg_m3 = 2550.0
-rolling_stiffness = 0.5
-rolling_limit = 0.2
-[solver]
-dt_s = 1.43e-5
-damping = 0.1
-gravity_m_s2 = [0.0, 0.0, -9.81]
-steps = $steps
-max_overlap_ratio = 1.0
-[output]
-every = 10000000
-history_every = 10000000
-checkpoint_every = 10000000
-[[mesh]]
-file = "$ref/mesh.stl"
-contact = "$contact"
-TOML
+  facet_silo_scene "$work/silo_$contact.toml" "$ref" "$contact" "$steps" 100000000
 done
 ours() { "$gs" simulate "$1" --threads 1 -q -o "$work/run" | sed -n 's/.*(\([0-9.e+]*\) particle-steps\/s.*/\1/p'; }
 g_yade=$(ours "$work/silo_yade.toml")

@@ -532,17 +532,12 @@ Scene load_scene(const std::filesystem::path& path) {
       r.fail("specimen.cloud_solid_fraction", "too dense for random sequential addition (< 0.45)",
              value_str(sp.cloud_solid_fraction));
   }
-  std::vector<double> radii;
-  for (const auto& p : s.particles) radii.push_back(p.radius);
-  if (s.specimen) radii.push_back(0.5 * s.specimen->sizes.dmin_m);
-  s.dt_pwave = pwave_timestep(radii, m.density, m.young_ec);
-  double auto_dt_safety = 0;  // "auto": set again below, once clumps and fillings are in
+  double auto_dt_safety = 0;  // "auto": dt is set at the end, once clumps and fillings are in
   if (sol->contains("dt_s") && (*sol)["dt_s"].is_string()) {
     if (r.string(sol, "solver", "dt_s", true, "") != "auto")
       r.fail("solver.dt_s", "expected a number or \"auto\"");
     auto_dt_safety = r.positive(sol, "solver", "dt_safety", false, 0.3);
-    s.config.dt = auto_dt_safety * pwave_timestep(radii, m.density, m.young_ec);
-    if (!std::isfinite(s.config.dt)) s.config.dt = 1;  // (no particles yet: set below)
+    s.config.dt = 1;  // (a placeholder until then)
   } else {
     s.config.dt = r.positive(sol, "solver", "dt_s", true, 0);
   }
