@@ -144,6 +144,11 @@ std::string history_header(const solver::Simulation& sim) {
         for (const char* c : {"_fx_N", "_fy_N", "_fz_N"})
           h += "," + w.spec.name + "." + std::to_string(f) + c;
   h += ",removed,removed_mass_kg";
+  if (sim.periodic()) {  // the cell's stress (Pa, compression negative) and its matrix (m)
+    static const char* ij[] = {"xx", "xy", "xz", "yx", "yy", "yz", "zx", "zy", "zz"};
+    for (const char* c : ij) h += std::string(",cell_stress_") + c + "_Pa";
+    for (const char* c : ij) h += std::string(",cell_h") + c + "_m";
+  }
   return h;
 }
 
@@ -181,6 +186,13 @@ std::string history_row(solver::Simulation& sim) {
       }
   std::snprintf(buf, sizeof buf, ",%zu,%.17g", sim.removed_count(), sim.removed_mass());
   row += buf;
+  if (sim.periodic())
+    for (const Eigen::Matrix3d& m : {sim.cell_stress(), sim.cell().hsize})
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) {
+          std::snprintf(buf, sizeof buf, ",%.17g", m(i, j));
+          row += buf;
+        }
   return row;
 }
 
@@ -212,6 +224,14 @@ void run(const Args& a) {
   solver::Simulation sim(scene.config, scene.particles, scene.walls);
   if (!scene.clumps.empty()) sim.set_clumps(scene.clumps);
   if (scene.outlet) sim.set_outlet(scene.outlet->first, scene.outlet->second);
+  if (scene.cell) {
+    try {
+      sim.set_periodic(scene.cell->hsize, scene.cell->planar);
+      sim.set_velocity_gradient(scene.cell->vel_grad);
+    } catch (const std::invalid_argument& e) {
+      throw InputError(a.scene, "[cell]", e.what());
+    }
+  }
   if (scene.output.facet_forces) sim.set_facet_forces(true);
   RunMetadata meta;
   meta.provenance = "granoscope simulate " + a.scene;

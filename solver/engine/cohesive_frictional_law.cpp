@@ -28,7 +28,7 @@ inline double zero_max(double x) {
   return 0.0 < x ? x : 0.0;
 }  // std::max(0.0, x)
 
-template <bool kTwist>
+template <bool kTwist, bool kPeriodic>
 [[gnu::always_inline]] inline void law_lanes(ContactBatch& batch, int count, double dt) {
   auto in3 = [&](Batch::Field f, int j) {
     return V3{batch.v[f][j], batch.v[f + 1][j], batch.v[f + 2][j]};
@@ -75,8 +75,13 @@ template <bool kTwist>
     const V3 twist_axis = select(fresh, zero, angle * old_n);
     // Relative velocity of body 2 with respect to body 1 at the contact (seed 004 eq 3.5).
     const double alpha = (r1 + r2) / (r1 + r2 - pen);
-    const V3 rel_radii = (v2 - v1) * alpha + cross(w2, -r2 * n) - cross(w1, r1 * n);
-    const V3 rel_point = (v2 + cross(w2, c2)) - (v1 + cross(w1, c1));
+    V3 rel_radii = (v2 - v1) * alpha + cross(w2, -r2 * n) - cross(w1, r1 * n);
+    V3 rel_point = (v2 + cross(w2, c2)) - (v1 + cross(w1, c1));
+    if constexpr (kPeriodic) {  // (YADE: relativeVelocity += α·shiftVel, or += shiftVel)
+      const V3 sv = in3(Batch::SVX, j);
+      rel_radii += alpha * sv;
+      rel_point += sv;
+    }
     V3 rel = select(ratchet_[j] != 0, rel_radii, rel_point);
     rel = rel - dot(n, rel) * n;
     const V3 shear_inc = rel * dt;
@@ -136,45 +141,51 @@ template <bool kTwist>
 }
 
 // The law compiled for each instruction set (docs/physics.md: the same bits from each).
-void law_generic(ContactBatch& batch, int count, double dt, bool twist) {
-  if (twist)
-    law_lanes<true>(batch, count, dt);
-  else
-    law_lanes<false>(batch, count, dt);
+[[gnu::always_inline]] inline void law_variants(ContactBatch& batch, int count, double dt,
+                                                bool twist, bool periodic) {
+  if (periodic) {
+    if (twist)
+      law_lanes<true, true>(batch, count, dt);
+    else
+      law_lanes<false, true>(batch, count, dt);
+  } else if (twist) {
+    law_lanes<true, false>(batch, count, dt);
+  } else {
+    law_lanes<false, false>(batch, count, dt);
+  }
+}
+
+void law_generic(ContactBatch& batch, int count, double dt, bool twist, bool periodic) {
+  law_variants(batch, count, dt, twist, periodic);
 }
 
 #if GS_SIMD_X86
-__attribute__((target("avx2"))) void law_avx2(ContactBatch& batch, int count, double dt,
-                                              bool twist) {
-  if (twist)
-    law_lanes<true>(batch, count, dt);
-  else
-    law_lanes<false>(batch, count, dt);
+__attribute__((target("avx2"))) void law_avx2(ContactBatch& batch, int count, double dt, bool twist,
+                                              bool periodic) {
+  law_variants(batch, count, dt, twist, periodic);
 }
 
 __attribute__((target("avx512f"))) void law_avx512(ContactBatch& batch, int count, double dt,
-                                                   bool twist) {
-  if (twist)
-    law_lanes<true>(batch, count, dt);
-  else
-    law_lanes<false>(batch, count, dt);
+                                                   bool twist, bool periodic) {
+  law_variants(batch, count, dt, twist, periodic);
 }
 #endif
 
 }  // namespace
 
-void cohesive_frictional_batch(ContactBatch& batch, int count, double dt, bool twist) {
+void cohesive_frictional_batch(ContactBatch& batch, int count, double dt, bool twist,
+                               bool periodic) {
 #if GS_SIMD_X86
   switch (simd_level()) {
     case SimdLevel::Avx512:
-      return law_avx512(batch, count, dt, twist);
+      return law_avx512(batch, count, dt, twist, periodic);
     case SimdLevel::Avx2:
-      return law_avx2(batch, count, dt, twist);
+      return law_avx2(batch, count, dt, twist, periodic);
     case SimdLevel::Generic:
       break;
   }
 #endif
-  law_generic(batch, count, dt, twist);
+  law_generic(batch, count, dt, twist, periodic);
 }
 
 }  // namespace gs::solver

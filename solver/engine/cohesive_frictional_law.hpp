@@ -50,6 +50,7 @@ struct ContactBatch {
     C1X, C1Y, C1Z,  // contact point − centre of body 1 (torque arm)
     C2X, C2Y, C2Z,  // contact point − centre of body 2
     FRESH,          // 1: the contact is new this step (history starts at zero)
+    SVX, SVY, SVZ,  // periodic cell: velocity of body 2's image relative to body 2 (else unset)
     ONX, ONY, ONZ,  // last step's normal
     KN, KS, KR, KTW, TAN_FRICTION, MAX_ROLL, MAX_TWIST,  // KTW, MAX_TWIST: only with `twist`
     // history: read, and written back with this step's values
@@ -80,6 +81,9 @@ struct ContactBatch {
 /// every variant gives the same bits.
 /// `twist`: twisting moments are enabled. Without it KTW, MAX_TWIST and TX..TZ are not read
 /// (the caller need not fill them) and the twisting moments come out zero.
-void cohesive_frictional_batch(ContactBatch& batch, int count, double dt, bool twist);
+/// `periodic`: body 2 is an image across a periodic cell's faces, moving with SV relative to
+/// the body (YADE's getIncidentVel with shiftVel: α·SV added to the relative velocity).
+void cohesive_frictional_batch(ContactBatch& batch, int count, double dt, bool twist,
+                               bool periodic = false);
 
 }  // namespace gs::solver

@@ -8,8 +8,26 @@
 
 namespace gs::solver {
 
-bool NeighborList::stale(const ParticleState& p, const std::vector<WallState>& walls) const {
+bool NeighborList::stale(const ParticleState& p, const std::vector<WallState>& walls,
+                         const PeriodicCell* cell) const {
   if (ref_pos.size() != p.size() || wall_ref.size() != walls.size()) return true;
+  if (cell) {
+    // Branch vectors change by the particles' non-affine displacements and by M·(branch at the
+    // build), M = ΔH·H_ref⁻¹ (|M|₂ ≤ |M|_F): a pair farther than r_a + r_b + skin at the
+    // build stays apart while 2·max|u| + |M|·(2 r_max + skin) < skin.
+    moved = HUGE_VAL;  // (no facet walls in a periodic cell)
+    if (cell->hsize == h_ref) {
+      double d2 = 0;
+      for (std::size_t i = 0; i < p.size(); ++i)
+        d2 = std::max(d2, (p.pos[i] - ref_pos[i]).squaredNorm());
+      return 2 * std::sqrt(d2) > skin;
+    }
+    const Eigen::Matrix3d m = (cell->hsize - h_ref) * h_ref.inverse();
+    double d2 = 0;
+    for (std::size_t i = 0; i < p.size(); ++i)
+      d2 = std::max(d2, (p.pos[i] - ref_pos[i] - m * ref_pos[i]).squaredNorm());
+    return 2 * std::sqrt(d2) + m.norm() * (2 * max_radius + skin) > skin;
+  }
   double dmax2 = 0;
   for (std::size_t i = 0; i < p.size(); ++i)
     dmax2 = std::max(dmax2, (p.pos[i] - ref_pos[i]).squaredNorm());
@@ -57,10 +75,12 @@ constexpr int kForward[13][3] = {{1, 0, 0},  {-1, 1, 0}, {0, 1, 0},  {1, 1, 0}, 
 
 }  // namespace
 
-void NeighborList::build(const ParticleState& p, const std::vector<WallState>& walls) {
+void NeighborList::build(const ParticleState& p, const std::vector<WallState>& walls,
+                         const PeriodicCell* periodic_cell, bool planar_z) {
   const std::size_t n = p.size();
   if (n >= kWallBase) throw std::invalid_argument("too many particles for the neighbour list");
   pairs.clear();
+  cell_dist.clear();
   ref_pos = p.pos;
   moved = 0;
   wall_ref.resize(walls.size());
@@ -73,6 +93,7 @@ void NeighborList::build(const ParticleState& p, const std::vector<WallState>& w
   }
   ++builds;
   if (n == 0) return;
+  if (periodic_cell) return build_periodic(p, *periodic_cell, planar_z);
   double rmax = 0;
   const bool removal = p.removed.size() == n;
   auto gone = [&](std::size_t i) { return removal && p.removed[i] != 0; };
@@ -225,6 +246,125 @@ void NeighborList::build(const ParticleState& p, const std::vector<WallState>& w
       for (; y > b && (y - 1)->second > v.second; --y) *y = *(y - 1);
       *y = v;
     }
+  }
+}
+
+void NeighborList::build_periodic(const ParticleState& p, const PeriodicCell& cell, bool planar_z) {
+  // Particles are binned by their wrapped fractional coordinates w = s − floor(s), s = H⁻¹·x,
+  // into cells at least 2 r_max + skin wide (measured between the faces of the sheared cell),
+  // and a cell's neighbours wrap around the faces; a pair found between particle i and the
+  // image of j shifted by n periods (n ∈ {−1, 0, 1}³) has cellDist n + floor(s_i) − floor(s_j)
+  // in the unwrapped positions YADE keeps.
+  const std::size_t n = p.size();
+  const bool removal = p.removed.size() == n;
+  auto gone = [&](std::size_t i) { return removal && p.removed[i] != 0; };
+  h_ref = cell.hsize;
+  double rmax = 0;
+  for (std::size_t i = 0; i < n; ++i)
+    if (!gone(i)) rmax = std::max(rmax, p.radius[i]);
+  max_radius = rmax;
+  const double reach_max = 2 * rmax + skin;
+  const Eigen::Vector3d width = cell.widths();
+  Eigen::Array3i dims;
+  bool wraps[3];
+  for (int k = 0; k < 3; ++k) {
+    wraps[k] = !(k == 2 && planar_z);
+    if (!wraps[k]) {
+      if (!(width[k] > reach_max))
+        throw PeriodicTooSmall("periodic cell thinner in z (" + std::to_string(width[k]) +
+                               " m) than 2 r_max + skin (" + std::to_string(reach_max) + " m)");
+      dims[k] = 1;
+      continue;
+    }
+    dims[k] = static_cast<int>(std::min(1024.0, std::floor(width[k] / reach_max)));
+    if (!(dims[k] >= 3))
+      throw PeriodicTooSmall(
+          "periodic cell width " + std::to_string(width[k]) + " m along base " + std::to_string(k) +
+          " is below 3 (2 r_max + skin) = " + std::to_string(3 * reach_max) + " m");
+  }
+  const std::size_t ncells = static_cast<std::size_t>(dims[0]) * dims[1] * dims[2];
+  auto index_of = [&](int x, int y, int z) {
+    return static_cast<std::uint32_t>((z * dims[1] + y) * dims[0] + x);
+  };
+  const Eigen::Matrix3d inv = cell.hsize.inverse();
+  period_.resize(n);
+  cell_of_particle_.resize(n);
+  cell_start_.assign(ncells + 1, 0);
+  std::vector<Eigen::Vector3d> wrapped(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (gone(i)) continue;
+    Eigen::Vector3d s = inv * p.pos[i];
+    Eigen::Array3i c;
+    for (int k = 0; k < 3; ++k) {
+      const double fl = wraps[k] ? std::floor(s[k]) : 0.0;
+      period_[i][k] = static_cast<int>(fl);
+      s[k] -= fl;
+      c[k] = std::min(dims[k] - 1, std::max(0, static_cast<int>(std::floor(s[k] * dims[k]))));
+    }
+    wrapped[i] = cell.hsize * s;
+    cell_of_particle_[i] = index_of(c[0], c[1], c[2]);
+    ++cell_start_[cell_of_particle_[i] + 1];
+  }
+  for (std::size_t c = 0; c < ncells; ++c) cell_start_[c + 1] += cell_start_[c];
+  cell_fill_.assign(cell_start_.begin(), cell_start_.end() - 1);
+  slots_.resize(cell_start_[ncells]);
+  const bool clumped = p.clump.size() == n;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (gone(i)) continue;
+    const Eigen::Vector3d& x = wrapped[i];
+    slots_[cell_fill_[cell_of_particle_[i]]++] = {
+        x[0], x[1], x[2], p.radius[i], static_cast<std::uint32_t>(i), clumped ? p.clump[i] : -1};
+  }
+  found_periodic_.clear();
+  auto test = [&](const Slot& a, const Slot& b, const Eigen::Vector3i& shift,
+                  const Eigen::Vector3d& offset) {
+    if (a.clump >= 0 && a.clump == b.clump) return;
+    const double reach = a.r + b.r + skin;
+    const double dx = b.x + offset[0] - a.x, dy = b.y + offset[1] - a.y, dz = b.z + offset[2] - a.z;
+    if (!(dx * dx + dy * dy + dz * dz < reach * reach * (1 + 1e-12))) return;
+    const Eigen::Vector3i cd = shift + period_[a.index] - period_[b.index];
+    if (a.index < b.index)
+      found_periodic_.push_back({a.index, b.index, cd});
+    else
+      found_periodic_.push_back({b.index, a.index, -cd});
+  };
+  for (int cz = 0; cz < dims[2]; ++cz)
+    for (int cy = 0; cy < dims[1]; ++cy)
+      for (int cx = 0; cx < dims[0]; ++cx) {
+        const std::uint32_t ci = index_of(cx, cy, cz);
+        const std::uint32_t s0 = cell_start_[ci], s1 = cell_start_[ci + 1];
+        if (s0 == s1) continue;
+        for (std::uint32_t s = s0; s < s1; ++s)
+          for (std::uint32_t t = s + 1; t < s1; ++t)
+            test(slots_[s], slots_[t], Eigen::Vector3i::Zero(), Eigen::Vector3d::Zero());
+        for (const auto& o : kForward) {
+          int nc[3] = {cx + o[0], cy + o[1], cz + o[2]};
+          Eigen::Vector3i shift = Eigen::Vector3i::Zero();
+          bool inside = true;
+          for (int k = 0; k < 3; ++k) {
+            if (nc[k] >= 0 && nc[k] < dims[k]) continue;
+            if (!wraps[k]) {
+              inside = false;
+              break;
+            }
+            shift[k] = nc[k] < 0 ? -1 : 1;
+            nc[k] -= shift[k] * dims[k];
+          }
+          if (!inside) continue;
+          const Eigen::Vector3d offset = cell.hsize * shift.cast<double>();
+          const std::uint32_t cj = index_of(nc[0], nc[1], nc[2]);
+          const std::uint32_t t0 = cell_start_[cj], t1 = cell_start_[cj + 1];
+          for (std::uint32_t s = s0; s < s1; ++s)
+            for (std::uint32_t t = t0; t < t1; ++t) test(slots_[s], slots_[t], shift, offset);
+        }
+      }
+  std::sort(found_periodic_.begin(), found_periodic_.end(),
+            [](const auto& x, const auto& y) { return x.a != y.a ? x.a < y.a : x.b < y.b; });
+  pairs.resize(found_periodic_.size());
+  cell_dist.resize(found_periodic_.size());
+  for (std::size_t k = 0; k < found_periodic_.size(); ++k) {
+    pairs[k] = {found_periodic_[k].a, found_periodic_[k].b};
+    cell_dist[k] = found_periodic_[k].cd;
   }
 }
 

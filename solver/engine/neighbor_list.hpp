@@ -5,11 +5,20 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "dem_types.hpp"
+#include "periodic_cell.hpp"
 
 namespace gs::solver {
+
+/// A periodic cell too small for the neighbour search (or for one image per pair).
+class PeriodicTooSmall : public std::invalid_argument {
+ public:
+  using std::invalid_argument::invalid_argument;
+};
 
 struct NeighborList {
   double skin = 0;
@@ -21,13 +30,29 @@ struct NeighborList {
   std::vector<Eigen::Vector3d> wall_normal_ref;
   std::vector<Eigen::Quaterniond> wall_ori_ref;  // facet walls' rotations at the last build
   std::int64_t builds = 0;
+  /// Periodic cell (build with a cell): the period of body b's image relative to body a, per
+  /// pair (YADE's Interaction.cellDist: the branch vector is x_b + H·cell_dist − x_a).
+  std::vector<Eigen::Vector3i> cell_dist;
+  Eigen::Matrix3d h_ref = Eigen::Matrix3d::Identity();  // the cell at the last build
+  double max_radius = 0;                                // of the particles at the last build
   /// Set by stale(): a bound on how far any particle and any wall point have moved since the
   /// last build (m), i.e. on how much any pair's gap can have closed.
   mutable double moved = 0;
 
   /// True when some pair may have come within contact since the last build.
-  bool stale(const ParticleState& p, const std::vector<WallState>& walls) const;
-  void build(const ParticleState& p, const std::vector<WallState>& walls);
+  /// With a cell, the gap of a pair also closes by the cell's deformation since the build:
+  /// with M = (H − H_ref)·H_ref⁻¹, by at most |M|·(2 r_max + skin) beyond twice the largest
+  /// non-affine displacement x − x_ref − M·x_ref.
+  bool stale(const ParticleState& p, const std::vector<WallState>& walls,
+             const PeriodicCell* cell = nullptr) const;
+  /// With a cell: pairs between images across its faces too (each periodic direction must be
+  /// at least 3 search cells of 2 r_max + skin wide; PeriodicTooSmall otherwise). `planar_z`:
+  /// all centres lie in one plane z = const and the cell is thicker in z than 2 r_max + skin, so
+  /// no z-image can be within reach and z is not searched periodically.
+  void build(const ParticleState& p, const std::vector<WallState>& walls,
+             const PeriodicCell* cell = nullptr, bool planar_z = false);
+  /// The smallest cell width (m) build() accepts in a periodic direction.
+  double min_periodic_width(double max_radius) const { return 3 * (2 * max_radius + skin); }
 
  private:
   // Scratch of build(), kept between builds (no allocations once sized).
@@ -46,6 +71,13 @@ struct NeighborList {
   std::vector<std::uint32_t> plain_walls_;
   std::vector<std::pair<std::uint32_t, std::uint32_t>> found_;
   std::vector<std::uint32_t> first_start_;
+  struct PeriodicPair {
+    std::uint32_t a, b;
+    Eigen::Vector3i cd;
+  };
+  std::vector<PeriodicPair> found_periodic_;
+  std::vector<Eigen::Vector3i> period_;  // floor(H⁻¹·x) of each particle at the build
+  void build_periodic(const ParticleState& p, const PeriodicCell& cell, bool planar_z);
 };
 
 }  // namespace gs::solver

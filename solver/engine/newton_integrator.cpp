@@ -5,6 +5,7 @@
 
 #include <Eigen/Geometry>
 
+#include "periodic_cell.hpp"
 #include "rigid_clump.hpp"
 #include "simd_level.hpp"
 
@@ -416,6 +417,62 @@ void integrate_clump_bodies(ClumpBody* clumps, const ClumpLoad* loads, std::size
       damp[k0 + static_cast<std::size_t>(j)] = b.v[F::DAMP][j];
     }
   }
+}
+
+IntegrationSums integrate_particles_homogeneous(ParticleState& p, std::size_t begin,
+                                                std::size_t end, const Eigen::Vector3d& gravity,
+                                                double damping, double dt,
+                                                const HomogeneousField& field) {
+  IntegrationSums sums;
+  const V3 g(gravity);
+  const bool planar = field.planar;
+  const V3 d_spin(field.d_spin);
+  for (std::size_t i = begin; i < end; ++i) {
+    const V3 pos0(p.pos[i]);
+    V3 vel(p.vel[i]), angvel(p.angvel[i]);
+    if (!p.fixed[i]) {
+      const double m = p.mass[i];
+      const V3 force(p.force[i]), torque(p.torque[i]);
+      const V3 fluct = vel - mat_vec(field.prev_vel_grad, pos0);  // Cell::bodyFluctuationVel
+      sums.gravity_power += m * dot(g, vel);
+      sums.external_power += dot(V3(p.external_force[i]), vel);
+      if (damping != 0)
+        sums.damping += dot(abs(fluct), abs(force + m * g)) * damping * dt +
+                        dot(abs(angvel), abs(torque)) * damping * dt;
+      V3 lin = force / m + g;  // computeAccel (blocked components: 0)
+      if (planar) lin.z = 0;
+      lin = {lin.x * cundall_factor(damping, dt, fluct.x, lin.x),
+             lin.y * cundall_factor(damping, dt, fluct.y, lin.y),
+             lin.z * cundall_factor(damping, dt, fluct.z, lin.z)};
+      lin += mat_vec(field.prev_vel_grad, vel);  // convective term (homoDeform = 2)
+      vel = vel + dt * lin;
+      if (!p.rot_blocked[i]) {
+        V3 ang = torque / p.inertia[i];
+        if (planar) ang.x = ang.y = 0;
+        ang = {ang.x * cundall_factor(damping, dt, angvel.x, ang.x),
+               ang.y * cundall_factor(damping, dt, angvel.y, ang.y),
+               ang.z * cundall_factor(damping, dt, angvel.z, ang.z)};
+        angvel = angvel + dt * ang;
+      }
+    } else {
+      vel += mat_vec(dt * field.prev_vel_grad, vel);  // (YADE: fully blocked bodies)
+    }
+    vel += mat_vec(field.d_vel_grad, pos0);  // leapfrogTranslate: the change of the mean field
+    const V3 pos = pos0 + vel * dt;
+    angvel += d_spin;  // leapfrogSphericalRotate (YADE adds it always)
+    vel.store(p.vel[i]);
+    angvel.store(p.angvel[i]);
+    pos.store(p.pos[i]);
+    add_to(p.rot[i], angvel * dt);
+    const double a2 = squared_norm(angvel);
+    if (a2 != 0) {
+      const double a = std::sqrt(a2);
+      p.ori[i] = Eigen::Quaterniond(Eigen::AngleAxisd(a * dt, p.angvel[i] / a)) * p.ori[i];
+    }
+    p.ori[i].normalize();
+    sums.finite = sums.finite && squared_norm(vel) < HUGE_VAL && squared_norm(pos) < HUGE_VAL;
+  }
+  return sums;
 }
 
 }  // namespace gs::solver

@@ -37,4 +37,23 @@ IntegrationSums integrate_particles(ParticleState& p, std::size_t begin, std::si
                                     const Eigen::Vector3d& gravity, double damping, double dt,
                                     bool clump_members = true);
 
+/// The homogeneous-deformation terms of YADE's NewtonIntegrator in a periodic cell
+/// (Cell.homoDeform = 2), and YADE's 2D emulation blockedDOFs = 'zXY'.
+struct HomogeneousField {
+  Eigen::Matrix3d prev_vel_grad = Eigen::Matrix3d::Zero();  // L of the previous step
+  Eigen::Matrix3d d_vel_grad = Eigen::Matrix3d::Zero();     // L − L_prev
+  Eigen::Vector3d d_spin = Eigen::Vector3d::Zero();  // (−W_yz, W_xz, −W_xy), W = ½(ΔL − ΔLᵀ)
+  bool planar = false;  // no translation along z, no rotation about x or y
+};
+
+/// integrate_particles with a homogeneous field, per particle in YADE's order: damping of the
+/// force part of the acceleration against the fluctuation velocity v − L_prev·x, the convective
+/// term a += L_prev·v, v += dt·a, then v += ΔL·x and x += dt·v; ω += dt·α, then ω += Δspin and
+/// the orientation turned by |ω|·dt (AngleAxis, as leapfrogSphericalRotate). Blocked degrees of
+/// freedom get no acceleration (their velocities keep what the field gives them). No clumps.
+IntegrationSums integrate_particles_homogeneous(ParticleState& p, std::size_t begin,
+                                                std::size_t end, const Eigen::Vector3d& gravity,
+                                                double damping, double dt,
+                                                const HomogeneousField& field);
+
 }  // namespace gs::solver

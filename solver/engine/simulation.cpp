@@ -205,11 +205,62 @@ void Simulation::insert_particle(std::uint32_t i, const Eigen::Vector3d& positio
   invalidate_neighbors();
 }
 
+void Simulation::set_periodic(const Eigen::Matrix3d& hsize, bool planar) {
+  if (step_ != 0) throw std::invalid_argument("a periodic cell is set before the first step");
+  if (!walls_.empty()) throw std::invalid_argument("walls in a periodic cell are not supported");
+  if (!clumps_.empty()) throw std::invalid_argument("clumps in a periodic cell are not supported");
+  if (!hsize.allFinite() || !(hsize.determinant() > 0))
+    throw std::invalid_argument("periodic cell is degenerate or inverted (det H = " +
+                                std::to_string(hsize.determinant()) + ")");
+  if (planar) {
+    // YADE's 2D emulation: the cell's third base vector along z, no z component in the others,
+    // and every centre in one plane z = const.
+    if (hsize(2, 0) != 0 || hsize(2, 1) != 0 || hsize(0, 2) != 0 || hsize(1, 2) != 0)
+      throw std::invalid_argument("2D cell: the base vectors must lie in the xy plane and z");
+    for (std::size_t i = 1; i < p_.size(); ++i)
+      if (p_.pos[i].z() != p_.pos[0].z())
+        throw std::invalid_argument("2D: particle " + std::to_string(p_.id[i]) +
+                                    " at z = " + std::to_string(p_.pos[i].z()) +
+                                    " m is not in the plane z = " + std::to_string(p_.pos[0].z()) +
+                                    " m");
+  }
+  periodic_ = true;
+  planar_ = planar;
+  field_.planar = planar;
+  cell_ = PeriodicCell{};
+  cell_.hsize = hsize;
+  cell_.prev_hsize = hsize;
+  invalidate_neighbors();
+  nl_.build(p_, walls_, cell_ptr(), planar_);  // (throws PeriodicTooSmall now, not at step 1)
+  invalidate_neighbors();
+}
+
+void Simulation::set_velocity_gradient(const Eigen::Matrix3d& l) {
+  if (!periodic_) throw std::invalid_argument("a velocity gradient needs a periodic cell");
+  if (!l.allFinite()) throw std::invalid_argument("velocity gradient is not finite");
+  if (planar_ && (l(2, 0) != 0 || l(2, 1) != 0 || l(0, 2) != 0 || l(1, 2) != 0 || l(2, 2) != 0))
+    throw std::invalid_argument("2D: the velocity gradient must be in the xy plane");
+  cell_.set_velocity_gradient(l);
+}
+
+Eigen::Matrix3d Simulation::cell_stress() const {
+  Eigen::Matrix3d sigma = Eigen::Matrix3d::Zero();
+  for (std::size_t k = 0; k < hist_.size(); ++k) {
+    const auto& h = hist_[k];
+    if (!h.real || h.b >= kWallBase) continue;
+    Eigen::Vector3d branch = p_.pos[h.a] - p_.pos[h.b];
+    if (periodic_) branch -= cell_.hsize * nl_.cell_dist[k].cast<double>();
+    sigma += (h.fn * h.normal + h.shear_force) * branch.transpose();
+  }
+  const double volume = periodic_ ? cell_.volume() : 0.0;
+  return volume > 0 ? Eigen::Matrix3d(sigma / volume) : sigma;
+}
+
 void Simulation::rebuild_neighbors() {
   // The old histories and parameters are swapped out (their buffers are reused).
   old_hist_.swap(hist_);
   old_params_.swap(params_);
-  nl_.build(p_, walls_);
+  nl_.build(p_, walls_, cell_ptr(), planar_);
   attach_histories(old_hist_, &old_params_);
 }
 
@@ -385,6 +436,7 @@ void Simulation::set_facet_forces(bool on) {
   }
   m1 = {V3(p_.pos[a]), V3(p_.vel[a]), V3(p_.angvel[a])};
   m2 = {V3(p_.pos[b]), V3(p_.vel[b]), V3(p_.angvel[b])};
+  if (periodic_) m2.pos = m2.pos + cell_.shift_pos(nl_.cell_dist[k]);  // se32.position + shift2
   return sphere_sphere_geometry(m1.pos, p_.radius[a], m2.pos, p_.radius[b], g);
 }
 
@@ -466,6 +518,7 @@ void Simulation::accumulate_walls() {
   put(F::C1X, g.point - m1.pos);
   put(F::C2X, g.point - m2.pos);
   B.v[F::FRESH][j] = h.real ? 0 : 1;
+  if (periodic_) put(F::SVX, b < kWallBase ? cell_.shift_vel(nl_.cell_dist[k]) : V3());
   put(F::ONX, V3(h.normal));
   put(F::SX, V3(h.shear_force));
   put(F::BX, V3(h.bending));
@@ -535,7 +588,12 @@ int Simulation::fill_batch(std::size_t& k, std::size_t end, ContactBatch& batch,
     bool in_reach;
     if (b < kWallBase) {
       const double reach = p_.radius[a] + p_.radius[b];
-      in_reach = !((p_.pos[b] - p_.pos[a]).squaredNorm() > reach * reach);
+      if (periodic_) {  // (the image of b)
+        const V3 d = V3(p_.pos[b]) + cell_.shift_pos(nl_.cell_dist[k]) - V3(p_.pos[a]);
+        in_reach = !(squared_norm(d) > reach * reach * (1 + 1e-12));
+      } else {
+        in_reach = !((p_.pos[b] - p_.pos[a]).squaredNorm() > reach * reach);
+      }
     } else {
       in_reach = !(facet_gap_[k] > nl_.moved) &&
                  wall_may_touch(walls_[b - kWallBase], p_.pos[a], p_.radius[a]);
@@ -571,7 +629,8 @@ int Simulation::fill_batch(std::size_t& k, std::size_t end, ContactBatch& batch,
 }
 
 void Simulation::step() {
-  if (nl_.stale(p_, walls_)) rebuild_neighbors();
+  if (periodic_) cell_.integrate(cfg_.dt);  // (YADE: Scene::moveToNextTimeStep, before engines)
+  if (nl_.stale(p_, walls_, cell_ptr())) rebuild_neighbors();
   const double dt = cfg_.dt;
   const std::size_t np = nl_.pairs.size();
   loads_.resize(np);
@@ -616,7 +675,7 @@ void Simulation::step() {
       };
       for (std::size_t k = 0; k < np;) {
         const int m = fill_batch(k, np, batch, lane_pair, max_overlap_ratio);
-        cohesive_frictional_batch(batch, m, dt, cfg_.twist_beta > 0);
+        cohesive_frictional_batch(batch, m, dt, cfg_.twist_beta > 0, periodic_);
         for (int j = 0; j < m; ++j) {
           const std::uint32_t kk = lane_pair[j];
           ContactLoads L;
@@ -658,7 +717,7 @@ void Simulation::step() {
       std::uint32_t lane_pair[ContactBatch::kLanes];
       for (std::size_t k = np * t / nt; k < k_end;) {
         const int m = fill_batch(k, k_end, batch, lane_pair, my_max_overlap);
-        cohesive_frictional_batch(batch, m, dt, cfg_.twist_beta > 0);
+        cohesive_frictional_batch(batch, m, dt, cfg_.twist_beta > 0, periodic_);
         for (int j = 0; j < m; ++j) {
           const std::uint32_t kk = lane_pair[j];
           ContactLoads& L = loads_[kk];
@@ -708,6 +767,15 @@ void Simulation::step() {
       accumulate_walls();
       update_servos();
       if (!clumps_.empty()) gather_clump_loads();  // (before the integration moves members)
+      if (periodic_) {
+        // NewtonIntegrator's start: a pending gradient becomes current, and the change of the
+        // mean field since the last step is added to velocities and spins.
+        cell_.apply_pending_gradient();
+        field_.prev_vel_grad = cell_.prev_vel_grad;
+        field_.d_vel_grad = cell_.vel_grad - cell_.prev_vel_grad;
+        const Eigen::Matrix3d r = 0.5 * (field_.d_vel_grad - field_.d_vel_grad.transpose());
+        field_.d_spin = Eigen::Vector3d(-r(1, 2), r(0, 2), -r(0, 1));
+      }
       for (const auto& w : walls_) ledger_.wall_work += -w.force.dot(w.vel) * dt;
     }  // (implicit barrier: servo velocities and the work terms use this step's loads)
 
@@ -721,8 +789,11 @@ void Simulation::step() {
         fr += particle_dissipation_[2 * i];
         ro += particle_dissipation_[2 * i + 1];
       }
-      const IntegrationSums sums =
-          integrate_particles(p_, begin, end, cfg_.gravity, cfg_.damping, dt, !clumps_.empty());
+      const IntegrationSums sums = periodic_ || planar_
+                                       ? integrate_particles_homogeneous(
+                                             p_, begin, end, cfg_.gravity, cfg_.damping, dt, field_)
+                                       : integrate_particles(p_, begin, end, cfg_.gravity,
+                                                             cfg_.damping, dt, !clumps_.empty());
       finite = finite && sums.finite;
       chunk_sums_[kSums * c] = fr;
       chunk_sums_[kSums * c + 1] = ro;
@@ -739,6 +810,7 @@ void Simulation::step() {
     ledger_.damping_dissipation += chunk_sums_[kSums * c + 4];
   }
   if (!clumps_.empty()) finite = integrate_clumps() && finite;
+  if (periodic_) cell_.prev_vel_grad = cell_.vel_grad;  // (NewtonIntegrator's end)
   if (!(max_overlap_ratio <= cfg_.max_overlap_ratio))
     throw BlowUp("step " + std::to_string(step_) + ": overlap of " +
                  std::to_string(max_overlap_ratio) + " radius exceeds " +
@@ -784,10 +856,16 @@ std::size_t Simulation::sphere_contact_count() const {
 
 double Simulation::kinetic_energy() const {
   double e = 0;
-  for (std::size_t i = 0; i < p_.size(); ++i)
-    if (p_.clump[i] < 0)
-      e += 0.5 * p_.mass[i] * p_.vel[i].squaredNorm() +
-           0.5 * p_.inertia[i] * p_.angvel[i].squaredNorm();
+  for (std::size_t i = 0; i < p_.size(); ++i) {
+    if (p_.clump[i] >= 0) continue;
+    if (periodic_) {  // fluctuations about the mean field (YADE's utils.kineticEnergy)
+      const Eigen::Vector3d v = p_.vel[i] - cell_.vel_grad * p_.pos[i];
+      e += 0.5 * p_.mass[i] * v.squaredNorm() + 0.5 * p_.inertia[i] * p_.angvel[i].squaredNorm();
+      continue;
+    }
+    e += 0.5 * p_.mass[i] * p_.vel[i].squaredNorm() +
+         0.5 * p_.inertia[i] * p_.angvel[i].squaredNorm();
+  }
   for (const auto& c : clumps_) e += clump_kinetic_energy(c);  // (members skipped, as YADE)
   return e;
 }
@@ -880,7 +958,7 @@ const EnergyLedger& Simulation::energy() {
     if (step_ == 0) {
       // Overlaps present in the initial packing become contacts in the first step: their
       // normal elastic energy ½·Kn·u² belongs to the initial state.
-      if (nl_.stale(p_, walls_)) rebuild_neighbors();
+      if (nl_.stale(p_, walls_, cell_ptr())) rebuild_neighbors();
       for (std::size_t k = 0; k < nl_.pairs.size(); ++k) {
         ContactGeometry g;
         BodyMotion m1, m2;
@@ -894,6 +972,9 @@ const EnergyLedger& Simulation::energy() {
 }
 
 void Simulation::check_energy() {
+  // In a periodic cell the ledger does not carry the work of the cell's deformation (the mean
+  // field is imposed, not a load): the check would fire on a correct run.
+  if (periodic_) return;
   const auto& e = energy();
   const double turnover =
       e.stored() + e.dissipated() + std::abs(e.gravity_work) + std::abs(e.wall_work) + e.initial;
@@ -915,7 +996,7 @@ Frame Simulation::frame() const {
     if (p_.removed[i]) continue;  // (left through the outlet)
     auto& q = f.particles.emplace_back();
     q.id = p_.id[i];
-    q.position = p_.pos[i];
+    q.position = periodic_ ? cell_.wrap(p_.pos[i]) : p_.pos[i];
     q.radius = p_.radius[i];
     q.velocity = p_.vel[i];
     q.angular_velocity = p_.angvel[i];
@@ -982,6 +1063,14 @@ Frame Simulation::frame() const {
     q.mass = c.mass;
     q.principal_inertia = c.inertia;
   }
+  if (periodic_) {  // the cell, with the positions wrapped into it
+    f.domain.periodic = true;
+    f.domain.cell = cell_.hsize;
+    f.domain.lo = Eigen::Vector3d::Zero();
+    f.domain.hi = cell_.hsize.rowwise().sum();
+    f.two_d = planar_;
+    return f;
+  }
   const auto [lo, hi] = particle_bounds(f);
   f.domain.lo = lo;
   f.domain.hi = hi;
@@ -991,7 +1080,8 @@ Frame Simulation::frame() const {
 // ------------------------------------------------------------------ checkpoints
 
 namespace {
-constexpr char kMagic[8] = {'G', 'S', 'C', 'K', 'P', 'T', '0', '5'};
+constexpr char kMagic[8] = {'G', 'S', 'C', 'K', 'P', 'T', '0', '6'};
+constexpr char kMagicV05[8] = {'G', 'S', 'C', 'K', 'P', 'T', '0', '5'};  // (no periodic cell)
 constexpr char kMagicV04[8] = {'G', 'S', 'C', 'K', 'P', 'T', '0', '4'};  // (no wall rotation)
 constexpr char kMagicV03[8] = {'G', 'S', 'C', 'K', 'P', 'T', '0', '3'};  // (no clumps)
 
@@ -1074,6 +1164,17 @@ void Simulation::save_checkpoint(const std::filesystem::path& path,
     put_vec(o, p_.removed);
     put(o, static_cast<std::uint64_t>(removed_count_));
     put(o, removed_mass_);
+    put(o, static_cast<std::uint8_t>(periodic_));
+    if (periodic_) {
+      put(o, cell_.hsize);
+      put(o, cell_.trsf);
+      put(o, cell_.vel_grad);
+      put(o, cell_.next_vel_grad);
+      put(o, static_cast<std::uint8_t>(cell_.vel_grad_changed));
+      put(o, cell_.prev_vel_grad);
+      put(o, cell_.prev_hsize);
+      put(o, cell_.vgrad_times_prev_h);
+    }
     put(o, static_cast<std::uint64_t>(extra.size()));
     o.write(extra.data(), static_cast<std::streamsize>(extra.size()));
     if (!o.flush()) throw InputError(path.string(), "cannot write checkpoint");
@@ -1089,7 +1190,8 @@ std::string Simulation::load_checkpoint(const std::filesystem::path& path) {
   in.read(magic, 8);
   const bool v03 = in && std::memcmp(magic, kMagicV03, 8) == 0;
   const bool v04 = in && std::memcmp(magic, kMagicV04, 8) == 0;
-  if (!in || (!v03 && !v04 && std::memcmp(magic, kMagic, 8) != 0))
+  const bool v05 = in && std::memcmp(magic, kMagicV05, 8) == 0;
+  if (!in || (!v03 && !v04 && !v05 && std::memcmp(magic, kMagic, 8) != 0))
     throw InputError(file, "not a granoscope checkpoint");
   get(in, step_, file);
   get(in, time_, file);
@@ -1160,6 +1262,25 @@ std::string Simulation::load_checkpoint(const std::filesystem::path& path) {
     removed_count_ = static_cast<std::size_t>(removed);
     get(in, removed_mass_, file);
   }
+  std::uint8_t periodic = 0;
+  if (!v03 && !v04 && !v05) get(in, periodic, file);
+  if ((periodic != 0) != periodic_)
+    throw InputError(file, "checkpoint does not match the scene (periodic cell)",
+                     std::to_string(periodic));
+  if (periodic_) {
+    get(in, cell_.hsize, file);
+    get(in, cell_.trsf, file);
+    get(in, cell_.vel_grad, file);
+    get(in, cell_.next_vel_grad, file);
+    std::uint8_t changed = 0;
+    get(in, changed, file);
+    cell_.vel_grad_changed = changed != 0;
+    get(in, cell_.prev_vel_grad, file);
+    get(in, cell_.prev_hsize, file);
+    get(in, cell_.vgrad_times_prev_h, file);
+    if (!cell_.hsize.allFinite() || !(cell_.hsize.determinant() > 0))
+      throw InputError(file, "corrupt checkpoint (periodic cell)");
+  }
   std::uint64_t extra_size = 0;
   get(in, extra_size, file);
   if (extra_size > (1ull << 30))
@@ -1168,7 +1289,7 @@ std::string Simulation::load_checkpoint(const std::filesystem::path& path) {
   in.read(extra.data(), static_cast<std::streamsize>(extra_size));
   if (!in) throw InputError(file, "truncated checkpoint");
   // Rebuild the neighbour list from the restored state and put the histories back.
-  nl_.build(p_, walls_);
+  nl_.build(p_, walls_, cell_ptr(), planar_);
   attach_histories(real);
   return extra;
 }

@@ -13,6 +13,8 @@
 #include "contact_geometry.hpp"
 #include "dem_types.hpp"
 #include "neighbor_list.hpp"
+#include "newton_integrator.hpp"
+#include "periodic_cell.hpp"
 #include "rigid_clump.hpp"
 #include "snapshot.hpp"
 
@@ -133,6 +135,23 @@ class Simulation {
   void insert_particle(std::uint32_t i, const Eigen::Vector3d& position);
   bool pending(std::size_t i) const { return p_.removed[i] == 2; }
 
+  /// Periodic cell (before the first step; YADE's O.periodic with O.cell.hSize): particles
+  /// interact with the images of the others across its faces, positions stay unwrapped (as
+  /// YADE stores them), and a velocity gradient deforms the cell and the assembly. `planar`:
+  /// YADE's 2D emulation (blockedDOFs 'zXY' on every particle; all centres in one plane
+  /// z = const). Throws std::invalid_argument on walls or clumps (not supported in a cell), a
+  /// degenerate or inverted cell, or a cell too small (PeriodicTooSmall).
+  void set_periodic(const Eigen::Matrix3d& hsize, bool planar = false);
+  bool periodic() const { return periodic_; }
+  bool planar() const { return planar_; }
+  const PeriodicCell& cell() const { return cell_; }
+  /// YADE's O.cell.velGrad = L: takes effect in the next step's integration, and the cell then
+  /// follows one step later (docs/physics.md).
+  void set_velocity_gradient(const Eigen::Matrix3d& l);
+  /// YADE's utils.getStress() in a periodic cell: (1/det H)·Σ (Fn + Fs) ⊗ (x1 − x2 − H·cellDist)
+  /// over the real contacts (Pa, compression negative; seed 000 eq 12, Love–Weber).
+  Eigen::Matrix3d cell_stress() const;
+
   /// Forces a neighbour-list rebuild before the next step.
   void invalidate_neighbors() { nl_.ref_pos.clear(); }
 
@@ -163,6 +182,7 @@ class Simulation {
   /// The law's results in lane j back into pair k's history, and its loads.
   void finish_pair(std::size_t k, const ContactBatch& batch, int j, ContactLoads& loads);
   void update_servos();
+  const PeriodicCell* cell_ptr() const { return periodic_ ? &cell_ : nullptr; }
   /// Clump loads from their members, the clumps' integration, and the members moved rigidly;
   /// adds the clumps' gravity work and damping to the ledger. False on a non-finite state.
   bool integrate_clumps();
@@ -176,6 +196,9 @@ class Simulation {
   void remove_outflow();
 
   std::vector<ClumpBody> clumps_;
+  bool periodic_ = false, planar_ = false;
+  PeriodicCell cell_;
+  HomogeneousField field_;  // this step's homogeneous terms of the integration
   bool outlet_ = false;
   Eigen::Vector3d keep_lo_ = Eigen::Vector3d::Zero(), keep_hi_ = Eigen::Vector3d::Zero();
   std::size_t removed_count_ = 0;

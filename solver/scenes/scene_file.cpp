@@ -73,6 +73,29 @@ struct Reader {
     return v;
   }
 
+  /// A 3×3 matrix as 3 rows of 3 finite numbers (row i, column j).
+  Eigen::Matrix3d matrix3(const toml::table* t, const std::string& sec, const std::string& key,
+                          bool required, const Eigen::Matrix3d& fallback) const {
+    if (!t || !t->contains(key)) {
+      if (required) fail(sec + "." + key, "missing");
+      return fallback;
+    }
+    const auto* a = (*t)[key].as_array();
+    const std::string what = "expected 3 rows of 3 finite numbers";
+    if (!a || a->size() != 3) fail(sec + "." + key, what);
+    Eigen::Matrix3d m;
+    for (std::size_t i = 0; i < 3; ++i) {
+      const auto* row = (*a)[i].as_array();
+      if (!row || row->size() != 3) fail(sec + "." + key, what, "row " + std::to_string(i));
+      for (std::size_t j = 0; j < 3; ++j) {
+        const auto d = (*row)[j].value<double>();
+        if (!d || !std::isfinite(*d)) fail(sec + "." + key, what, "row " + std::to_string(i));
+        m(static_cast<int>(i), static_cast<int>(j)) = *d;
+      }
+    }
+    return m;
+  }
+
   std::string string(const toml::table* t, const std::string& sec, const std::string& key,
                      bool required, const std::string& fallback) const {
     if (!t || !t->contains(key)) {
@@ -445,7 +468,7 @@ Scene load_scene(const std::filesystem::path& path) {
     static const char* sections[] = {"scene",          "material",     "solver",      "output",
                                      "walls",          "specimen",     "preparation", "triaxial",
                                      "plane_strain",   "direct_shear", "mesh",        "outlet",
-                                     "clump_template", "clumps",       "fill"};
+                                     "clump_template", "clumps",       "fill",        "cell"};
     if (std::find(std::begin(sections), std::end(sections), k.str()) == std::end(sections))
       r.fail("[" + std::string(k.str()) + "]", "unknown section");
   }
@@ -705,6 +728,33 @@ Scene load_scene(const std::filesystem::path& path) {
     }
   }
   read_clumps(r, root, path, s);
+  if (const auto* cell = r.table("cell", false)) {
+    // Periodic cell (docs/scenes.md "[cell]"; YADE's O.cell.hSize and O.cell.velGrad).
+    r.only(cell, "cell", {"size_m", "hsize_m", "velocity_gradient_1_s", "two_d"});
+    auto& c = s.cell.emplace();
+    if (cell->contains("size_m") == cell->contains("hsize_m"))
+      r.fail("cell", "give one of size_m and hsize_m");
+    if (cell->contains("size_m")) {
+      const Eigen::Vector3d size = r.vec3(cell, "cell", "size_m", true, {});
+      if (!(size.array() > 0).all()) r.fail("cell.size_m", "must be positive");
+      c.hsize = size.asDiagonal();
+    } else {
+      c.hsize = r.matrix3(cell, "cell", "hsize_m", true, {});
+    }
+    if (!(c.hsize.determinant() > 0))
+      r.fail(cell->contains("size_m") ? "cell.size_m" : "cell.hsize_m",
+             "singular or inverted cell (det H <= 0)", value_str(c.hsize.determinant()));
+    c.vel_grad = r.matrix3(cell, "cell", "velocity_gradient_1_s", false, Eigen::Matrix3d::Zero());
+    const std::string two_d = r.string(cell, "cell", "two_d", false, "");
+    if (two_d == "spheres_in_plane")
+      c.planar = true;
+    else if (!two_d.empty())
+      r.fail("cell.two_d", "expected \"spheres_in_plane\"", two_d);
+    if (root.contains("walls") || root.contains("mesh"))
+      r.fail("[cell]", "walls and meshes in a periodic cell are not supported");
+    if (root.contains("clumps")) r.fail("[cell]", "clumps in a periodic cell are not supported");
+    if (!s.test.empty()) r.fail("[cell]", "a periodic cell runs a plain scene (no scene.test)");
+  }
   if (const auto* outlet = r.table("outlet", false)) {
     r.only(outlet, "outlet", {"keep_lo_m", "keep_hi_m"});
     const Eigen::Vector3d lo = r.vec3(outlet, "outlet", "keep_lo_m", true, {});

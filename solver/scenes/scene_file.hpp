@@ -63,6 +63,13 @@ struct Scene {
   std::uint32_t fill_first = 0;
   std::vector<std::vector<std::uint32_t>> fill_layers;
   std::vector<std::size_t> open_after_fill;
+  /// [cell]: a periodic cell (Simulation::set_periodic) with a velocity gradient.
+  struct CellSpec {
+    Eigen::Matrix3d hsize = Eigen::Matrix3d::Identity();
+    Eigen::Matrix3d vel_grad = Eigen::Matrix3d::Zero();
+    bool planar = false;  // two_d = "spheres_in_plane"
+  };
+  std::optional<CellSpec> cell;
   std::int64_t steps = 0;
   OutputSpec output;
   std::vector<std::pair<std::string, std::string>> parameters;  // flattened, for run metadata

@@ -1,0 +1,233 @@
+// The periodic cell against exact answers: affine motion of a contact-free assembly, a pair
+// touching across a face against the same pair inside the cell, bit-for-bit resumption, 2D
+// emulation, and the cell's error cases.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <random>
+
+#include "packing_csv.hpp"
+#include "reference_case.hpp"
+#include "simulation.hpp"
+
+using namespace gs;
+using solver::Simulation;
+
+namespace {
+
+solver::SimulationConfig config(double damping = 0.2) {
+  solver::SimulationConfig c;
+  c.material.young_ec = 3.0e7;
+  c.material.stiffness_ratio = 0.3;
+  c.material.friction_deg = 25.0;
+  c.material.density = 2550.0;
+  c.material.rolling_beta = 0.5;
+  c.material.rolling_eta = 0.3;
+  c.damping = damping;
+  c.dt = 2e-6;
+  return c;
+}
+
+Particle sphere(std::int64_t id, const Eigen::Vector3d& x, double r) {
+  Particle p;
+  p.id = id;
+  p.position = x;
+  p.radius = r;
+  return p;
+}
+
+Eigen::Matrix3d cube(double side) {
+  return side * Eigen::Matrix3d::Identity();
+}
+
+}  // namespace
+
+// x_n = (I + dt·L)^n·x_0 and v_n = L·x_{n−1} exactly for YADE's scheme (the mean field enters
+// as ΔL·x in the first step, then as the convective term L·v); the cell follows one step late:
+// H_n = (I + dt·L)^{n−1}·H_0; spins are W's axial vector.
+TEST(PeriodicCell, ContactFreeAssemblyMovesAffinely) {
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> u(0.0, 0.02);
+  std::vector<Particle> ps;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      for (int k = 0; k < 3; ++k)  // on a 6.67 mm grid with jitter, radius 0.5 mm: no contact
+        ps.push_back(
+            sphere(static_cast<int>(ps.size()),
+                   Eigen::Vector3d(0.0033 + i * 0.0067, 0.0033 + j * 0.0067, 0.0033 + k * 0.0067) +
+                       Eigen::Vector3d(u(rng), u(rng), u(rng)) * 0.02,
+                   0.0005));
+  Simulation sim(config(0.3), ps, {});
+  Eigen::Matrix3d hsize;
+  hsize << 0.02, 0.002, 0, 0, 0.021, 0.001, 0, 0, 0.019;  // a sheared cell
+  sim.set_periodic(hsize);
+  Eigen::Matrix3d l;
+  l << 0.5, 2.0, -0.3, -0.4, -0.2, 0.7, 0.1, 0.6, 0.3;
+  sim.set_velocity_gradient(l);
+  const double dt = sim.config().dt;
+  const Eigen::Matrix3d step_map = Eigen::Matrix3d::Identity() + dt * l;
+  Eigen::Matrix3d f = Eigen::Matrix3d::Identity();  // (I + dt·L)^n
+  const Eigen::Matrix3d w = 0.5 * (l - l.transpose());
+  const Eigen::Vector3d spin(-w(1, 2), w(0, 2), -w(0, 1));
+  double worst_x = 0, worst_v = 0, worst_h = 0;
+  std::vector<Eigen::Vector3d> prev(ps.size());
+  for (std::size_t i = 0; i < ps.size(); ++i) prev[i] = ps[i].position;
+  for (int n = 1; n <= 2000; ++n) {
+    const Eigen::Matrix3d f_prev = f;
+    sim.step();
+    f = step_map * f;
+    const auto& p = sim.particles();
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      worst_x = std::max(worst_x, (p.pos[i] - f * ps[i].position).norm() / 0.02);
+      worst_v = std::max(worst_v, (p.vel[i] - l * prev[i]).norm() / (l.norm() * 0.02));
+      EXPECT_LT((p.angvel[i] - spin).norm(), 1e-14 * spin.norm()) << "step " << n;
+      prev[i] = p.pos[i];
+    }
+    worst_h = std::max(worst_h, (sim.cell().hsize - f_prev * hsize).norm() / hsize.norm());
+    ASSERT_EQ(sim.contact_count(), 0u);
+  }
+  EXPECT_LT(worst_x, 1e-12) << "positions relative to the cell size";  // (2000 steps of ulps)
+  EXPECT_LT(worst_v, 1e-12) << "velocities relative to |L|·L_cell";
+  EXPECT_LT(worst_h, 1e-12) << "cell one step behind";
+  // The frame holds the cell and the positions wrapped into it.
+  const Frame fr = sim.frame();
+  EXPECT_TRUE(fr.domain.periodic);
+  EXPECT_EQ(fr.domain.cell, sim.cell().hsize);
+  const Eigen::Matrix3d inv = sim.cell().hsize.inverse();
+  for (const auto& q : fr.particles) {
+    const Eigen::Vector3d s = inv * q.position;
+    EXPECT_TRUE((s.array() >= -1e-12).all() && (s.array() < 1 + 1e-12).all()) << s.transpose();
+  }
+}
+
+namespace {
+
+/// The loads of a two-sphere run in a 10 mm cube with v_y = 100/s·x (the pair's branch along x,
+/// so the mean field shears the contact while the overlap pushes the spheres apart): x1, x2 are
+/// the unwrapped centres.
+struct PairRun {
+  std::vector<Eigen::Vector3d> force1, torque1;
+  std::vector<std::size_t> contacts;
+};
+
+PairRun run_pair(const Eigen::Vector3d& x1, const Eigen::Vector3d& x2) {
+  Simulation sim(config(0.0), {sphere(0, x1, 0.001), sphere(1, x2, 0.001)}, {});
+  sim.set_periodic(cube(0.01));
+  Eigen::Matrix3d l = Eigen::Matrix3d::Zero();
+  l(1, 0) = 100.0;
+  sim.set_velocity_gradient(l);
+  PairRun r;
+  for (int n = 0; n < 40; ++n) {
+    sim.step();
+    r.contacts.push_back(sim.contact_count());
+    r.force1.push_back(sim.particles().force[0]);
+    r.torque1.push_back(sim.particles().torque[0]);
+  }
+  return r;
+}
+
+}  // namespace
+
+// Across the x faces the image of sphere 2 moves with its own velocity plus L·H·cellDist; the
+// contact must see what the same pair sees inside the cell (round-off of the positions apart).
+TEST(PeriodicCell, PairAcrossBoundaryFeelsTheSameForceAsInside) {
+  const PairRun inside = run_pair({0.00403, 0.005, 0.005}, {0.00597, 0.005, 0.005});
+  // (sphere 1's image at 10.97 mm: the same branch, +1.94 mm along x, as inside)
+  const PairRun across = run_pair({0.00903, 0.005, 0.005}, {0.00097, 0.005, 0.005});
+  EXPECT_EQ(inside.contacts, across.contacts);
+  ASSERT_EQ(inside.contacts.at(5), 1u);
+  double fmax = 0, worst = 0, shear = 0, tmax = 0, worst_t = 0;
+  for (std::size_t n = 0; n < inside.force1.size(); ++n) {
+    fmax = std::max(fmax, inside.force1[n].norm());
+    worst = std::max(worst, (across.force1[n] - inside.force1[n]).norm());
+    worst_t = std::max(worst_t, (across.torque1[n] - inside.torque1[n]).norm());
+    tmax = std::max(tmax, inside.torque1[n].norm());
+    shear = std::max(shear, std::abs(inside.force1[n].y()));
+  }
+  EXPECT_GT(shear, 1e-3 * fmax) << "the mean field shears the contact";
+  EXPECT_LT(worst, 1e-9 * fmax) << "force across the boundary";
+  EXPECT_LT(worst_t, 1e-9 * tmax) << "torque across the boundary";
+}
+
+TEST(PeriodicCell, ResumesBitForBit) {
+  // The dense packing of the shared YADE case (tests/data/yade_periodic), sheared and compressed.
+  const auto ps = read_packing_csv(test::reference_case_dir("periodic") / "packing.csv").particles;
+  Eigen::Matrix3d l = Eigen::Matrix3d::Zero();
+  l(0, 2) = 20.0;
+  l.diagonal().setConstant(-1.0);
+  auto make = [&] {
+    auto sim = std::make_unique<Simulation>(config(), ps, std::vector<solver::WallSpec>{});
+    sim->set_periodic(cube(0.019384323656096786));
+    sim->set_velocity_gradient(l);
+    return sim;
+  };
+  auto a = make();
+  a->run(300);
+  const auto ckpt = std::filesystem::temp_directory_path() / "gs_periodic_resume.ckpt";
+  a->save_checkpoint(ckpt);
+  a->run(300);
+  auto b = make();
+  b->load_checkpoint(ckpt);
+  b->run(300);
+  std::filesystem::remove(ckpt);
+  ASSERT_GT(a->contact_count(), 2000u);
+  EXPECT_EQ(a->cell().hsize, b->cell().hsize);
+  EXPECT_EQ(a->cell_stress(), b->cell_stress());
+  for (std::size_t i = 0; i < ps.size(); ++i) {
+    EXPECT_EQ(a->particles().pos[i], b->particles().pos[i]) << i;
+    EXPECT_EQ(a->particles().vel[i], b->particles().vel[i]) << i;
+    EXPECT_EQ(a->particles().angvel[i], b->particles().angvel[i]) << i;
+  }
+}
+
+TEST(PeriodicCell, PlanarEmulationKeepsTheDisksInThePlane) {
+  // The packing of the shared YADE 2D case (tests/data/yade_periodic2d), sheared and compressed.
+  const auto ps =
+      read_packing_csv(test::reference_case_dir("periodic2d") / "packing.csv").particles;
+  Simulation sim(config(), ps, {});
+  Eigen::Matrix3d h = Eigen::Matrix3d::Zero();
+  h.diagonal() << 0.04783235800060865, 0.04783235800060865, 0.008;
+  sim.set_periodic(h, true);
+  Eigen::Matrix3d l = Eigen::Matrix3d::Zero();
+  l(0, 0) = -2;
+  l(1, 1) = -2;
+  l(0, 1) = 5;
+  sim.set_velocity_gradient(l);
+  sim.run(1000);
+  ASSERT_GT(sim.contact_count(), 1000u);
+  for (std::size_t i = 0; i < ps.size(); ++i) {
+    EXPECT_EQ(sim.particles().pos[i].z(), 0.004);
+    EXPECT_EQ(sim.particles().vel[i].z(), 0.0);
+    EXPECT_EQ(sim.particles().angvel[i].x(), 0.0);
+    EXPECT_EQ(sim.particles().angvel[i].y(), 0.0);
+  }
+  EXPECT_TRUE(sim.frame().two_d);
+  // A non-planar packing, a velocity gradient out of the plane.
+  auto bad = ps;
+  bad[7].position.z() = 0.0041;
+  Simulation off(config(), bad, {});
+  EXPECT_THROW(off.set_periodic(h, true), std::invalid_argument);
+  Eigen::Matrix3d lz = Eigen::Matrix3d::Zero();
+  lz(0, 2) = 1;
+  EXPECT_THROW(sim.set_velocity_gradient(lz), std::invalid_argument);
+}
+
+TEST(PeriodicCell, RejectsDegenerateInvertedAndTooSmallCells) {
+  const std::vector<Particle> ps = {sphere(0, {0.002, 0.002, 0.002}, 0.001),
+                                    sphere(1, {0.006, 0.006, 0.006}, 0.001)};
+  Simulation s1(config(), ps, {});
+  Eigen::Matrix3d singular = cube(0.01);
+  singular.col(2) = singular.col(0);
+  EXPECT_THROW(s1.set_periodic(singular), std::invalid_argument);
+  Eigen::Matrix3d inverted = cube(0.01);
+  inverted(2, 2) = -0.01;
+  EXPECT_THROW(s1.set_periodic(inverted), std::invalid_argument);
+  // 3·(2·r_max + skin) = 3·(2 + 0.5) mm = 7.5 mm: a 7 mm cell is too small, 8 mm is fine.
+  EXPECT_THROW(s1.set_periodic(cube(0.007)), solver::PeriodicTooSmall);
+  EXPECT_NO_THROW(s1.set_periodic(cube(0.008)));
+  Simulation s2(config(), ps, {solver::WallSpec{}});
+  EXPECT_THROW(s2.set_periodic(cube(0.01)), std::invalid_argument);  // walls
+  Simulation s3(config(), ps, {});
+  EXPECT_THROW(s3.set_velocity_gradient(Eigen::Matrix3d::Identity()), std::invalid_argument);
+}
