@@ -93,13 +93,20 @@ file = \"teeth_6k.stl\""
 scene teeth60k "$walls
 [[mesh]]
 file = \"teeth_60k.stl\""
-rate() { "$gs" simulate "$work/$1.toml" --threads 1 -q -o "$work/out_$1" | sed -n 's/.*(\([0-9.e+]*\) particle-steps\/s.*/\1/p'; }
+# Per run: particle-steps/s, and the contacts at the end (sphere-sphere and sphere-wall, from the
+# final line), so that the cost can be set against what the contacts themselves cost.
+rate() {
+  "$gs" simulate "$work/$1.toml" --threads 1 -q -o "$work/out_$1" |
+    sed -n 's/.*(\([0-9.e+]*\) particle-steps\/s.*/\1/p; s/^final: \([0-9]*\) contacts.*/\1/p' | paste -sd' '
+}
 a=$(rate plane); b=$(rate teeth6k); c=$(rate teeth60k)
-"$py" - "$a" "$b" "$c" <<'PY'
+"$py" - $a $b $c <<'PY'
 import sys
-a, b, c = map(float, sys.argv[1:])
-print("5476 spheres settling on a 6 x 6 cm floor, 2000 steps, one thread (particle-steps/s):")
-print(f"  plane floor                           {a:.3g}")
-print(f"  saw-tooth, 1000 teeth, 6000 triangles {b:.3g}   cost {a / b:.2f}x the plane's")
-print(f"  saw-tooth, 10000 teeth, 60000 tri.    {c:.3g}   cost {a / c:.2f}x the plane's")
+a, na, b, nb, c, nc = map(float, sys.argv[1:])
+n = 5476
+print("5476 spheres settling on a 6 x 6 cm floor, 2000 steps, one thread:")
+print("  %-38s %12s %9s %10s %22s" % ("floor", "p-steps/s", "contacts", "cost", "cost per (sphere+contact)"))
+for name, r, k in (("plane", a, na), ("saw-tooth, 1000 teeth, 6000 triangles", b, nb),
+                   ("saw-tooth, 10000 teeth, 60000 tri.", c, nc)):
+    print("  %-38s %12.3g %9d %9.2fx %21.2fx" % (name, r, k, a / r, (a / r) * (n + na) / (n + k)))
 PY
