@@ -37,10 +37,13 @@ bool NeighborList::stale(const ParticleState& p, const std::vector<WallState>& w
   double wmax = 0;
   for (std::size_t w = 0; w < walls.size(); ++w) {
     const WallState& wall = walls[w];
-    double move = (wall.pos - wall_ref[w]).norm();
+    double move = wall.pos == wall_ref[w] ? 0.0 : (wall.pos - wall_ref[w]).norm();
     if (wall.spec.shape == WallShape::Facets) {
-      // A rotated mesh: its points moved at most 2·sin(θ/2)·reach more than its reference.
-      move += 2 * std::abs(std::sin(0.5 * wall.ori.angularDistance(wall_ori_ref[w]))) * wall.reach;
+      // A rotated mesh: its points moved at most 2·sin(θ/2)·reach more than its reference
+      // (nothing when it has not turned: a still mesh of many walls costs no trigonometry).
+      if (wall.ori.coeffs() != wall_ori_ref[w].coeffs())
+        move +=
+            2 * std::abs(std::sin(0.5 * wall.ori.angularDistance(wall_ori_ref[w]))) * wall.reach;
     } else if ((wall.normal - wall_normal_ref[w]).norm() > 0) {
       return true;  // rotated plane
     }

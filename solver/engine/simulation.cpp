@@ -345,6 +345,27 @@ void Simulation::attach_histories(const std::vector<ContactHistory>& old,
         1e-9 * (r + w.reach + std::abs(x.x - wp.x) + std::abs(x.y - wp.y) + std::abs(x.z - wp.z));
     facet_gap_[k] = dist - r - tol;
   }
+  // Pairs that start deferred: a positive gap (the pass would find them apart at once, since the
+  // bound on the displacements is 0 right after a build).
+  deferred_.clear();
+  deferred_next_ = 0;
+  pass_pairs_.clear();
+  for (const std::uint32_t k : wall_pairs_)
+    if (facet_gap_[k] > 0) deferred_.push_back(k);
+  if (!deferred_.empty()) {
+    std::sort(deferred_.begin(), deferred_.end(), [&](std::uint32_t x, std::uint32_t y) {
+      return facet_gap_[x] != facet_gap_[y] ? facet_gap_[x] < facet_gap_[y] : x < y;
+    });
+    for (const std::uint32_t k : deferred_) hist_[k].real = false;
+    pass_pairs_.reserve(np);
+    std::vector<std::uint8_t> is_deferred(np, 0);
+    for (const std::uint32_t k : deferred_) is_deferred[k] = 1;
+    for (std::size_t k = 0; k < np; ++k)
+      if (!is_deferred[k]) pass_pairs_.push_back(static_cast<std::uint32_t>(k));
+    pass_wall_pairs_.clear();
+    for (const std::uint32_t k : wall_pairs_)
+      if (!is_deferred[k]) pass_wall_pairs_.push_back(k);
+  }
   if (std::max(1, cfg_.threads) == 1) return;  // (the per-particle lists serve threads only)
   // Pairs of each particle in pair order (entry = pair << 1 | 1 when the particle is the
   // second body).
@@ -475,7 +496,8 @@ void Simulation::accumulate_walls() {
   }
   if (facet_forces_)
     for (auto& w : walls_) w.facet_force.assign(w.facets.size(), Eigen::Vector3d::Zero());
-  for (const std::uint32_t k : wall_pairs_) {
+  // (the deferred pairs are not active: only the visited ones are looked at)
+  for (const std::uint32_t k : deferred_.empty() ? wall_pairs_ : pass_wall_pairs_) {
     if (!active_[k]) continue;
     const ContactLoads& L = loads_[k];
     WallState& w = walls_[nl_.pairs[k].second - kWallBase];
@@ -573,7 +595,26 @@ namespace {
 
 }  // namespace
 
-int Simulation::fill_batch(std::size_t& k, std::size_t end, ContactBatch& batch,
+void Simulation::admit_deferred() {
+  if (deferred_next_ == deferred_.size()) return;
+  admitted_.clear();
+  while (deferred_next_ < deferred_.size() && !(facet_gap_[deferred_[deferred_next_]] > nl_.moved))
+    admitted_.push_back(deferred_[deferred_next_++]);
+  if (admitted_.empty()) return;
+  std::sort(admitted_.begin(), admitted_.end());
+  const std::size_t old = pass_pairs_.size();
+  pass_pairs_.insert(pass_pairs_.end(), admitted_.begin(), admitted_.end());
+  std::inplace_merge(pass_pairs_.begin(), pass_pairs_.begin() + static_cast<std::ptrdiff_t>(old),
+                     pass_pairs_.end());
+  const std::size_t old_w = pass_wall_pairs_.size();
+  pass_wall_pairs_.insert(pass_wall_pairs_.end(), admitted_.begin(), admitted_.end());
+  std::inplace_merge(pass_wall_pairs_.begin(),
+                     pass_wall_pairs_.begin() + static_cast<std::ptrdiff_t>(old_w),
+                     pass_wall_pairs_.end());
+}
+
+template <bool kIndexed>
+int Simulation::fill_batch(std::size_t& i, std::size_t end, ContactBatch& batch,
                            std::uint32_t* lane_pair, double& max_overlap_ratio) {
   // Pass 1 without branches (whether a candidate is within reach is a coin flip that the
   // branch predictor loses): candidates within reach are compacted, the others lose their
@@ -583,7 +624,8 @@ int Simulation::fill_batch(std::size_t& k, std::size_t end, ContactBatch& batch,
   // farther than its radius from the plane of every facet (the facet distance is at least that).
   std::uint32_t near[ContactBatch::kLanes];
   int m = 0;
-  for (; k < end && m < ContactBatch::kLanes; ++k) {
+  for (; i < end && m < ContactBatch::kLanes; ++i) {
+    const std::size_t k = kIndexed ? pass_pairs_[i] : i;
     const auto [a, b] = nl_.pairs[k];
     bool in_reach;
     if (b < kWallBase) {
@@ -631,8 +673,12 @@ int Simulation::fill_batch(std::size_t& k, std::size_t end, ContactBatch& batch,
 void Simulation::step() {
   if (periodic_) cell_.integrate(cfg_.dt);  // (YADE: Scene::moveToNextTimeStep, before engines)
   if (nl_.stale(p_, walls_, cell_ptr())) rebuild_neighbors();
+  admit_deferred();
   const double dt = cfg_.dt;
   const std::size_t np = nl_.pairs.size();
+  // The pairs the contact pass visits: all, or pass_pairs_ while some facet pairs are deferred.
+  const bool indexed = !deferred_.empty();
+  const std::size_t nv = indexed ? pass_pairs_.size() : np;
   loads_.resize(np);
   active_.assign(np, 0);
   dissipation_.resize(2 * np);
@@ -673,8 +719,9 @@ void Simulation::step() {
         particle_dissipation_[2 * cur] = fr_cur;
         particle_dissipation_[2 * cur + 1] = ro_cur;
       };
-      for (std::size_t k = 0; k < np;) {
-        const int m = fill_batch(k, np, batch, lane_pair, max_overlap_ratio);
+      for (std::size_t i = 0; i < nv;) {
+        const int m = indexed ? fill_batch<true>(i, nv, batch, lane_pair, max_overlap_ratio)
+                              : fill_batch<false>(i, nv, batch, lane_pair, max_overlap_ratio);
         cohesive_frictional_batch(batch, m, dt, cfg_.twist_beta > 0, periodic_);
         for (int j = 0; j < m; ++j) {
           const std::uint32_t kk = lane_pair[j];
@@ -711,12 +758,13 @@ void Simulation::step() {
       // Each thread takes a contiguous share of the pairs, in batches.
       const std::size_t t = static_cast<std::size_t>(omp_get_thread_num());
       const std::size_t nt = static_cast<std::size_t>(omp_get_num_threads());
-      const std::size_t k_end = np * (t + 1) / nt;
+      const std::size_t k_end = nv * (t + 1) / nt;
       double my_max_overlap = 0;
       ContactBatch batch;
       std::uint32_t lane_pair[ContactBatch::kLanes];
-      for (std::size_t k = np * t / nt; k < k_end;) {
-        const int m = fill_batch(k, k_end, batch, lane_pair, my_max_overlap);
+      for (std::size_t i = nv * t / nt; i < k_end;) {
+        const int m = indexed ? fill_batch<true>(i, k_end, batch, lane_pair, my_max_overlap)
+                              : fill_batch<false>(i, k_end, batch, lane_pair, my_max_overlap);
         cohesive_frictional_batch(batch, m, dt, cfg_.twist_beta > 0, periodic_);
         for (int j = 0; j < m; ++j) {
           const std::uint32_t kk = lane_pair[j];

@@ -177,8 +177,13 @@ class Simulation {
   bool prepare_pair(std::size_t k, ContactBatch& batch, int j, double& max_overlap_ratio);
   /// Fills a batch with the next touching pairs from k (advanced) up to end; returns the
   /// number of lanes, lane_pair[j] the pair of lane j.
-  int fill_batch(std::size_t& k, std::size_t end, ContactBatch& batch, std::uint32_t* lane_pair,
+  /// With kIndexed, positions i in [i, end) of pass_pairs_ instead of pairs themselves.
+  template <bool kIndexed>
+  int fill_batch(std::size_t& i, std::size_t end, ContactBatch& batch, std::uint32_t* lane_pair,
                  double& max_overlap_ratio);
+  /// The facet pairs whose gap the displacements since the build may have closed join the
+  /// pairs the contact pass visits (in pair order).
+  void admit_deferred();
   /// The law's results in lane j back into pair k's history, and its loads.
   void finish_pair(std::size_t k, const ContactBatch& batch, int j, ContactLoads& loads);
   void update_servos();
@@ -208,6 +213,13 @@ class Simulation {
   NeighborList nl_;
   std::vector<ContactHistory> hist_;  // parallel to nl_.pairs
   std::vector<double> facet_gap_;     // facet-wall pairs: the gap at the last build (m)
+  // The contact pass visits pass_pairs_ (ascending) when some facet pairs are deferred: those
+  // whose gap at the build exceeds the displacement bound since (nl_.moved), sorted by gap;
+  // deferred_next_ is the first not yet admitted. A deferred pair provably does not touch, so
+  // skipping it changes no result (its history is marked not real at the build, as the pass
+  // would have marked it).
+  std::vector<std::uint32_t> pass_pairs_, pass_wall_pairs_, deferred_, admitted_;
+  std::size_t deferred_next_ = 0;
   bool facet_forces_ = false;
   std::vector<std::uint32_t> pair_facet_;  // closest facet of each wall pair (facet forces on)
   std::vector<ContactParams> params_;
