@@ -228,6 +228,7 @@ void run(const Args& a) {
     try {
       sim.set_periodic(scene.cell->hsize, scene.cell->planar);
       sim.set_velocity_gradient(scene.cell->vel_grad);
+      if (scene.cell->servo) sim.set_cell_servo(*scene.cell->servo);
     } catch (const std::invalid_argument& e) {
       throw InputError(a.scene, "[cell]", e.what());
     }

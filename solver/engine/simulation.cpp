@@ -235,6 +235,26 @@ void Simulation::set_periodic(const Eigen::Matrix3d& hsize, bool planar) {
   invalidate_neighbors();
 }
 
+void Simulation::set_cell_servo(const CellServo& servo) {
+  if (!periodic_) throw std::invalid_argument("a cell servo needs a periodic cell");
+  if (!servo.target.allFinite()) throw std::invalid_argument("cell servo target is not finite");
+  const bool any = servo.stress[0] || servo.stress[1] || servo.stress[2];
+  if (any && (!(servo.gain > 0) || !std::isfinite(servo.gain)))
+    throw std::invalid_argument("cell servo gain must be positive (" + std::to_string(servo.gain) +
+                                ")");
+  if (any && (!(servo.max_rate > 0) || !std::isfinite(servo.max_rate)))
+    throw std::invalid_argument("cell servo rate limit must be positive (" +
+                                std::to_string(servo.max_rate) + ")");
+  if (planar_ && (servo.stress[2] || servo.target[2] != 0))
+    throw std::invalid_argument("2D: the cell servo acts in the xy plane only");
+  cell_servo_ = servo;
+  servo_base_gradient_ = cell_.vel_grad_changed ? cell_.next_vel_grad : cell_.vel_grad;
+  servo_base_gradient_.diagonal().setZero();
+  Eigen::Matrix3d l = servo_base_gradient_;
+  for (int i = 0; i < 3; ++i) l(i, i) = servo.stress[i] ? 0.0 : servo.target[i];
+  cell_.set_velocity_gradient(l);
+}
+
 void Simulation::set_velocity_gradient(const Eigen::Matrix3d& l) {
   if (!periodic_) throw std::invalid_argument("a velocity gradient needs a periodic cell");
   if (!l.allFinite()) throw std::invalid_argument("velocity gradient is not finite");
@@ -859,6 +879,18 @@ void Simulation::step() {
   }
   if (!clumps_.empty()) finite = integrate_clumps() && finite;
   if (periodic_) cell_.prev_vel_grad = cell_.vel_grad;  // (NewtonIntegrator's end)
+  if (cell_servo_) {
+    // The next step's diagonal from this step's stress (forces of this step, positions and
+    // cell after it, as YADE's getStress() there).
+    const Eigen::Matrix3d sigma = cell_stress();
+    Eigen::Matrix3d l = servo_base_gradient_;
+    const CellServo& sv = *cell_servo_;
+    for (int i = 0; i < 3; ++i)
+      l(i, i) = sv.stress[i]
+                    ? std::clamp(sv.gain * (sv.target[i] - sigma(i, i)), -sv.max_rate, sv.max_rate)
+                    : sv.target[i];
+    cell_.set_velocity_gradient(l);
+  }
   if (!(max_overlap_ratio <= cfg_.max_overlap_ratio))
     throw BlowUp("step " + std::to_string(step_) + ": overlap of " +
                  std::to_string(max_overlap_ratio) + " radius exceeds " +

@@ -5,6 +5,7 @@
 
 #include <array>
 #include <filesystem>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -19,6 +20,17 @@
 #include "snapshot.hpp"
 
 namespace gs::solver {
+
+/// Control of a periodic cell's diagonal (the role of YADE's PeriTriaxController): each axis
+/// either strain-rate controlled (L_ii = target, 1/s) or stress controlled: after each step
+/// L_ii = clamp(gain·(target − σ_ii), ±max_rate) with σ the cell stress (Pa, compression
+/// negative), taking effect in the next step as any velocity gradient does.
+struct CellServo {
+  std::array<bool, 3> stress = {false, false, false};  // true: axis i is stress controlled
+  Eigen::Vector3d target = Eigen::Vector3d::Zero();    // Pa (stress axes) or 1/s (rate axes)
+  double gain = 0;                                     // 1/(Pa·s)
+  double max_rate = 0;                                 // 1/s, |L_ii| of a stress axis
+};
 
 struct SimulationConfig {
   Material material;
@@ -151,6 +163,9 @@ class Simulation {
   /// YADE's utils.getStress() in a periodic cell: (1/det H)·Σ (Fn + Fs) ⊗ (x1 − x2 − H·cellDist)
   /// over the real contacts (Pa, compression negative; seed 000 eq 12, Love–Weber).
   Eigen::Matrix3d cell_stress() const;
+  /// Controls the cell's diagonal from now on; the off-diagonal gradient is the last one set
+  /// (set_velocity_gradient). Throws without a cell, or on a bad gain, rate limit or target.
+  void set_cell_servo(const CellServo& servo);
 
   /// Forces a neighbour-list rebuild before the next step.
   void invalidate_neighbors() { nl_.ref_pos.clear(); }
@@ -204,6 +219,8 @@ class Simulation {
   bool periodic_ = false, planar_ = false;
   PeriodicCell cell_;
   HomogeneousField field_;  // this step's homogeneous terms of the integration
+  std::optional<CellServo> cell_servo_;
+  Eigen::Matrix3d servo_base_gradient_ = Eigen::Matrix3d::Zero();  // its off-diagonal part
   bool outlet_ = false;
   Eigen::Vector3d keep_lo_ = Eigen::Vector3d::Zero(), keep_hi_ = Eigen::Vector3d::Zero();
   std::size_t removed_count_ = 0;

@@ -730,7 +730,9 @@ Scene load_scene(const std::filesystem::path& path) {
   read_clumps(r, root, path, s);
   if (const auto* cell = r.table("cell", false)) {
     // Periodic cell (docs/scenes.md "[cell]"; YADE's O.cell.hSize and O.cell.velGrad).
-    r.only(cell, "cell", {"size_m", "hsize_m", "velocity_gradient_1_s", "two_d"});
+    r.only(cell, "cell",
+           {"size_m", "hsize_m", "velocity_gradient_1_s", "two_d", "control", "target",
+            "servo_gain", "max_rate_1_s"});
     auto& c = s.cell.emplace();
     if (cell->contains("size_m") == cell->contains("hsize_m"))
       r.fail("cell", "give one of size_m and hsize_m");
@@ -750,6 +752,31 @@ Scene load_scene(const std::filesystem::path& path) {
       c.planar = true;
     else if (!two_d.empty())
       r.fail("cell.two_d", "expected \"spheres_in_plane\"", two_d);
+    if (cell->contains("control")) {
+      // Each diagonal axis: "stress" (target in Pa, compression negative) or "rate" (1/s).
+      auto& sv = c.servo.emplace();
+      const auto* ctl = (*cell)["control"].as_array();
+      if (!ctl || ctl->size() != 3) r.fail("cell.control", "expected 3 of \"stress\" and \"rate\"");
+      for (std::size_t i = 0; i < 3; ++i) {
+        const auto v = (*ctl)[i].value<std::string>();
+        if (!v || (*v != "stress" && *v != "rate"))
+          r.fail("cell.control", "expected 3 of \"stress\" and \"rate\"",
+                 v ? *v : "entry " + std::to_string(i));
+        sv.stress[i] = *v == "stress";
+      }
+      sv.target = r.vec3(cell, "cell", "target", true, {});
+      const bool any = sv.stress[0] || sv.stress[1] || sv.stress[2];
+      sv.gain = any ? r.positive(cell, "cell", "servo_gain", true, 0) : 0.0;
+      sv.max_rate = any ? r.positive(cell, "cell", "max_rate_1_s", true, 0) : 0.0;
+      for (int i = 0; i < 3; ++i)
+        if (c.vel_grad(i, i) != 0)
+          r.fail("cell.velocity_gradient_1_s",
+                 "its diagonal is the servo's (cell.control): give 0 there",
+                 value_str(c.vel_grad(i, i)));
+    } else {
+      for (const char* k : {"target", "servo_gain", "max_rate_1_s"})
+        if (cell->contains(k)) r.fail(std::string("cell.") + k, "needs cell.control");
+    }
     if (root.contains("walls") || root.contains("mesh"))
       r.fail("[cell]", "walls and meshes in a periodic cell are not supported");
     if (root.contains("clumps")) r.fail("[cell]", "clumps in a periodic cell are not supported");

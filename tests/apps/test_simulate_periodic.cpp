@@ -134,6 +134,16 @@ TEST(SimulatePeriodic, BadCellsFailWithOneLine) {
       {"size_m = [0.05, 0.05, 0.008]\nsize_x = 1\n", "unknown key"},
       {"size_m = [0.05, 0.05, 0.008]\nhsize_m = [[1, 0, 0], [0, 1, 0], [0, 0, 1]]\n",
        "one of size_m and hsize_m"},
+      {"size_m = [0.05, 0.05, 0.008]\ncontrol = [\"stress\", \"rate\", \"strain\"]\n",
+       "cell.control"},
+      {"size_m = [0.05, 0.05, 0.008]\ncontrol = [\"stress\", \"rate\", \"rate\"]\n"
+       "target = [-1e5, -0.1, 0]\nmax_rate_1_s = 0.5\n",
+       "cell.servo_gain: missing"},
+      {"size_m = [0.05, 0.05, 0.008]\ncontrol = [\"stress\", \"stress\", \"rate\"]\n"
+       "target = [-1e5, -1e5, 0.1]\nservo_gain = 1e-4\nmax_rate_1_s = 0.5\n"
+       "two_d = \"spheres_in_plane\"\n",
+       "xy plane only"},
+      {"size_m = [0.05, 0.05, 0.008]\nservo_gain = 1e-4\n", "needs cell.control"},
   };
   int k = 0;
   for (const auto& [cell, expect] : cases) {
