@@ -227,6 +227,7 @@ void run(const Args& a) {
   if (scene.cell) {
     try {
       sim.set_periodic(scene.cell->hsize, scene.cell->planar);
+      if (scene.cell->disks) sim.set_disks(scene.cell->hsize(2, 2));
       sim.set_velocity_gradient(scene.cell->vel_grad);
       if (scene.cell->servo) sim.set_cell_servo(*scene.cell->servo);
     } catch (const std::invalid_argument& e) {

@@ -255,6 +255,22 @@ void Simulation::set_cell_servo(const CellServo& servo) {
   cell_.set_velocity_gradient(l);
 }
 
+void Simulation::set_disks(double thickness_m) {
+  if (!planar_) throw std::invalid_argument("disks need a planar periodic cell");
+  if (!(thickness_m > 0) || !std::isfinite(thickness_m))
+    throw std::invalid_argument("disk thickness must be positive (" + std::to_string(thickness_m) +
+                                " m)");
+  if (step_ != 0) throw std::invalid_argument("disks are set before the first step");
+  disk_thickness_ = thickness_m;
+  for (std::size_t i = 0; i < p_.size(); ++i) {
+    const double r = p_.radius[i];
+    p_.mass[i] = M_PI * r * r * thickness_m * cfg_.material.density;
+    p_.inertia[i] = 0.5 * p_.mass[i] * r * r;
+  }
+  params_key_valid_ = false;
+  invalidate_neighbors();
+}
+
 void Simulation::set_velocity_gradient(const Eigen::Matrix3d& l) {
   if (!periodic_) throw std::invalid_argument("a velocity gradient needs a periodic cell");
   if (!l.allFinite()) throw std::invalid_argument("velocity gradient is not finite");
@@ -327,6 +343,11 @@ void Simulation::attach_histories(const std::vector<ContactHistory>& old,
       params_[k] = contact_params(cfg_.material, 2 * ra, ra, cfg_.twist_beta, cfg_.twist_eta);
     else
       params_[k] = contact_params(cfg_.material, ra, rb, cfg_.twist_beta, cfg_.twist_eta);
+    if (disk_thickness_ > 0 && !ws) {  // disks: a line contact of Ec per unit thickness
+      params_[k].kn = mat.young_ec * disk_thickness_;
+      params_[k].ks = mat.stiffness_ratio * params_[k].kn;
+      params_[k].kr = mat.rolling_beta * params_[k].ks * ra * rb;
+    }
     if (pr.second >= kWallBase) {
       const double wf = walls_[pr.second - kWallBase].spec.friction_deg;
       if (wf >= 0) params_[k].tan_friction = std::tan(wf * M_PI / 180.0);

@@ -154,6 +154,12 @@ class Simulation {
   /// z = const). Throws std::invalid_argument on walls or clumps (not supported in a cell), a
   /// degenerate or inverted cell, or a cell too small (PeriodicTooSmall).
   void set_periodic(const Eigen::Matrix3d& hsize, bool planar = false);
+  /// True disks in the plane (after set_periodic(…, planar = true); seed 002's assembly): a
+  /// disk of thickness t has m = ρ·π·r²·t and I = m·r²/2, and a contact between disks the
+  /// normal stiffness Ec·t (Ec per unit thickness, whatever the radii: a line contact), Ks =
+  /// νc·Kn, Kr = β·Ks·R1·R2. Throws unless the cell is planar, or on t <= 0.
+  void set_disks(double thickness_m);
+  bool disks() const { return disk_thickness_ > 0; }
   bool periodic() const { return periodic_; }
   bool planar() const { return planar_; }
   const PeriodicCell& cell() const { return cell_; }
@@ -217,6 +223,7 @@ class Simulation {
 
   std::vector<ClumpBody> clumps_;
   bool periodic_ = false, planar_ = false;
+  double disk_thickness_ = 0;  // m; > 0: true disks (set_disks)
   PeriodicCell cell_;
   HomogeneousField field_;  // this step's homogeneous terms of the integration
   std::optional<CellServo> cell_servo_;

@@ -748,10 +748,11 @@ Scene load_scene(const std::filesystem::path& path) {
              "singular or inverted cell (det H <= 0)", value_str(c.hsize.determinant()));
     c.vel_grad = r.matrix3(cell, "cell", "velocity_gradient_1_s", false, Eigen::Matrix3d::Zero());
     const std::string two_d = r.string(cell, "cell", "two_d", false, "");
-    if (two_d == "spheres_in_plane")
+    if (two_d == "spheres_in_plane" || two_d == "disks")
       c.planar = true;
     else if (!two_d.empty())
-      r.fail("cell.two_d", "expected \"spheres_in_plane\"", two_d);
+      r.fail("cell.two_d", "expected \"spheres_in_plane\" or \"disks\"", two_d);
+    c.disks = two_d == "disks";
     if (cell->contains("control")) {
       // Each diagonal axis: "stress" (target in Pa, compression negative) or "rate" (1/s).
       auto& sv = c.servo.emplace();

@@ -67,7 +67,8 @@ struct Scene {
   struct CellSpec {
     Eigen::Matrix3d hsize = Eigen::Matrix3d::Identity();
     Eigen::Matrix3d vel_grad = Eigen::Matrix3d::Zero();
-    bool planar = false;             // two_d = "spheres_in_plane"
+    bool planar = false;  // two_d = "spheres_in_plane" or "disks"
+    bool disks = false;   // two_d = "disks": disks as thick as the cell (Simulation::set_disks)
     std::optional<CellServo> servo;  // control / target / servo_gain / max_rate_1_s
   };
   std::optional<CellSpec> cell;

@@ -130,7 +130,7 @@ TEST(SimulatePeriodic, BadCellsFailWithOneLine) {
       {"hsize_m = [[0.05, 0.05, 0], [0.05, 0.05, 0], [0, 0, 0.008]]\n", "singular or inverted"},
       {"hsize_m = [[0.05, 0, 0], [0, -0.05, 0], [0, 0, 0.008]]\n", "singular or inverted"},
       {"size_m = [0.05, 0.05, 0.008]\nvelocity_gradient_1_s = [[1, 0], [0, 1]]\n", "3 rows of 3"},
-      {"size_m = [0.05, 0.05, 0.008]\ntwo_d = \"disks\"\n", "cell.two_d"},
+      {"size_m = [0.05, 0.05, 0.008]\ntwo_d = \"discs\"\n", "cell.two_d"},
       {"size_m = [0.05, 0.05, 0.008]\nsize_x = 1\n", "unknown key"},
       {"size_m = [0.05, 0.05, 0.008]\nhsize_m = [[1, 0, 0], [0, 1, 0], [0, 0, 1]]\n",
        "one of size_m and hsize_m"},

@@ -269,3 +269,41 @@ TEST(PeriodicCell, ServoHoldsStressAxesAndDrivesRateAxes) {
   servo.gain = -1;
   EXPECT_THROW(sim.set_cell_servo(servo), std::invalid_argument);
 }
+
+// True disks: m = ρ·π·r²·t, I = m·r²/2, Kn = Ec·t. Two equal disks meeting head on (no damping,
+// no friction work: a central impact) stay in contact for half a period of the reduced mass on
+// Kn, π·sqrt(m/(2·Kn)), and leave with the speed they came with.
+TEST(PeriodicCell, DisksHaveDiskMassInertiaAndLineStiffness) {
+  const double r = 0.001, t = 0.004, v0 = 0.05;
+  auto a = sphere(0, {0.004, 0.005, 0.002}, r);
+  auto b = sphere(1, {0.00601, 0.005, 0.002}, r);
+  a.velocity = {v0, 0, 0};
+  b.velocity = {-v0, 0, 0};
+  auto cfg = config(0.0);
+  cfg.dt = 1e-7;
+  Simulation sim(cfg, {a, b}, {});
+  Eigen::Matrix3d h = Eigen::Matrix3d::Zero();
+  h.diagonal() << 0.012, 0.012, t;
+  sim.set_periodic(h, true);
+  sim.set_disks(t);
+  const double m = 2550.0 * M_PI * r * r * t;
+  EXPECT_NEAR(sim.particles().mass[0], m, 1e-15 * m);
+  EXPECT_NEAR(sim.particles().inertia[0], 0.5 * m * r * r, 1e-15 * m * r * r);
+  int first = -1, last = -1;
+  for (int n = 1; n <= 20000; ++n) {
+    sim.step();
+    if (sim.contact_count() == 1) {
+      if (first < 0) first = n;
+      last = n;
+    }
+  }
+  ASSERT_GT(first, 0);
+  const double kn = 3.0e7 * t;
+  const double duration = M_PI * std::sqrt(0.5 * m / kn);
+  EXPECT_NEAR((last - first + 1) * cfg.dt, duration, 2 * cfg.dt);
+  EXPECT_NEAR(sim.particles().vel[0].x(), -v0, 1e-6 * v0);
+  EXPECT_NEAR(sim.particles().vel[1].x(), v0, 1e-6 * v0);
+  Simulation not_planar(cfg, {a, b}, {});
+  not_planar.set_periodic(cube(0.012));
+  EXPECT_THROW(not_planar.set_disks(t), std::invalid_argument);
+}
