@@ -498,7 +498,8 @@ void Simulation::set_facet_forces(bool on) {
   }
   m1 = {V3(p_.pos[a]), V3(p_.vel[a]), V3(p_.angvel[a])};
   m2 = {V3(p_.pos[b]), V3(p_.vel[b]), V3(p_.angvel[b])};
-  if (periodic_) m2.pos = m2.pos + cell_.shift_pos(nl_.cell_dist[k]);  // se32.position + shift2
+  if (periodic_ && !nl_.cell_dist[k].isZero())
+    m2.pos = m2.pos + cell_.shift_pos(nl_.cell_dist[k]);  // se32.position + shift2
   return sphere_sphere_geometry(m1.pos, p_.radius[a], m2.pos, p_.radius[b], g);
 }
 
@@ -581,7 +582,9 @@ void Simulation::accumulate_walls() {
   put(F::C1X, g.point - m1.pos);
   put(F::C2X, g.point - m2.pos);
   B.v[F::FRESH][j] = h.real ? 0 : 1;
-  if (periodic_) put(F::SVX, b < kWallBase ? cell_.shift_vel(nl_.cell_dist[k]) : V3());
+  if (periodic_)  // (a pair inside the cell: no shift; +0 either way)
+    put(F::SVX, b < kWallBase && !nl_.cell_dist[k].isZero() ? cell_.shift_vel(nl_.cell_dist[k])
+                                                            : V3());
   put(F::ONX, V3(h.normal));
   put(F::SX, V3(h.shear_force));
   put(F::BX, V3(h.bending));
@@ -672,7 +675,9 @@ int Simulation::fill_batch(std::size_t& i, std::size_t end, ContactBatch& batch,
     if (b < kWallBase) {
       const double reach = p_.radius[a] + p_.radius[b];
       if (periodic_) {  // (the image of b)
-        const V3 d = V3(p_.pos[b]) + cell_.shift_pos(nl_.cell_dist[k]) - V3(p_.pos[a]);
+        const Eigen::Vector3i& cd = nl_.cell_dist[k];
+        const V3 d = (cd.isZero() ? V3(p_.pos[b]) : V3(p_.pos[b]) + cell_.shift_pos(cd)) -
+                     V3(p_.pos[a]);
         in_reach = !(squared_norm(d) > reach * reach * (1 + 1e-12));
       } else {
         in_reach = !((p_.pos[b] - p_.pos[a]).squaredNorm() > reach * reach);
