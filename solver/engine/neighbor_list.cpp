@@ -76,6 +76,44 @@ constexpr int kForward[13][3] = {{1, 0, 0},  {-1, 1, 0}, {0, 1, 0},  {1, 1, 0}, 
                                  {0, -1, 1}, {1, -1, 1}, {-1, 0, 1}, {0, 0, 1}, {1, 0, 1},
                                  {-1, 1, 1}, {0, 1, 1},  {1, 1, 1}};
 
+/// Calls test(s, t, shift) for every pair of slots (cell ranges of `start`) in one cell or in a
+/// cell and one of its forward neighbours, each pair once; a neighbour across a face of a
+/// direction that wraps is taken from the other side, `shift` the periods crossed (else such
+/// neighbours do not exist).
+template <class Test>
+void for_each_slot_pair(const Eigen::Array3i& dims, const bool (&wraps)[3],
+                        const std::vector<std::uint32_t>& start, Test&& test) {
+  auto index_of = [&](int x, int y, int z) {
+    return static_cast<std::uint32_t>((z * dims[1] + y) * dims[0] + x);
+  };
+  const Eigen::Vector3i none = Eigen::Vector3i::Zero();
+  for (int cz = 0; cz < dims[2]; ++cz)
+    for (int cy = 0; cy < dims[1]; ++cy)
+      for (int cx = 0; cx < dims[0]; ++cx) {
+        const std::uint32_t ci = index_of(cx, cy, cz);
+        const std::uint32_t s0 = start[ci], s1 = start[ci + 1];
+        if (s0 == s1) continue;
+        for (std::uint32_t s = s0; s < s1; ++s)
+          for (std::uint32_t t = s + 1; t < s1; ++t) test(s, t, none);
+        for (const auto& o : kForward) {
+          int nc[3] = {cx + o[0], cy + o[1], cz + o[2]};
+          Eigen::Vector3i shift = none;
+          bool inside = true;
+          for (int k = 0; k < 3 && inside; ++k) {
+            if (nc[k] >= 0 && nc[k] < dims[k]) continue;
+            inside = wraps[k];
+            shift[k] = nc[k] < 0 ? -1 : 1;
+            nc[k] -= shift[k] * dims[k];
+          }
+          if (!inside) continue;
+          const std::uint32_t cj = index_of(nc[0], nc[1], nc[2]);
+          const std::uint32_t t0 = start[cj], t1 = start[cj + 1];
+          for (std::uint32_t s = s0; s < s1; ++s)
+            for (std::uint32_t t = t0; t < t1; ++t) test(s, t, shift);
+        }
+      }
+}
+
 }  // namespace
 
 void NeighborList::build(const ParticleState& p, const std::vector<WallState>& walls,
@@ -148,30 +186,16 @@ void NeighborList::build(const ParticleState& p, const std::vector<WallState>& w
   // criterion |xj − xi| < ri + rj + skin, with a relative hair of slack (more candidates
   // are harmless; fewer are not).
   found_.clear();
-  auto test = [&](const Slot& a, const Slot& b) {
-    if (a.clump >= 0 && a.clump == b.clump) return;  // one clump
-    const double reach = a.r + b.r + skin;
-    const double dx = b.x - a.x, dy = b.y - a.y, dz = b.z - a.z;
-    if (dx * dx + dy * dy + dz * dz < reach * reach * (1 + 1e-12))
-      found_.emplace_back(std::min(a.index, b.index), std::max(a.index, b.index));
-  };
-  for (int cz = 0; cz < dims[2]; ++cz)
-    for (int cy = 0; cy < dims[1]; ++cy)
-      for (int cx = 0; cx < dims[0]; ++cx) {
-        const std::uint32_t ci = index_of(cx, cy, cz);
-        const std::uint32_t s0 = cell_start_[ci], s1 = cell_start_[ci + 1];
-        if (s0 == s1) continue;
-        for (std::uint32_t s = s0; s < s1; ++s)
-          for (std::uint32_t t = s + 1; t < s1; ++t) test(slots_[s], slots_[t]);
-        for (const auto& o : kForward) {
-          const int nx = cx + o[0], ny = cy + o[1], nz = cz + o[2];
-          if (nx < 0 || ny < 0 || nx >= dims[0] || ny >= dims[1] || nz >= dims[2]) continue;
-          const std::uint32_t cj = index_of(nx, ny, nz);
-          const std::uint32_t t0 = cell_start_[cj], t1 = cell_start_[cj + 1];
-          for (std::uint32_t s = s0; s < s1; ++s)
-            for (std::uint32_t t = t0; t < t1; ++t) test(slots_[s], slots_[t]);
-        }
-      }
+  const bool no_wrap[3] = {false, false, false};
+  for_each_slot_pair(
+      dims, no_wrap, cell_start_, [&](std::uint32_t s, std::uint32_t t, const Eigen::Vector3i&) {
+        const Slot &a = slots_[s], &b = slots_[t];
+        if (a.clump >= 0 && a.clump == b.clump) return;  // one clump
+        const double reach = a.r + b.r + skin;
+        const double dx = b.x - a.x, dy = b.y - a.y, dz = b.z - a.z;
+        if (dx * dx + dy * dy + dz * dz < reach * reach * (1 + 1e-12))
+          found_.emplace_back(std::min(a.index, b.index), std::max(a.index, b.index));
+      });
   // Facets are binned, each on its own, into the cells their bounding box (grown by the
   // largest reach) covers, in (wall, facet) order within a cell; other walls are checked by all.
   plain_walls_.clear();
@@ -319,48 +343,21 @@ void NeighborList::build_periodic(const ParticleState& p, const PeriodicCell& ce
         x[0], x[1], x[2], p.radius[i], static_cast<std::uint32_t>(i), clumped ? p.clump[i] : -1};
   }
   found_periodic_.clear();
-  auto test = [&](const Slot& a, const Slot& b, const Eigen::Vector3i& shift,
-                  const Eigen::Vector3d& offset) {
-    if (a.clump >= 0 && a.clump == b.clump) return;
-    const double reach = a.r + b.r + skin;
-    const double dx = b.x + offset[0] - a.x, dy = b.y + offset[1] - a.y, dz = b.z + offset[2] - a.z;
-    if (!(dx * dx + dy * dy + dz * dz < reach * reach * (1 + 1e-12))) return;
-    const Eigen::Vector3i cd = shift + period_[a.index] - period_[b.index];
-    if (a.index < b.index)
-      found_periodic_.push_back({a.index, b.index, cd});
-    else
-      found_periodic_.push_back({b.index, a.index, -cd});
-  };
-  for (int cz = 0; cz < dims[2]; ++cz)
-    for (int cy = 0; cy < dims[1]; ++cy)
-      for (int cx = 0; cx < dims[0]; ++cx) {
-        const std::uint32_t ci = index_of(cx, cy, cz);
-        const std::uint32_t s0 = cell_start_[ci], s1 = cell_start_[ci + 1];
-        if (s0 == s1) continue;
-        for (std::uint32_t s = s0; s < s1; ++s)
-          for (std::uint32_t t = s + 1; t < s1; ++t)
-            test(slots_[s], slots_[t], Eigen::Vector3i::Zero(), Eigen::Vector3d::Zero());
-        for (const auto& o : kForward) {
-          int nc[3] = {cx + o[0], cy + o[1], cz + o[2]};
-          Eigen::Vector3i shift = Eigen::Vector3i::Zero();
-          bool inside = true;
-          for (int k = 0; k < 3; ++k) {
-            if (nc[k] >= 0 && nc[k] < dims[k]) continue;
-            if (!wraps[k]) {
-              inside = false;
-              break;
-            }
-            shift[k] = nc[k] < 0 ? -1 : 1;
-            nc[k] -= shift[k] * dims[k];
-          }
-          if (!inside) continue;
-          const Eigen::Vector3d offset = cell.hsize * shift.cast<double>();
-          const std::uint32_t cj = index_of(nc[0], nc[1], nc[2]);
-          const std::uint32_t t0 = cell_start_[cj], t1 = cell_start_[cj + 1];
-          for (std::uint32_t s = s0; s < s1; ++s)
-            for (std::uint32_t t = t0; t < t1; ++t) test(slots_[s], slots_[t], shift, offset);
-        }
-      }
+  for_each_slot_pair(dims, wraps, cell_start_,
+                     [&](std::uint32_t s, std::uint32_t t, const Eigen::Vector3i& shift) {
+                       const Slot &a = slots_[s], &b = slots_[t];
+                       if (a.clump >= 0 && a.clump == b.clump) return;
+                       const Eigen::Vector3d offset = cell.hsize * shift.cast<double>();
+                       const double reach = a.r + b.r + skin;
+                       const double dx = b.x + offset[0] - a.x, dy = b.y + offset[1] - a.y,
+                                    dz = b.z + offset[2] - a.z;
+                       if (!(dx * dx + dy * dy + dz * dz < reach * reach * (1 + 1e-12))) return;
+                       const Eigen::Vector3i cd = shift + period_[a.index] - period_[b.index];
+                       if (a.index < b.index)
+                         found_periodic_.push_back({a.index, b.index, cd});
+                       else
+                         found_periodic_.push_back({b.index, a.index, -cd});
+                     });
   std::sort(found_periodic_.begin(), found_periodic_.end(),
             [](const auto& x, const auto& y) { return x.a != y.a ? x.a < y.a : x.b < y.b; });
   pairs.resize(found_periodic_.size());
