@@ -22,6 +22,7 @@
 #include "errors.hpp"
 #include "text_parse.hpp"
 #include "vtk_io.hpp"
+#include "vtk_xml_check.hpp"
 
 namespace gs {
 
@@ -47,6 +48,7 @@ void run_reader(Reader* r, const std::filesystem::path& path) {
   std::error_code ec;
   if (!std::filesystem::exists(path, ec)) throw InputError(name, "no such file");
   if (!std::filesystem::is_regular_file(path, ec)) throw InputError(name, "not a regular file");
+  check_vtk_xml_structure(path);  // what VTK would trust: counts, sizes, nesting
   ErrorSink sink;
   vtkNew<vtkCallbackCommand> cb;
   cb->SetCallback(&ErrorSink::on_error);
@@ -54,7 +56,11 @@ void run_reader(Reader* r, const std::filesystem::path& path) {
   r->AddObserver(vtkCommand::ErrorEvent, cb);
   r->AddObserver(vtkCommand::WarningEvent, cb);
   r->SetFileName(name.c_str());
-  r->Update();
+  try {
+    r->Update();
+  } catch (const std::bad_alloc&) {
+    throw InputError(name, "not enough memory to read the file");
+  }
   if (!sink.first.empty() || r->GetErrorCode() != 0)
     throw InputError(name, "cannot read VTK XML file",
                      sink.first.empty() ? "reader error" : sink.first);

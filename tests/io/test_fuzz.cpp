@@ -5,6 +5,7 @@
 #include <fstream>
 #include <random>
 
+#include "../apps/cli_util.hpp"
 #include "errors.hpp"
 #include "test_util.hpp"
 #include "trajectory_io.hpp"
@@ -121,4 +122,137 @@ TEST(FuzzOwnFormats, Hdf5VtuVtpPvd) {
     const Outcome o = fuzz(dir / victim, dir / entry, 120, 777u);
     EXPECT_GT(o.rejected, 0) << victim;
   }
+}
+
+// ------------------------------------------------------------------ hostile headers (issue 15)
+// Hand-made files that crashed the readers (negative counts, 200 000 nested elements), made them
+// allocate gigabytes from a few kilobytes (a compression header claiming 2^30 blocks, a
+// NumberOfPoints of 1e8 or 1e12), or read fewer values than the file holds without a word. Each
+// must give its one exact line through the library and the CLI (exit 2, nothing written).
+
+namespace {
+
+std::string vtu_text(const std::string& npoints, const std::string& ncells,
+                     const std::string& values = "") {
+  const std::string v = values.empty() ? "0.001 0.001 0.001" : values;
+  return R"(<?xml version="1.0"?>
+<VTKFile type="UnstructuredGrid" version="0.1" byte_order="LittleEndian">
+  <UnstructuredGrid>
+    <Piece NumberOfPoints=")" +
+         npoints + R"(" NumberOfCells=")" + ncells + R"(">
+      <PointData>
+        <DataArray type="Float64" Name="radius" format="ascii">)" +
+         v + R"(</DataArray>
+      </PointData>
+      <Points>
+        <DataArray type="Float64" NumberOfComponents="3" format="ascii">0 0 0 0.002 0 0 0.004 0 0</DataArray>
+      </Points>
+      <Cells>
+        <DataArray type="Int64" Name="connectivity" format="ascii">0 1 2</DataArray>
+        <DataArray type="Int64" Name="offsets" format="ascii">1 2 3</DataArray>
+        <DataArray type="UInt8" Name="types" format="ascii">1 1 1</DataArray>
+      </Cells>
+    </Piece>
+  </UnstructuredGrid>
+</VTKFile>
+)";
+}
+
+// Appended raw zlib data whose header claims `blocks` blocks, padded to ~7.7 kB.
+std::string block_bomb(std::uint32_t blocks) {
+  std::string s =
+      "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" "
+      "byte_order=\"LittleEndian\" header_type=\"UInt32\" compressor=\"vtkZLibDataCompressor\">\n"
+      "<UnstructuredGrid><Piece NumberOfPoints=\"3\" NumberOfCells=\"0\"><PointData>"
+      "<DataArray type=\"Float64\" Name=\"radius\" format=\"appended\" offset=\"0\"/></PointData>"
+      "<Points><DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"appended\" "
+      "offset=\"0\"/></Points></Piece></UnstructuredGrid>\n<AppendedData encoding=\"raw\">\n_";
+  const std::uint32_t hdr[3] = {blocks, 32768, 100};
+  s.append(reinterpret_cast<const char*>(hdr), sizeof hdr);
+  s += std::string(7000, '\0') + "\n</AppendedData>\n</VTKFile>\n";
+  return s;
+}
+
+struct Hostile {
+  std::string file, content, what;  // what: the message after "FILE: "
+};
+
+void expect_hostile_rejected(const gs::test::ScratchDir& dir, const std::vector<Hostile>& cases) {
+  const auto log = dir / "log";
+  std::filesystem::create_directories(log);
+  for (const auto& c : cases) {
+    const auto path = dir / c.file;
+    spit(path, c.content);
+    const std::string msg = path.string() + ": " + c.what;
+    try {
+      (void)read_snapshots(path);
+      ADD_FAILURE() << c.file << ": accepted";
+    } catch (const InputError& e) {
+      EXPECT_EQ(e.what(), msg);
+    }
+    const auto r =
+        gs::test::run_cli("convert " + path.string() + " " + (dir / "out.h5").string(), log);
+    EXPECT_EQ(r.rc, 2) << c.file;
+    EXPECT_EQ(r.err, "error: " + msg + "\n");
+    EXPECT_EQ(r.out, "");
+    EXPECT_FALSE(std::filesystem::exists(dir / "out.h5"));
+    EXPECT_FALSE(std::filesystem::exists(dir / "out.h5.partial"));
+  }
+}
+
+}  // namespace
+
+TEST(HostileInputs, VtkXmlHeadersAreCheckedBeforeVtkTrustsThem) {
+  gs::test::ScratchDir dir("hostile_vtu");
+  std::string deep = "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"0.1\">";
+  for (int i = 0; i < 200000; ++i) deep += "<a>";
+  for (int i = 0; i < 200000; ++i) deep += "</a>";
+  deep += "</VTKFile>\n";
+  std::string forty;
+  for (int i = 0; i < 40; ++i) forty += "0.001 ";
+  const std::vector<Hostile> cases = {
+      {"np-1.vtu", vtu_text("-1", "3"), "Piece NumberOfPoints is not a non-negative integer (-1)"},
+      {"np-5.vtu", vtu_text("-5", "3"), "Piece NumberOfPoints is not a non-negative integer (-5)"},
+      {"nc-1.vtu", vtu_text("3", "-1"), "Piece NumberOfCells is not a non-negative integer (-1)"},
+      {"nc-5.vtu", vtu_text("3", "-5"), "Piece NumberOfCells is not a non-negative integer (-5)"},
+      {"deep.vtu", deep, "XML elements nested too deep (more than 64 levels)"},
+      {"bomb.vtu", block_bomb(1u << 30),
+       "DataArray radius compression header claims more blocks than the file holds (1073741824 "
+       "blocks)"},
+      {"np1e8.vtu", vtu_text("100000000", "3"),
+       "Piece NumberOfPoints exceeds what the file can hold (100000000)"},
+      {"np1e12.vtu", vtu_text("1000000000000", "3"),
+       "Piece NumberOfPoints exceeds what the file can hold (1000000000000)"},
+      {"extra.vtu", vtu_text("3", "3", forty),
+       "DataArray radius holds a different number of values than declared (40 values, expected "
+       "3)"},
+      {"short.vtu", vtu_text("3", "3", "0.001 0.001"),
+       "DataArray radius holds a different number of values than declared (2 values, expected "
+       "3)"},
+  };
+  expect_hostile_rejected(dir, cases);
+}
+
+// The binary flavours: our appended raw zlib .vtu and YADE's appended base64 one, with
+// NumberOfPoints one short of the 40 values they hold (VTK read 39 particles, exit 0).
+TEST(HostileInputs, BinaryVtuWithFewerPointsDeclaredThanStored) {
+  gs::test::ScratchDir dir("hostile_vtu_bin");
+  const std::string yade = slurp(kData / "yade/yade_spheres.20000.vtu");
+  ASSERT_EQ(read_snapshots(kData / "yade/yade_spheres.20000.vtu").frames.at(0).particles.size(),
+            40u);
+  write_snapshots(dir / "ours.vtu", read_snapshots(kData / "yade/yade_spheres.20000.vtu"));
+  auto cut_to_39 = [](std::string s) {
+    const auto k = s.find("NumberOfPoints=\"40\"");
+    EXPECT_NE(k, std::string::npos);
+    s.replace(k, 19, "NumberOfPoints=\"39\"");
+    return s;
+  };
+  const std::vector<Hostile> cases = {
+      {"yade39.vtu", cut_to_39(yade),
+       "DataArray radii holds a different number of bytes than declared (320 bytes, expected "
+       "312)"},
+      {"ours39.vtu", cut_to_39(slurp(dir / "ours.vtu")),
+       "DataArray id holds a different number of bytes than declared (320 bytes, expected 312)"},
+  };
+  expect_hostile_rejected(dir, cases);
 }
