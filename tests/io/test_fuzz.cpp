@@ -1,7 +1,9 @@
 // Bounded mutation fuzzing of every reader: each fixture is bit-flipped and truncated, and each
 // mutant must give either a valid result or an InputError — no crash, no hang, no other error.
 #include <gtest/gtest.h>
+#include <hdf5.h>
 
+#include <chrono>
 #include <fstream>
 #include <random>
 
@@ -255,4 +257,85 @@ TEST(HostileInputs, BinaryVtuWithFewerPointsDeclaredThanStored) {
        "DataArray id holds a different number of bytes than declared (320 bytes, expected 312)"},
   };
   expect_hostile_rejected(dir, cases);
+}
+
+// HDF5: a file of a few kilobytes whose datasets declare 10^8 particles (took 23 GB and was
+// killed); links into other files (followed silently); and a long trajectory of empty frames,
+// which `convert` wrote in super-linear time (10^4 frames 2.5 s, 3·10^4 frames 9.6 s).
+TEST(HostileInputs, Hdf5DeclaredRowsExternalLinksAndLongTrajectories) {
+  gs::test::ScratchDir dir("hostile_h5");
+  Trajectory t;
+  t.frames = {gs::test::random_frame(30, 20, 1, 0.0)};
+  for (auto& f : t.frames) f.walls.clear();
+  write_snapshots(dir / "good.h5", t);
+  ASSERT_EQ(read_snapshots(dir / "good.h5").frames.size(), 1u);
+
+  // 10^8 particles declared: the datasets extended (no chunk written), the frame index patched.
+  std::filesystem::copy_file(dir / "good.h5", dir / "big.h5");
+  {
+    const hid_t f = H5Fopen((dir / "big.h5").c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+    ASSERT_GE(f, 0);
+    for (const char* d : {"id", "position", "radius", "velocity", "angular_velocity", "orientation",
+                          "rotation", "mass", "clump_id", "material_id"}) {
+      const hid_t ds = H5Dopen2(f, (std::string("/particles/") + d).c_str(), H5P_DEFAULT);
+      ASSERT_GE(ds, 0) << d;
+      const hid_t sp = H5Dget_space(ds);
+      hsize_t dims[2] = {0, 0};
+      const int rank = H5Sget_simple_extent_dims(sp, dims, nullptr);
+      dims[0] = 100000000;
+      ASSERT_GE(rank, 1);
+      EXPECT_GE(H5Dset_extent(ds, dims), 0);
+      H5Sclose(sp);
+      H5Dclose(ds);
+    }
+    const hid_t e = H5Dopen2(f, "/frames/end", H5P_DEFAULT);
+    const std::int64_t end[3] = {100000000, 20, 0};
+    EXPECT_GE(H5Dwrite(e, H5T_NATIVE_INT64, H5S_ALL, H5S_ALL, H5P_DEFAULT, end), 0);
+    H5Dclose(e);
+    H5Fclose(f);
+  }
+  const std::string big = (dir / "big.h5").string();
+  try {
+    (void)read_snapshots(dir / "big.h5");
+    ADD_FAILURE() << "10^8 declared particles accepted";
+  } catch (const InputError& e) {
+    const std::string want =
+        big +
+        ": dataset declares more rows than the file stores (/particles/id: 100000000 rows in ";
+    EXPECT_EQ(std::string(e.what()).rfind(want, 0), 0u) << e.what();
+  }
+
+  // External links: one dataset, and a whole group, into another (valid) file.
+  std::filesystem::copy_file(dir / "good.h5", dir / "other.h5");
+  for (const auto& [file, link] : std::vector<std::pair<std::string, std::string>>{
+           {"ext_ds.h5", "/particles/radius"}, {"ext_group.h5", "/particles"}}) {
+    std::filesystem::copy_file(dir / "good.h5", dir / file);
+    const hid_t f = H5Fopen((dir / file).c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+    ASSERT_GE(f, 0);
+    EXPECT_GE(H5Ldelete(f, link.c_str(), H5P_DEFAULT), 0);
+    EXPECT_GE(H5Lcreate_external((dir / "other.h5").c_str(), link.c_str(), f, link.c_str(),
+                                 H5P_DEFAULT, H5P_DEFAULT),
+              0);
+    H5Fclose(f);
+  }
+  const std::vector<Hostile> links = {
+      {"ext_ds.h5", slurp(dir / "ext_ds.h5"), "external link not followed (/particles/radius)"},
+      {"ext_group.h5", slurp(dir / "ext_group.h5"), "external link not followed (/particles)"},
+  };
+  expect_hostile_rejected(dir, links);
+
+  // 2·10^5 empty frames: written and read back in linear time (was ~15 minutes extrapolated).
+  Trajectory many;
+  many.frames.resize(200000);
+  for (std::size_t i = 0; i < many.frames.size(); ++i) {
+    many.frames[i].step = static_cast<std::int64_t>(i);
+    many.frames[i].time = static_cast<double>(i);
+  }
+  const auto t0 = std::chrono::steady_clock::now();
+  write_snapshots(dir / "many.h5", many);
+  const Trajectory back = read_snapshots(dir / "many.h5");
+  const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  ASSERT_EQ(back.frames.size(), many.frames.size());
+  EXPECT_EQ(back.frames.back().step, 199999);
+  EXPECT_LT(secs, 60.0);
 }
