@@ -29,6 +29,8 @@ std::string read_file_bytes(const std::filesystem::path& path, std::size_t max_b
 std::string read_text_file(const std::filesystem::path& path, std::size_t max_bytes) {
   const std::string name = path.string();
   std::string s = read_file_bytes(path, max_bytes);
+  // A UTF-8 byte-order mark (spreadsheets write one) is not part of the first field.
+  if (s.rfind("\xEF\xBB\xBF", 0) == 0) s.erase(0, 3);
   if (s.find('\0') != std::string::npos)
     throw InputError(name, "binary content in a text file",
                      "NUL byte at offset " + std::to_string(s.find('\0')));

@@ -249,6 +249,11 @@ Trajectory read_pvd_series(const std::filesystem::path& pvd_path) {
     const std::string xml = text::read_text_file(p, 1u << 26);
     if (xml.find("<VTKFile") == std::string::npos || xml.find("Collection") == std::string::npos)
       throw InputError(p.string(), "not a ParaView collection (.pvd)");
+    // A collection cut short lists only some of its frames: it must close.
+    if (xml.find("</Collection>") == std::string::npos ||
+        xml.find("</VTKFile>") == std::string::npos)
+      throw InputError(p.string(),
+                       "truncated collection (no closing </Collection> and </VTKFile>)");
     std::vector<std::pair<double, std::filesystem::path>> out;
     static const std::regex ds(R"(<DataSet\b([^>]*)>)");
     static const std::regex ts(R"(timestep\s*=\s*"([^"]*)\")"), fl(R"(file\s*=\s*"([^"]*)\")");

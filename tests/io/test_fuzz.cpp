@@ -339,3 +339,70 @@ TEST(HostileInputs, Hdf5DeclaredRowsExternalLinksAndLongTrajectories) {
   EXPECT_EQ(back.frames.back().step, 199999);
   EXPECT_LT(secs, 60.0);
 }
+
+// Silently wrong imports: two LIGGGHTS blocks with one TIMESTEP (every pair went to the last),
+// a .pvd cut in half (8 of 17 frames, exit 0); and a CSV with a UTF-8 byte-order mark (its id
+// column was "missing"), which is accepted.
+TEST(HostileInputs, RepeatedTimestepsCutCollectionsAndByteOrderMarks) {
+  gs::test::ScratchDir dir("hostile_text");
+  const std::string block =
+      "ITEM: TIMESTEP\n100\nITEM: NUMBER OF ATOMS\n2\nITEM: BOX BOUNDS ff ff ff\n0 0.01\n0 0.01\n"
+      "0 0.01\nITEM: ATOMS id type x y z radius mass\n1 1 0.002 0.002 0.002 0.001 1e-5\n"
+      "2 1 0.0039 0.002 0.002 0.001 1e-5\n";
+  std::string series =
+      "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n"
+      "  <Collection>\n";
+  for (int i = 0; i < 17; ++i)
+    series += "    <DataSet timestep=\"" + std::to_string(i) + "\" part=\"0\" file=\"p.vtu\"/>\n";
+  series += "  </Collection>\n</VTKFile>\n";
+  spit(dir / "p.vtu", vtu_text("3", "3"));
+  spit(dir / "full.pvd", series);
+  ASSERT_EQ(read_snapshots(dir / "full.pvd").frames.size(), 17u);
+  const std::vector<Hostile> cases = {
+      {"twice.dump", block + block, "line 12: timestep repeats the block at line 1 (100)"},
+      {"cut.pvd", series.substr(0, series.size() / 2),
+       "truncated collection (no closing </Collection> and </VTKFile>)"},
+  };
+  expect_hostile_rejected(dir, cases);
+
+  spit(dir / "bom.csv", "\xEF\xBB\xBFid,x,y,z,r\n1,0,0,0,0.001\n2,0.003,0,0,0.001\n");
+  const Frame f = read_snapshots(dir / "bom.csv").frames.at(0);
+  ASSERT_EQ(f.particles.size(), 2u);
+  EXPECT_EQ(f.particles[1].id, 2);
+  EXPECT_EQ(f.particles[1].position.x(), 0.003);
+}
+
+// Already one clean line before issue 15, kept in the corpus: ids NaN or 1e30 in a .vtu, a
+// fractional interaction id in legacy VTK.
+TEST(HostileInputs, NonIntegralIdsStayRejected) {
+  gs::test::ScratchDir dir("hostile_ids");
+  const std::string rad = "Name=\"radius\" format=\"ascii\">0.001 0.001 0.001</DataArray>";
+  auto with_ids = [&](const std::string& ids) {
+    std::string s = vtu_text("3", "3");
+    s.replace(s.find(rad), rad.size(),
+              rad + "\n        <DataArray type=\"Float64\" Name=\"id\" format=\"ascii\">" + ids +
+                  "</DataArray>");
+    return s;
+  };
+  spit(dir / "f-spheres-0.vtk",
+       "# vtk DataFile Version 3.0.\nc\nASCII\nDATASET POLYDATA\nPOINTS 2 double\n0 0 0\n"
+       "0.002 0 0\nPOINT_DATA 2\nSCALARS radius double 1\nLOOKUP_TABLE default\n0.001\n0.001\n"
+       "SCALARS id double 1\nLOOKUP_TABLE default\n10\n11\n");
+  const std::string intrs =
+      "# vtk DataFile Version 3.0.\nc\nASCII\nDATASET POLYDATA\nPOINTS 2 double\n0 0 0\n"
+      "0.002 0 0\nLINES 1 3\n2 0 1\nCELL_DATA 1\nSCALARS id1 double 1\nLOOKUP_TABLE default\n"
+      "10.5\nSCALARS id2 double 1\nLOOKUP_TABLE default\n11\n";
+  spit(dir / "f-intrs-0.vtk", intrs);
+  try {
+    (void)read_snapshots(dir / "f-spheres-0.vtk");
+    ADD_FAILURE() << "fractional interaction id accepted";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.what(),
+              (dir / "f-intrs-0.vtk").string() + ": interaction id1 is not an integer (10.5)");
+  }
+  const std::vector<Hostile> cases = {
+      {"nan.vtu", with_ids("1 nan 3"), "particle id is not an integer (nan)"},
+      {"big.vtu", with_ids("1 1e30 3"), "particle id is not an integer (1e+30)"},
+  };
+  expect_hostile_rejected(dir, cases);
+}
