@@ -225,7 +225,9 @@ void register_dic(CLI::App& app) {
   c->add_option("--zncc-min", args->zncc_min, "POIs below this ZNCC are invalid")
       ->capture_default_str();
   c->add_option("--search", args->search, "seed search half-width, px")->capture_default_str();
-  c->add_option("--threads", args->threads, "threads (0 = OpenMP default)")->capture_default_str();
+  c->add_option("--threads", args->threads, "threads (0 = OpenMP default, at most 1024)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 1024));
   c->add_flag("--no-csv", args->no_csv, "do not write CSV tables");
   c->add_flag("--no-vtk", args->no_vtk, "do not write VTK images");
   c->callback([args] { run_dic(*args); });

@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <fstream>
 #include <iostream>
+#include <limits>
 #include <map>
 #include <memory>
 #include <optional>
@@ -422,8 +423,10 @@ void register_simulate(CLI::App& app) {
   cmd->add_option("--steps", a->steps,
                   "stop at this step (a plain scene: its number of steps; a laboratory test "
                   "ends earlier if its programme ends first)")
-      ->check(CLI::NonNegativeNumber);
-  cmd->add_option("--threads", a->threads, "override the thread count")->check(CLI::PositiveNumber);
+      ->check(CLI::Range(std::int64_t{0}, std::numeric_limits<std::int64_t>::max()));
+  cmd->add_option("--threads", a->threads,
+                  "override the thread count (1 to " + std::to_string(solver::kMaxThreads) + ")")
+      ->check(CLI::Range(1, solver::kMaxThreads));
   cmd->add_flag("--resume", a->resume, "continue from the last checkpoint in the output directory");
   cmd->add_flag("-q,--quiet", a->quiet, "no progress line");
   cmd->callback([a] { run(*a); });

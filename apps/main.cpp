@@ -17,6 +17,31 @@ CLI::App& analyze_command(CLI::App& app) {
   return *a;
 }
 
+namespace {
+
+/// CLI11 reports a mistyped subcommand as "A subcommand is required": name it, and the choices.
+void check_subcommand_names(CLI::App& app, int argc, char** argv) {
+  CLI::App* cur = &app;
+  std::string path = "";
+  for (int i = 1; i < argc && cur->get_require_subcommand_min() > 0; ++i) {
+    const std::string a = argv[i];
+    if (a.empty() || a[0] == '-') return;  // an option (--help, --version): CLI11's to judge
+    CLI::App* next = nullptr;
+    std::string names;
+    for (auto* s : cur->get_subcommands([](CLI::App*) { return true; })) {
+      if (s->check_name(a)) next = s;
+      names += (names.empty() ? "" : ", ") + s->get_name();
+    }
+    if (!next)
+      throw CLI::ParseError("unknown " + path + "subcommand (" + a + "); one of: " + names,
+                            CLI::ExitCodes::ExtrasError);
+    path += next->get_name() + " ";
+    cur = next;
+  }
+}
+
+}  // namespace
+
 }  // namespace gs::cli
 
 int main(int argc, char** argv) {
@@ -35,6 +60,7 @@ int main(int argc, char** argv) {
   gs::cli::register_analyze_contacts(app);
   gs::cli::register_analyze_hhd(app);
   try {
+    gs::cli::check_subcommand_names(app, argc, argv);
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     // --help and --version print as CLI11 prints them; a usage error is one line, the rule of

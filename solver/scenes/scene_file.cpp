@@ -546,7 +546,11 @@ Scene load_scene(const std::filesystem::path& path) {
     r.fail("solver.damping", "outside [0, 1)", value_str(s.config.damping));
   s.config.gravity = r.vec3(sol, "solver", "gravity_m_s2", false, Eigen::Vector3d::Zero());
   s.steps = r.integer(sol, "solver", "steps", s.test.empty(), 0, 0);
-  s.config.threads = static_cast<int>(r.integer(sol, "solver", "threads", false, 1, 1));
+  const std::int64_t threads = r.integer(sol, "solver", "threads", false, 1, 1);
+  if (threads > kMaxThreads)
+    r.fail("solver.threads", "must be at most " + std::to_string(kMaxThreads),
+           std::to_string(threads));
+  s.config.threads = static_cast<int>(threads);
   s.config.skin = r.number(sol, "solver", "skin_m", false, 0);
   s.config.max_overlap_ratio = r.positive(sol, "solver", "max_overlap_ratio", false, 0.1);
   s.config.max_energy_residual = r.positive(sol, "solver", "max_energy_residual", false, 0.2);

@@ -22,6 +22,9 @@
 
 namespace gs::solver {
 
+/// The most threads a scene or `simulate --threads` may ask for (a million crashed the run).
+inline constexpr int kMaxThreads = 1024;
+
 struct OutputSpec {
   std::string trajectory = "trajectory.h5";
   std::int64_t every = 1000;            // steps between trajectory frames

@@ -406,3 +406,61 @@ TEST(HostileInputs, NonIntegralIdsStayRejected) {
   };
   expect_hostile_rejected(dir, cases);
 }
+
+// The CLI: a thread count of a million crashed `simulate` (SIGSEGV), from the command line or
+// the scene; --threads -1 was taken by `dic`; CLI11's range errors printed a 309-digit bound; a
+// mistyped subcommand was "A subcommand is required"; libpng printed its own line before ours and
+// a 250 kB PNG claiming 16 000 x 16 000 pixels took 4.3 GB.
+TEST(HostileInputs, CliThreadsSubcommandsAndImages) {
+  gs::test::ScratchDir dir("hostile_cli");
+  const auto log = dir / "log";
+  std::filesystem::create_directories(log);
+  const std::string scenes = std::string(GS_TEST_DATA_DIR) + "/scenes/";
+  std::filesystem::copy_file(scenes + "drop_packing.csv", dir / "drop_packing.csv");
+  std::string scene = slurp(scenes + "drop.toml");
+  scene.replace(scene.find("threads = 1"), 11, "threads = 1000000");
+  spit(dir / "drop.toml", scene);
+  const auto out = dir / "out";
+  struct Case {
+    std::string args, err;
+  };
+  const std::string png = (dir / "big.png").string(), crc = (dir / "crc.png").string();
+  // Signature and IHDR only: 16 000 x 16 000, and 64 x 64 with a wrong CRC.
+  spit(dir / "big.png",
+       std::string(
+           "\x89PNG\r\n\x1a\n\0\0\0\x0dIHDR\0\0\x3e\x80\0\0\x3e\x80\x08\0\0\0\0\xde\xad\xbe\xef",
+           33));
+  spit(dir / "crc.png",
+       std::string(
+           "\x89PNG\r\n\x1a\n\0\0\0\x0dIHDR\0\0\0\x40\0\0\0\x40\x08\0\0\0\0\xde\xad\xbe\xef", 33));
+  const std::vector<Case> cases = {
+      {"simulate " + (dir / "drop.toml").string() + " -o " + out.string(),
+       (dir / "drop.toml").string() + ": solver.threads: must be at most 1024 (1000000)"},
+      {"simulate " + scenes + "drop.toml -o " + out.string() + " --threads 1000000",
+       "--threads: Value 1000000 not in range 1 to 1024"},
+      {"simulate " + scenes + "drop.toml -o " + out.string() + " --threads -1",
+       "--threads: Value -1 not in range 1 to 1024"},
+      {"simulate " + scenes + "drop.toml -o " + out.string() + " --steps -1",
+       "--steps: Value -1 not in range 0 to 9223372036854775807"},
+      {"dic " + crc + " " + crc + " -o " + (dir / "d.h5").string() + " --threads -1",
+       "--threads: Value -1 not in range 0 to 1024"},
+      {"frobnicate",
+       "unknown subcommand (frobnicate); one of: info, convert, figures, simulate, surface, "
+       "render, dic, analyze"},
+      {"analyze frob",
+       "unknown analyze subcommand (frob); one of: strain, voidcells, rev, shearzone, invariants, "
+       "fabric, rose, chains, walls, hhd, vortices"},
+      {"dic " + png + " " + png + " -o " + (dir / "d.h5").string(),
+       png + ": image too large (16000 x 16000 pixels, at most 100000000)"},
+      {"dic " + crc + " " + crc + " -o " + (dir / "d.h5").string(),
+       crc + ": cannot decode image (libpng error: IHDR: CRC error)"},
+  };
+  for (const auto& c : cases) {
+    const auto r = gs::test::run_cli(c.args, log);
+    EXPECT_EQ(r.rc, 2) << c.args;
+    EXPECT_EQ(r.err, "error: " + c.err + "\n") << c.args;
+    EXPECT_EQ(r.out, "");
+    EXPECT_FALSE(std::filesystem::exists(out));
+    EXPECT_FALSE(std::filesystem::exists(dir / "d.h5"));
+  }
+}
