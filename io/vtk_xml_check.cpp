@@ -285,7 +285,14 @@ class Checker {
              attr(t, "NumberOfComponents"));
       comps = *c;
     }
-    const std::size_t ts = type_size(attr(t, "type"));
+    // VTK dereferences the array it failed to create for an unknown type (SIGSEGV).
+    static const char* known[] = {"Int8",   "UInt8", "Int16",  "UInt16",  "Int32",
+                                  "UInt32", "Int64", "UInt64", "Float32", "Float64",
+                                  "String", "Bit",   "IdType", "Char"};
+    const std::string type = attr(t, "type");
+    if (std::find(std::begin(known), std::end(known), type) == std::end(known))
+      fail(label + " has an unknown type", type.empty() ? "none" : type);
+    const std::size_t ts = type_size(type);
     const auto tuples = expected_tuples(t, parent);
     std::optional<std::uint64_t> values;
     if (tuples && ts > 0) values = *tuples * comps;

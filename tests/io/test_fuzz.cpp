@@ -243,6 +243,13 @@ TEST(HostileInputs, BinaryVtuWithFewerPointsDeclaredThanStored) {
   ASSERT_EQ(read_snapshots(kData / "yade/yade_spheres.20000.vtu").frames.at(0).particles.size(),
             40u);
   write_snapshots(dir / "ours.vtu", read_snapshots(kData / "yade/yade_spheres.20000.vtu"));
+  const std::string ours = slurp(dir / "ours.vtu");
+  auto edit = [](std::string s, const std::string& from, const std::string& to) {
+    const auto k = s.find(from);
+    EXPECT_NE(k, std::string::npos) << from;
+    if (k != std::string::npos) s.replace(k, from.size(), to);
+    return s;
+  };
   auto cut_to_39 = [](std::string s) {
     const auto k = s.find("NumberOfPoints=\"40\"");
     EXPECT_NE(k, std::string::npos);
@@ -255,6 +262,16 @@ TEST(HostileInputs, BinaryVtuWithFewerPointsDeclaredThanStored) {
        "312)"},
       {"ours39.vtu", cut_to_39(slurp(dir / "ours.vtu")),
        "DataArray id holds a different number of bytes than declared (320 bytes, expected 312)"},
+      // Mutants of the fuzz run that crashed VTK (SIGSEGV).
+      {"type.vtu",
+       edit(ours, "type=\"Float64\" Name=\"domain_hi\"", "type=\"Float10.5\" Name=\"domain_hi\""),
+       "DataArray domain_hi has an unknown type (Float10.5)"},
+      {"tuples.vtu",
+       edit(ours, "Name=\"domain_lo\" NumberOfComponents=\"3\" NumberOfTuples=\"1\"",
+            "Name=\"domain_lo\" NumberOfComponents=\"3\" NumberOfTuples=\"-1\""),
+       "DataArray domain_lo NumberOfTuples is not a count the file can hold (-1)"},
+      {"offset.vtu", edit(ours, "offset=\"0\"", "offset=\"1e30\""),
+       "DataArray TimeValue offset is not a non-negative integer (1e30)"},
   };
   expect_hostile_rejected(dir, cases);
 }
