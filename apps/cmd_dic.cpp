@@ -82,13 +82,17 @@ void run_dic(const DicArgs& a) {
   opt.strain_window_radius = a.strain_window / 2;
   opt.incremental = a.incremental;
 
-  if (!roi.empty()) {
-    try {
-      (void)dic::make_grid(images[0].rows, images[0].cols, radius, a.step, roi);
-    } catch (const std::invalid_argument& e) {
-      throw InputError(a.roi, e.what());
-    }
+  dic::PoiGrid grid;
+  try {
+    grid = dic::make_grid(images[0].rows, images[0].cols, radius, a.step, roi);
+  } catch (const std::invalid_argument& e) {
+    throw InputError(a.roi.empty() ? a.images[0] : a.roi, e.what());
   }
+  // A plane-fit window wider than the grid fits nothing: every strain would be NaN.
+  if (a.strain_window > std::min(grid.nx, grid.ny))
+    throw InputError("--strain-window", "larger than the POI grid",
+                     std::to_string(a.strain_window) + " POIs; grid " + std::to_string(grid.nx) +
+                         " x " + std::to_string(grid.ny));
   dic::SequenceResult result;
   try {
     result = dic::correlate_sequence(images, roi, opt);

@@ -481,3 +481,76 @@ TEST(HostileInputs, CliThreadsSubcommandsAndImages) {
     EXPECT_FALSE(std::filesystem::exists(dir / "d.h5"));
   }
 }
+
+// Wrong results without a word: two particles at one centre simulated with no contact; strain
+// of coordinates scaled by 1e150 or 1e-300 came out as zero gradients, exit 0; an interpreter
+// named by GRANOSCOPE_PYTHON that does not exist was passed over for another.
+TEST(HostileInputs, CoincidentCentresUnrepresentableScalesAndMissingInterpreter) {
+  gs::test::ScratchDir dir("hostile_results");
+  const auto log = dir / "log";
+  std::filesystem::create_directories(log);
+  const std::string scenes = std::string(GS_TEST_DATA_DIR) + "/scenes/";
+  std::string packing = slurp(scenes + "drop_packing.csv");
+  {  // particle 1 moved onto particle 0
+    const auto l1 = packing.find('\n') + 1, l2 = packing.find('\n', l1) + 1;
+    const auto l3 = packing.find('\n', l2) + 1;
+    const std::string row0 = packing.substr(l1, l2 - l1), row1 = packing.substr(l2, l3 - l2);
+    const std::string xyz0 = row0.substr(row0.find(','), row0.rfind(',') - row0.find(','));
+    const std::string moved = row1.substr(0, row1.find(',')) + xyz0 + row1.substr(row1.rfind(','));
+    packing.replace(l2, l3 - l2, moved);
+    spit(dir / "drop_packing.csv", packing);
+    std::filesystem::copy_file(scenes + "drop.toml", dir / "drop.toml");
+    const std::string xyz = xyz0.substr(1);
+    std::string shown;
+    for (char c : xyz) shown += c == ',' ? std::string(", ") : std::string(1, c);
+    const auto r = gs::test::run_cli(
+        "simulate " + (dir / "drop.toml").string() + " -o " + (dir / "run").string(), log);
+    EXPECT_EQ(r.rc, 2);
+    EXPECT_EQ(r.err, "error: " + (dir / "drop.toml").string() +
+                         ": particles: particles 0 and 1 have the same centre (" + shown + ")\n");
+    EXPECT_FALSE(std::filesystem::exists(dir / "run"));
+  }
+  for (const double scale : {1e150, 1e-300}) {
+    Trajectory t;
+    t.frames = {gs::test::random_frame(40, 0, 3, 0.0), gs::test::random_frame(40, 0, 3, 1.0)};
+    for (auto& f : t.frames) {
+      f.walls.clear();
+      f.domain.periodic = false;
+      for (auto& p : f.particles) {
+        p.position *= scale;
+        p.radius *= scale;
+      }
+      f.domain.lo *= scale;
+      f.domain.hi *= scale;
+    }
+    for (auto& p : t.frames[1].particles) p.position *= 1.01;
+    const auto in = dir / "scaled.h5";
+    std::filesystem::remove(in);
+    write_snapshots(in, t);
+    const auto r = gs::test::run_cli(
+        "analyze strain " + in.string() + " --from 0 --to 1 -o " + (dir / "st.h5").string(), log);
+    EXPECT_EQ(r.rc, 2) << r.err;
+    EXPECT_EQ(r.err.rfind("error: " + in.string() +
+                              ": particle positions span a length the geometry cannot handle (",
+                          0),
+              0u)
+        << r.err;
+    EXPECT_NE(r.err.find(" m; 1e-90 to 1e90)\n"), std::string::npos) << r.err;
+    EXPECT_FALSE(std::filesystem::exists(dir / "st.h5"));
+  }
+  write_snapshots(dir / "run.h5", [] {
+    Trajectory t;
+    t.frames = {gs::test::random_frame(5, 0, 1, 0.0)};
+    t.frames[0].walls.clear();
+    return t;
+  }());
+  const std::string cmd = "GRANOSCOPE_PYTHON=/nonexistent/python3 " + gs::test::kGranoscope +
+                          " figures " + (dir / "run.h5").string() + " -o " +
+                          (dir / "figs2").string() + " >" + (log / "o").string() + " 2>" +
+                          (log / "e").string();
+  const int status = std::system(cmd.c_str());
+  EXPECT_EQ(WEXITSTATUS(status), 2);
+  EXPECT_EQ(gs::test::slurp(log / "e"),
+            "error: GRANOSCOPE_PYTHON: no such interpreter (/nonexistent/python3)\n");
+  EXPECT_FALSE(std::filesystem::exists(dir / "figs2"));
+}
