@@ -431,6 +431,7 @@ namespace {
 // Two spheres at one centre have no contact normal: the engine skips the pair and they pass
 // through each other without a word. (Members of one clump may share a centre.)
 void check_distinct_centres(const Reader& r, const std::vector<Particle>& particles) {
+  // Members of one clump may share a centre.
   std::map<std::array<double, 3>, const Particle*> at;
   for (const auto& p : particles) {
     const auto [it, fresh] =
@@ -747,7 +748,9 @@ Scene load_scene(const std::filesystem::path& path) {
   }
   if (!s.open_after_fill.empty() && !s.fill)
     r.fail("[[mesh]].off_after_fill", "there is no [fill] section");
-  check_distinct_centres(r, s.particles);
+  // (The particles of a [fill] are placed later, layer by layer.)
+  check_distinct_centres(
+      r, {s.particles.begin(), s.particles.begin() + (s.fill ? s.fill_first : s.particles.size())});
   std::ostringstream flat;
   flat << root;
   s.parameters.emplace_back("scene.toml", flat.str());
