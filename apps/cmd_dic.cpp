@@ -4,6 +4,7 @@
 #include <CLI/CLI.hpp>
 #include <iostream>
 #include <opencv2/imgcodecs.hpp>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -111,18 +112,25 @@ void run_dic(const DicArgs& a) {
   info.image_rows = images[0].rows;
   info.image_cols = images[0].cols;
   const std::filesystem::path out(a.output);
-  dic::write_dic_hdf5(out, result, info);
-  for (std::size_t k = 0; k < result.frames.size(); ++k) {
-    char suffix[32];
-    std::snprintf(suffix, sizeof suffix, "_%04zu", k + 1);
-    const auto base = out.parent_path() / (out.stem().string() + suffix);
-    if (!a.no_csv) dic::write_dic_csv(base.string() + ".csv", result, k, info);
-    if (!a.no_vtk) dic::write_dic_vti(base.string() + ".vti", result, k, info);
-    std::size_t nvalid = 0;
-    for (const auto v : result.frames[k].valid) nvalid += v;
-    std::cout << a.images[k + 1] << ": " << nvalid << "/" << result.frames[k].valid.size()
-              << " valid POIs\n";
-  }
+  // The HDF5, CSV and VTI files appear together or not at all.
+  StagingDir staging(out.has_parent_path() ? out.parent_path() : std::filesystem::path("."));
+  std::ostringstream report;  // printed once everything is in place
+  staging.write([&] {
+    dic::write_dic_hdf5(staging / out.filename(), result, info);
+    for (std::size_t k = 0; k < result.frames.size(); ++k) {
+      char suffix[32];
+      std::snprintf(suffix, sizeof suffix, "_%04zu", k + 1);
+      const auto base = staging / (out.stem().string() + suffix);
+      if (!a.no_csv) dic::write_dic_csv(base.string() + ".csv", result, k, info);
+      if (!a.no_vtk) dic::write_dic_vti(base.string() + ".vti", result, k, info);
+      std::size_t nvalid = 0;
+      for (const auto v : result.frames[k].valid) nvalid += v;
+      report << a.images[k + 1] << ": " << nvalid << "/" << result.frames[k].valid.size()
+             << " valid POIs\n";
+    }
+  });
+  staging.commit();
+  std::cout << report.str();
   std::cout << "wrote " << out.string() << " (subset " << a.subset << " px, step " << a.step
             << " px, VSG " << info.vsg_px << " px)\n";
 }
@@ -165,24 +173,23 @@ void run_render(const RenderArgs& a) {
   ro.seed = a.seed;
   std::vector<dic::GroundTruth> truth;
   const double full = a.bits == 8 ? 255.0 : 65535.0;
-  for (std::size_t k = 0; k < reader.frame_count(); ++k) {
-    const Frame f = k == 0 ? ref : reader.frame(k);
-    const cv::Mat img = dic::render_frame(f, cam, ro);
-    cv::Mat q;
-    img.convertTo(q, a.bits == 8 ? CV_8U : CV_16U, full / 255.0);  // rounds and saturates
-    char name[64];
-    std::snprintf(name, sizeof name, "frame_%04zu.%s", k, a.format.c_str());
-    const std::filesystem::path target = std::filesystem::path(a.out_dir) / name;
-    AtomicOutput out(target);
-    const std::string tmp =
-        out.temp_path().string() + "." + a.format;  // imwrite needs the extension
-    if (!cv::imwrite(tmp, q)) throw InputError(target.string(), "cannot write image");
-    std::filesystem::rename(tmp, out.temp_path());
-    out.commit();
-    truth.push_back(dic::ground_truth(ref, f, cam));
-  }
-  dic::write_ground_truth_hdf5(std::filesystem::path(a.out_dir) / "ground_truth.h5", cam, a.view,
-                               truth);
+  StagingDir staging(a.out_dir);
+  staging.write([&] {
+    for (std::size_t k = 0; k < reader.frame_count(); ++k) {
+      const Frame f = k == 0 ? ref : reader.frame(k);
+      const cv::Mat img = dic::render_frame(f, cam, ro);
+      cv::Mat q;
+      img.convertTo(q, a.bits == 8 ? CV_8U : CV_16U, full / 255.0);  // rounds and saturates
+      char name[64];
+      std::snprintf(name, sizeof name, "frame_%04zu.%s", k, a.format.c_str());
+      const std::filesystem::path target = std::filesystem::path(a.out_dir) / name;
+      const std::filesystem::path staged = staging / name;  // imwrite needs the extension
+      dic::write_image(staged, q, target.string());
+      truth.push_back(dic::ground_truth(ref, f, cam));
+    }
+    dic::write_ground_truth_hdf5(staging / "ground_truth.h5", cam, a.view, truth);
+  });
+  staging.commit();  // the frames and their ground truth appear together or not at all
   std::cout << "rendered " << reader.frame_count() << " frames " << cam.cols << "x" << cam.rows
             << " px (" << a.px_per_d50 << " px per d50) to " << a.out_dir << "\n";
 }

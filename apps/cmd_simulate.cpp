@@ -76,9 +76,8 @@ class CsvOutput {
   void finish() {
     if (!out_.is_open()) return;
     out_.close();
-    std::error_code ec;
-    fs::rename(partial_, path_, ec);
-    if (ec) throw InputError(path_.string(), "cannot rename output into place", ec.message());
+    if (out_.fail()) throw InputError(partial_.string(), "cannot write output");
+    rename_durably(partial_, path_);
   }
   const fs::path& path() const { return path_; }
 

@@ -1,4 +1,6 @@
 // granoscope command-line interface. Each module registers its subcommands (apps/commands.hpp).
+#include <hdf5.h>
+
 #include <CLI/CLI.hpp>
 #include <exception>
 #include <iostream>
@@ -45,6 +47,10 @@ void check_subcommand_names(CLI::App& app, int argc, char** argv) {
 }  // namespace gs::cli
 
 int main(int argc, char** argv) {
+  // A file HDF5 could not close (a full disk) is closed again by HDF5's own exit handler, which
+  // then crashes (SIGSEGV after our error line): every file is closed by its owner, so HDF5 gets
+  // no exit handler.
+  H5dont_atexit();
   CLI::App app{"granoscope: DEM simulation and analysis of granular materials"};
   app.set_version_flag("--version", gs::code_version());
   app.require_subcommand(1);

@@ -113,4 +113,21 @@ cv::Mat read_grey_image(const std::filesystem::path& path) {
   return out;
 }
 
+void write_image(const std::filesystem::path& path, const cv::Mat& image, const std::string& name) {
+  std::string said;
+  bool written = false;
+  {
+    CapturedStderr capture;
+    try {
+      written = cv::imwrite(path.string(), image);
+    } catch (const cv::Exception& e) {
+      said = capture.first_line();
+      throw InputError(name, "cannot write image",
+                       said.empty() ? std::string(e.err.substr(0, 120)) : said);
+    }
+    said = capture.first_line();
+  }
+  if (!written) throw InputError(name, "cannot write image", said);
+}
+
 }  // namespace gs::dic

@@ -1,9 +1,13 @@
 #include "atomic_file.hpp"
 
+#include <fcntl.h>
 #include <unistd.h>
 
 #include <atomic>
+#include <cerrno>
+#include <cstring>
 #include <system_error>
+#include <vector>
 
 #include "errors.hpp"
 
@@ -11,6 +15,26 @@ namespace gs {
 
 namespace {
 std::atomic<unsigned> g_counter{0};
+}
+
+void sync_to_disk(const std::filesystem::path& path) {
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) throw InputError(path.string(), "cannot open to sync to disk", std::strerror(errno));
+  const int rc = ::fsync(fd);
+  const int err = errno;
+  ::close(fd);
+  // A directory on a filesystem that cannot sync directories (EINVAL) is not an error.
+  if (rc != 0 && !(err == EINVAL && std::filesystem::is_directory(path)))
+    throw InputError(path.string(), "cannot write output to disk", std::strerror(err));
+}
+
+void rename_durably(const std::filesystem::path& from, const std::filesystem::path& to) {
+  sync_to_disk(from);
+  std::error_code ec;
+  std::filesystem::rename(from, to, ec);
+  if (ec) throw InputError(to.string(), "cannot rename output into place", ec.message());
+  const auto parent = to.has_parent_path() ? to.parent_path() : std::filesystem::path(".");
+  sync_to_disk(parent);
 }
 
 AtomicOutput::AtomicOutput(std::filesystem::path target) : target_(std::move(target)) {
@@ -31,9 +55,46 @@ AtomicOutput::~AtomicOutput() {
 }
 
 void AtomicOutput::commit() {
+  rename_durably(temp_, target_);
+  committed_ = true;
+}
+
+StagingDir::StagingDir(std::filesystem::path dir) : dir_(std::move(dir)) {
   std::error_code ec;
-  std::filesystem::rename(temp_, target_, ec);
-  if (ec) throw InputError(target_.string(), "cannot rename output into place", ec.message());
+  if (!std::filesystem::is_directory(dir_, ec))
+    throw InputError(dir_.string(), "output directory does not exist");
+  staging_ = dir_ / (".staging-" + std::to_string(::getpid()) + "-" + std::to_string(g_counter++));
+  std::filesystem::create_directory(staging_, ec);
+  if (ec) throw InputError(staging_.string(), "cannot create directory", ec.message());
+}
+
+StagingDir::~StagingDir() {
+  std::error_code ec;
+  std::filesystem::remove_all(staging_, ec);
+}
+
+InputError StagingDir::renamed(const InputError& e) const {
+  std::string m = e.what();
+  const std::string from = staging_.string() + "/", to = dir_.string() + "/";
+  for (auto k = m.find(from); k != std::string::npos; k = m.find(from, k + to.size()))
+    m.replace(k, from.size(), to);
+  const auto colon = m.find(": ");
+  if (colon == std::string::npos) return InputError(dir_.string(), m);
+  return InputError(m.substr(0, colon), m.substr(colon + 2));
+}
+
+void StagingDir::commit() {
+  std::vector<std::filesystem::path> files;
+  for (const auto& e : std::filesystem::directory_iterator(staging_)) files.push_back(e.path());
+  for (const auto& f : files) {
+    sync_to_disk(f);
+    std::error_code ec;
+    std::filesystem::rename(f, dir_ / f.filename(), ec);
+    if (ec)
+      throw InputError((dir_ / f.filename()).string(), "cannot rename output into place",
+                       ec.message());
+  }
+  sync_to_disk(dir_);
   committed_ = true;
 }
 

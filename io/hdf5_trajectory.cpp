@@ -10,6 +10,7 @@
 #include <system_error>
 #include <vector>
 
+#include "atomic_file.hpp"
 #include "errors.hpp"
 
 namespace gs {
@@ -826,10 +827,7 @@ std::size_t TrajectoryWriter::frames_written() const {
 
 void TrajectoryWriter::finish() {
   impl_->close();
-  std::error_code ec;
-  std::filesystem::rename(impl_->file_path, impl_->final_path, ec);
-  if (ec)
-    throw InputError(impl_->final_path.string(), "cannot rename output into place", ec.message());
+  rename_durably(impl_->file_path, impl_->final_path);
   impl_->finished = true;
 }
 

@@ -554,3 +554,40 @@ TEST(HostileInputs, CoincidentCentresUnrepresentableScalesAndMissingInterpreter)
             "error: GRANOSCOPE_PYTHON: no such interpreter (/nonexistent/python3)\n");
   EXPECT_FALSE(std::filesystem::exists(dir / "figs2"));
 }
+
+// Partial outputs after errors (issue 15): with writes failing as on a full disk (a 4 kB file
+// size limit, SIGXFSZ ignored: EFBIG), `convert` to .pvd / .vtu / .h5 and `render` give one line
+// and exit 2, and leave nothing under a final name (a .pvd and its _files/ were left, after 89
+// lines of VTK's own diagnostics).
+TEST(HostileInputs, FailedWritesLeaveNoOutputAndOneLine) {
+  gs::test::ScratchDir dir("hostile_full");
+  const auto log = dir / "log";
+  std::filesystem::create_directories(log);
+  Trajectory t;
+  for (unsigned k = 0; k < 4; ++k) t.frames.push_back(gs::test::random_frame(200, 100, k, k));
+  for (auto& f : t.frames) f.walls.clear();
+  write_snapshots(dir / "in.h5", t);
+  write_snapshots(dir / "packing.h5", read_snapshots(kData / "packing_small.csv"));
+  const auto out = dir / "out";
+  for (const std::string& args :
+       {"convert " + (dir / "in.h5").string() + " " + (out / "x.pvd").string(),
+        "convert " + (dir / "in.h5").string() + " " + (out / "x.vtu").string(),
+        "convert " + (dir / "in.h5").string() + " " + (out / "x.h5").string(),
+        "render " + (dir / "packing.h5").string() + " -o " + (out / "r").string()}) {
+    std::filesystem::remove_all(out);
+    std::filesystem::create_directories(out);
+    const std::string cmd = "bash -c \"trap '' XFSZ; ulimit -f 4; " + gs::test::kGranoscope + " " +
+                            args + "\" >" + (log / "o").string() + " 2>" + (log / "e").string();
+    const int status = std::system(cmd.c_str());
+    ASSERT_TRUE(WIFEXITED(status)) << args;
+    EXPECT_EQ(WEXITSTATUS(status), 2) << args;
+    const std::string err = gs::test::slurp(log / "e");
+    EXPECT_EQ(err.rfind("error: " + out.string() + "/", 0), 0u) << err;
+    EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
+    EXPECT_EQ(gs::test::slurp(log / "o"), "");
+    std::vector<std::string> left;
+    for (const auto& e : std::filesystem::recursive_directory_iterator(out))
+      if (!e.is_directory()) left.push_back(e.path().string());
+    EXPECT_TRUE(left.empty()) << args << ": " << (left.empty() ? "" : left.front());
+  }
+}
