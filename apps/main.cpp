@@ -6,6 +6,7 @@
 #include <iostream>
 #include <string>
 
+#include "atomic_file.hpp"
 #include "commands.hpp"
 #include "snapshot.hpp"
 
@@ -51,6 +52,7 @@ int main(int argc, char** argv) {
   // then crashes (SIGSEGV after our error line): every file is closed by its owner, so HDF5 gets
   // no exit handler.
   H5dont_atexit();
+  const gs::InputScope inputs;  // no output of this command may replace one of its inputs
   CLI::App app{"granoscope: DEM simulation and analysis of granular materials"};
   app.set_version_flag("--version", gs::code_version());
   app.require_subcommand(1);

@@ -10,6 +10,7 @@
 #include <opencv2/imgproc.hpp>
 #include <string>
 
+#include "atomic_file.hpp"
 #include "errors.hpp"
 
 namespace gs::dic {
@@ -88,6 +89,7 @@ cv::Mat read_grey_image(const std::filesystem::path& path) {
   if (!std::filesystem::is_regular_file(path, ec))
     throw InputError(path.string(), "no such image file");
   check_png_size(path);
+  note_input(path);
   cv::Mat raw;
   std::string said;
   {

@@ -1,11 +1,14 @@
 #include "atomic_file.hpp"
 
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <atomic>
 #include <cerrno>
 #include <cstring>
+#include <mutex>
+#include <set>
 #include <system_error>
 #include <vector>
 
@@ -15,6 +18,37 @@ namespace gs {
 
 namespace {
 std::atomic<unsigned> g_counter{0};
+
+std::mutex g_inputs_mutex;
+std::set<std::pair<dev_t, ino_t>> g_inputs;  // (device, inode) of every input read
+
+int g_scopes = 0;
+
+}  // namespace
+
+InputScope::InputScope() {
+  const std::lock_guard<std::mutex> lock(g_inputs_mutex);
+  ++g_scopes;
+}
+
+InputScope::~InputScope() {
+  const std::lock_guard<std::mutex> lock(g_inputs_mutex);
+  if (--g_scopes == 0) g_inputs.clear();
+}
+
+void note_input(const std::filesystem::path& path) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0) return;
+  const std::lock_guard<std::mutex> lock(g_inputs_mutex);
+  if (g_scopes > 0) g_inputs.emplace(st.st_dev, st.st_ino);
+}
+
+void check_not_an_input(const std::filesystem::path& target) {
+  struct stat st {};
+  if (::stat(target.c_str(), &st) != 0) return;
+  const std::lock_guard<std::mutex> lock(g_inputs_mutex);
+  if (g_inputs.count({st.st_dev, st.st_ino}))
+    throw InputError(target.string(), "output would replace an input");
 }
 
 void sync_to_disk(const std::filesystem::path& path) {
@@ -29,6 +63,7 @@ void sync_to_disk(const std::filesystem::path& path) {
 }
 
 void rename_durably(const std::filesystem::path& from, const std::filesystem::path& to) {
+  check_not_an_input(to);
   sync_to_disk(from);
   std::error_code ec;
   std::filesystem::rename(from, to, ec);
@@ -43,6 +78,7 @@ AtomicOutput::AtomicOutput(std::filesystem::path target) : target_(std::move(tar
   std::error_code ec;
   if (!std::filesystem::is_directory(parent, ec))
     throw InputError(target_.string(), "output directory does not exist", parent.string());
+  check_not_an_input(target_);
   temp_ = target_;
   temp_ += ".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(g_counter++);
 }

@@ -9,6 +9,20 @@
 
 namespace gs {
 
+/// While one is alive (the CLI holds one for the whole command), every input the readers open is
+/// recorded, and no output may replace one, through any name (symbolic or hard links included).
+class InputScope {
+ public:
+  InputScope();
+  InputScope(const InputScope&) = delete;
+  InputScope& operator=(const InputScope&) = delete;
+  ~InputScope();
+};
+/// Records `path` as an input when an InputScope is alive (readers call it).
+void note_input(const std::filesystem::path& path);
+/// Throws InputError "TARGET: output would replace an input" when `target` is a noted input.
+void check_not_an_input(const std::filesystem::path& target);
+
 /// fsync of a file or directory; throws InputError naming it (a full disk shows here).
 void sync_to_disk(const std::filesystem::path& path);
 /// sync_to_disk(from), rename onto `to`, sync the directory of `to`.

@@ -702,6 +702,7 @@ TrajectoryWriter::TrajectoryWriter(std::filesystem::path path, const RunMetadata
                                    Options options)
     : impl_(std::make_unique<Impl>()) {
   impl_->final_path = std::move(path);
+  check_not_an_input(impl_->final_path);
   impl_->file_path = partial_path(impl_->final_path);
   impl_->options = options;
   try {
@@ -886,6 +887,7 @@ struct TrajectoryReader::Impl {
           Hid(H5Fopen(file_name.c_str(), H5F_ACC_RDONLY | H5F_ACC_SWMR_READ, fapl.get()), H5Fclose);
     }
     if (!file.valid()) throw InputError(file_name, "cannot open HDF5 file (corrupt or truncated)");
+    note_input(path);
 
     // Root attributes.
     auto attr_string = [&](const char* nm) {

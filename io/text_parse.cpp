@@ -6,6 +6,7 @@
 #include <fstream>
 #include <system_error>
 
+#include "atomic_file.hpp"
 #include "errors.hpp"
 
 namespace gs::text {
@@ -20,6 +21,7 @@ std::string read_file_bytes(const std::filesystem::path& path, std::size_t max_b
   if (size > max_bytes) throw InputError(name, "file too large", std::to_string(size) + " bytes");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(name, "cannot open file");
+  note_input(path);
   std::string s(size, '\0');
   in.read(s.data(), static_cast<std::streamsize>(size));
   if (static_cast<std::size_t>(in.gcount()) != size) throw InputError(name, "short read");

@@ -19,6 +19,7 @@
 #include <limits>
 #include <regex>
 
+#include "atomic_file.hpp"
 #include "errors.hpp"
 #include "text_parse.hpp"
 #include "vtk_io.hpp"
@@ -49,6 +50,7 @@ void run_reader(Reader* r, const std::filesystem::path& path) {
   if (!std::filesystem::exists(path, ec)) throw InputError(name, "no such file");
   if (!std::filesystem::is_regular_file(path, ec)) throw InputError(name, "not a regular file");
   check_vtk_xml_structure(path);  // what VTK would trust: counts, sizes, nesting
+  note_input(path);
   ErrorSink sink;
   vtkNew<vtkCallbackCommand> cb;
   cb->SetCallback(&ErrorSink::on_error);

@@ -445,6 +445,34 @@ void check_distinct_centres(const Reader& r, const std::vector<Particle>& partic
                value_str(p.position.z()));
   }
 }
+
+// Outputs stay inside the output directory, and none replaces another: each is a plain file
+// name (no directory part, no "..", not empty), all distinct, and none is the checkpoint index.
+// Checked before anything runs (a clash used to show only after the whole run; an absolute
+// trajectory path replaced a file anywhere on disk).
+void check_output_names(const Reader& r, const Scene& s) {
+  auto plain = [&](const std::string& key, const std::string& v) {
+    if (v.empty()) r.fail(key, "must not be empty");
+    if (v.find('/') != std::string::npos || v.find('\\') != std::string::npos || v == "." ||
+        v == ".." || v.find('\0') != std::string::npos)
+      r.fail(key, "must be a file name inside the output directory (no directory part)", v);
+  };
+  plain("scene.name", s.name);
+  const std::vector<std::pair<std::string, std::string>> outs = {
+      {"output.trajectory", s.output.trajectory},
+      {"output.history", s.output.history},
+      {"output.curve", s.output.curve},
+      {"output.specimen", s.output.specimen},
+      {"output.preparation", s.output.preparation},
+      {"(checkpoint index)", "checkpoint.txt"}};
+  for (std::size_t i = 0; i < outs.size(); ++i) {
+    if (i + 1 < outs.size()) plain(outs[i].first, outs[i].second);
+    for (std::size_t j = 0; j < i; ++j)
+      if (outs[i].second == outs[j].second)
+        r.fail(outs[i].first, "names the same file as " + outs[j].first, outs[i].second);
+  }
+}
+
 }  // namespace
 
 Scene load_scene(const std::filesystem::path& path) {
@@ -592,6 +620,7 @@ Scene load_scene(const std::filesystem::path& path) {
   s.output.curve_every = r.integer(out, "output", "curve_every", false, s.output.curve_every, 1);
   s.output.specimen = r.string(out, "output", "specimen", false, s.output.specimen);
   s.output.preparation = r.string(out, "output", "preparation", false, s.output.preparation);
+  check_output_names(r, s);
   if (out && out->contains("facet_forces")) {
     const auto* v = (*out)["facet_forces"].as_boolean();
     if (!v) r.fail("output.facet_forces", "expected true or false");

@@ -591,3 +591,74 @@ TEST(HostileInputs, FailedWritesLeaveNoOutputAndOneLine) {
     EXPECT_TRUE(left.empty()) << args << ": " << (left.empty() ? "" : left.front());
   }
 }
+
+// Outputs that escape or clobber (issue 15): a scene's output names with a directory part (an
+// absolute trajectory path replaced a file anywhere on disk), empty or clashing names (found only
+// after the whole run), and an output naming an input, directly or through a link (`analyze rev
+// in.h5 -o in.h5` overwrote its input).
+TEST(HostileInputs, OutputsStayInTheirDirectoryAndNeverReplaceAnInput) {
+  gs::test::ScratchDir dir("hostile_outputs");
+  const auto log = dir / "log";
+  std::filesystem::create_directories(log);
+  const std::string scenes = std::string(GS_TEST_DATA_DIR) + "/scenes/";
+  std::filesystem::copy_file(scenes + "drop_packing.csv", dir / "drop_packing.csv");
+  const std::string scene = slurp(scenes + "drop.toml");
+  const auto victim = dir / "victim.h5";
+  spit(victim, "precious");
+  const std::string out = (dir / "out").string();
+  struct Case {
+    std::string from, to, err;
+  };
+  const std::vector<Case> cases = {
+      {"trajectory = \"drop.h5\"", "trajectory = \"" + victim.string() + "\"",
+       "output.trajectory: must be a file name inside the output directory (no directory part) (" +
+           victim.string() + ")"},
+      {"trajectory = \"drop.h5\"", "trajectory = \"../victim.h5\"",
+       "output.trajectory: must be a file name inside the output directory (no directory part) "
+       "(../victim.h5)"},
+      {"trajectory = \"drop.h5\"", "trajectory = \"sub/drop.h5\"",
+       "output.trajectory: must be a file name inside the output directory (no directory part) "
+       "(sub/drop.h5)"},
+      {"trajectory = \"drop.h5\"", "trajectory = \"\"", "output.trajectory: must not be empty"},
+      {"trajectory = \"drop.h5\"", "trajectory = \"history.csv\"",
+       "output.history: names the same file as output.trajectory (history.csv)"},
+      {"trajectory = \"drop.h5\"", "trajectory = \"checkpoint.txt\"",
+       "(checkpoint index): names the same file as output.trajectory (checkpoint.txt)"},
+      {"name = \"drop\"", "name = \"../../evil\"",
+       "scene.name: must be a file name inside the output directory (no directory part) "
+       "(../../evil)"},
+  };
+  for (const auto& c : cases) {
+    std::string s = scene;
+    s.replace(s.find(c.from), c.from.size(), c.to);
+    spit(dir / "drop.toml", s);
+    const auto r =
+        gs::test::run_cli("simulate " + (dir / "drop.toml").string() + " -q -o " + out, log);
+    EXPECT_EQ(r.rc, 2) << c.to;
+    EXPECT_EQ(r.err, "error: " + (dir / "drop.toml").string() + ": " + c.err + "\n");
+    EXPECT_FALSE(std::filesystem::exists(out));
+  }
+  EXPECT_EQ(slurp(victim), "precious");
+
+  Trajectory t;
+  t.frames = {gs::test::random_frame(30, 20, 1, 0.0), gs::test::random_frame(30, 20, 1, 1.0)};
+  for (auto& f : t.frames) f.walls.clear();
+  const auto in = dir / "in.h5";
+  write_snapshots(in, t);
+  write_snapshots(dir / "in.vtu", t);
+  std::filesystem::create_symlink(in, dir / "alias.h5");
+  const std::string before = slurp(in), vtu_before = slurp(dir / "in.vtu");
+  const std::vector<std::pair<std::string, std::string>> clobber = {
+      {"analyze rev " + in.string() + " -o " + in.string(), in.string()},
+      {"convert " + in.string() + " " + (dir / "alias.h5").string(), (dir / "alias.h5").string()},
+      {"convert " + (dir / "in.vtu").string() + " " + (dir / "in.vtu").string(),
+       (dir / "in.vtp").string()},
+  };
+  for (const auto& [args, file] : clobber) {
+    const auto r = gs::test::run_cli(args, log);
+    EXPECT_EQ(r.rc, 2) << args;
+    EXPECT_EQ(r.err, "error: " + file + ": output would replace an input\n") << args;
+  }
+  EXPECT_EQ(slurp(in), before);
+  EXPECT_EQ(slurp(dir / "in.vtu"), vtu_before);
+}
