@@ -43,6 +43,13 @@ void note_input(const std::filesystem::path& path) {
   if (g_scopes > 0) g_inputs.emplace(st.st_dev, st.st_ino);
 }
 
+void forget_input(const std::filesystem::path& path) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0) return;
+  const std::lock_guard<std::mutex> lock(g_inputs_mutex);
+  g_inputs.erase({st.st_dev, st.st_ino});
+}
+
 void check_not_an_input(const std::filesystem::path& target) {
   struct stat st {};
   if (::stat(target.c_str(), &st) != 0) return;

@@ -20,6 +20,9 @@ class InputScope {
 };
 /// Records `path` as an input when an InputScope is alive (readers call it).
 void note_input(const std::filesystem::path& path);
+/// Forgets `path` as an input: a command's own state that it reads and then replaces (the
+/// checkpoint index of `simulate --resume`).
+void forget_input(const std::filesystem::path& path);
 /// Throws InputError "TARGET: output would replace an input" when `target` is a noted input.
 void check_not_an_input(const std::filesystem::path& target);
 

@@ -786,4 +786,34 @@ Scene load_scene(const std::filesystem::path& path) {
   return s;
 }
 
+namespace {
+void flatten(const toml::table& t, const std::string& prefix,
+             std::map<std::string, std::string>& out) {
+  for (const auto& [k, v] : t) {
+    const std::string key =
+        prefix.empty() ? std::string(k.str()) : prefix + "." + std::string(k.str());
+    if (const auto* sub = v.as_table()) {
+      flatten(*sub, key, out);
+    } else {
+      std::ostringstream os;
+      v.visit([&](auto&& x) { os << x; });
+      out[key] = os.str();
+    }
+  }
+}
+}  // namespace
+
+std::vector<std::string> scene_differences(const std::string& a, const std::string& b) {
+  std::map<std::string, std::string> fa, fb;
+  flatten(toml::parse(a), "", fa);
+  flatten(toml::parse(b), "", fb);
+  std::vector<std::string> keys;
+  for (const auto& [k, v] : fa)
+    if (!fb.count(k) || fb.at(k) != v) keys.push_back(k);
+  for (const auto& [k, v] : fb)
+    if (!fa.count(k)) keys.push_back(k);
+  std::sort(keys.begin(), keys.end());
+  return keys;
+}
+
 }  // namespace gs::solver

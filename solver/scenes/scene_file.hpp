@@ -118,4 +118,8 @@ class FixedSteps final : public LoadingProgramme {
 /// Reads and checks a scene file. Throws InputError "FILE: key: what (value)".
 Scene load_scene(const std::filesystem::path& path);
 
+/// Dotted keys whose values differ between two scenes given as TOML text (keys present in only
+/// one included), sorted. What `simulate --resume` compares with the scene of the run it resumes.
+std::vector<std::string> scene_differences(const std::string& a, const std::string& b);
+
 }  // namespace gs::solver
