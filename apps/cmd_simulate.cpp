@@ -6,6 +6,7 @@
 #include <sys/file.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <chrono>
 #include <cstdio>
@@ -430,6 +431,27 @@ void run(const Args& a) {
   const auto t0 = std::chrono::steady_clock::now();
   auto last_print = t0;
   const std::int64_t first = sim.step_count();
+  // stderr not a terminal (a log, CI): one line when a phase starts and at each 10 % of it.
+  const bool log_progress = !tty && !a.quiet;
+  std::size_t logged_phase = programmes.size();
+  int logged_tenth = -1;
+  auto log_line = [&](bool phase_start) {
+    const double prog = std::clamp(programmes[k]->progress(sim), 0.0, 1.0);
+    const int tenth = static_cast<int>(prog * 10.0 + 1e-9);
+    if (logged_phase == k && !phase_start && tenth <= logged_tenth) return;
+    if (logged_phase == k && phase_start) return;
+    logged_phase = k;
+    logged_tenth = tenth;
+    const double el = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    const double rate = static_cast<double>(sim.step_count() - first) / std::max(el, 1e-9);
+    const double done_frac = (static_cast<double>(k) + prog) / programmes.size();
+    const double eta = done_frac > 0 ? el * (1 - done_frac) / done_frac : 0;
+    std::fprintf(stderr, "%s %zu/%zu: step %lld  %.0f%%  %.3g steps/s  ETA %.0f s\n",
+                 programmes[k]->name().c_str(), k + 1, programmes.size(),
+                 static_cast<long long>(sim.step_count()), 100.0 * prog, rate, eta);
+    std::fflush(stderr);
+  };
+  if (log_progress) log_line(true);
   try {
     while (true) {
       if (programmes[k]->finished(sim)) {
@@ -451,6 +473,7 @@ void run(const Args& a) {
         curve_row();
         last_frame = programmes[k]->frame_index(sim);
         write_frame();
+        if (log_progress) log_line(true);
         continue;
       }
       if (stop_at && sim.step_count() >= *stop_at) break;
@@ -471,6 +494,7 @@ void run(const Args& a) {
         }
       }
       if (s % scene.output.checkpoint_every == 0) checkpoint(s);
+      if (log_progress && s % 64 == 0) log_line(false);
       if (tty) {
         const auto now = std::chrono::steady_clock::now();
         if (now - last_print > std::chrono::milliseconds(500)) {

@@ -888,3 +888,36 @@ TEST(Simulate, ResumeEdgeCasesEditedScenesAndConcurrentRuns) {
                             ": output directory is in use by another simulate run (pid " +
                             std::to_string(first) + ")\n");
 }
+
+// Issue 15, item 9: with stderr a log rather than a terminal, a progress line when a phase starts
+// and at each 10 % of it (the 8-minute plane-strain run of scripts/demo printed nothing); the
+// oedometer scene of scripts/demo runs on a bare clone (its packing is shipped in data/).
+TEST(Simulate, ProgressLinesInALogAndTheShippedOedometerPacking) {
+  gs::test::ScratchDir dir("simulate_progress");
+  const auto log = dir / "log";
+  std::filesystem::create_directories(log);
+  const auto r = gs::test::run_cli(
+      "simulate " + (kData / "scenes" / "drop.toml").string() + " -o " + (dir / "run").string(),
+      log);
+  ASSERT_EQ(r.rc, 0) << r.err;
+  std::vector<std::string> lines;
+  std::istringstream in(r.err);
+  for (std::string l; std::getline(in, l);) lines.push_back(l);
+  ASSERT_EQ(lines.size(), 11u) << r.err;
+  EXPECT_EQ(lines.front().rfind("steps 1/1: step 0  0%  ", 0), 0u) << lines.front();
+  for (std::size_t i = 1; i < lines.size(); ++i) {
+    EXPECT_NE(lines[i].find("  " + std::to_string(10 * i) + "%  "), std::string::npos) << lines[i];
+    EXPECT_NE(lines[i].find(" steps/s  ETA "), std::string::npos) << lines[i];
+  }
+  const auto q = gs::test::run_cli("simulate " + (kData / "scenes" / "drop.toml").string() +
+                                       " -q -o " + (dir / "quiet").string(),
+                                   log);
+  EXPECT_EQ(q.err, "");
+
+  const auto oed = gs::test::run_cli(std::string("simulate ") + GS_SOURCE_DIR +
+                                         "/data/scenes/oedometer_yade.toml -q --steps 10 -o " +
+                                         (dir / "oed").string(),
+                                     log);
+  EXPECT_EQ(oed.rc, 0) << oed.err;
+  EXPECT_EQ(gs::TrajectoryReader(dir / "oed" / "oedometer_yade.h5").particle_count(0), 883u);
+}
