@@ -52,6 +52,7 @@ int main(int argc, char** argv) {
   // then crashes (SIGSEGV after our error line): every file is closed by its owner, so HDF5 gets
   // no exit handler.
   H5dont_atexit();
+  H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);  // HDF5's error stack printing: ours is one line
   const gs::InputScope inputs;  // no output of this command may replace one of its inputs
   CLI::App app{"granoscope: DEM simulation and analysis of granular materials"};
   app.set_version_flag("--version", gs::code_version());
@@ -82,7 +83,12 @@ int main(int argc, char** argv) {
   } catch (const gs::cli::ExitStatus& s) {
     return s.code;
   } catch (const std::exception& e) {
-    std::cerr << "error: " << e.what() << "\n";
+    // One line whatever a library put in its message (OpenCV's assertion text spans lines).
+    std::string what = e.what();
+    for (char& c : what)
+      if (c == '\n' || c == '\r') c = ' ';
+    while (!what.empty() && what.back() == ' ') what.pop_back();
+    std::cerr << "error: " << what << "\n";
     return 2;
   }
   return 0;
