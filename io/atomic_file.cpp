@@ -116,14 +116,19 @@ StagingDir::~StagingDir() {
   std::filesystem::remove_all(staging_, ec);
 }
 
-InputError StagingDir::renamed(const InputError& e) const {
+InputError with_dir_renamed(const InputError& e, const std::filesystem::path& from_dir,
+                            const std::filesystem::path& to_dir) {
   std::string m = e.what();
-  const std::string from = staging_.string() + "/", to = dir_.string() + "/";
+  const std::string from = from_dir.string() + "/", to = to_dir.string() + "/";
   for (auto k = m.find(from); k != std::string::npos; k = m.find(from, k + to.size()))
     m.replace(k, from.size(), to);
   const auto colon = m.find(": ");
-  if (colon == std::string::npos) return InputError(dir_.string(), m);
+  if (colon == std::string::npos) return InputError(to_dir.string(), m);
   return InputError(m.substr(0, colon), m.substr(colon + 2));
+}
+
+InputError StagingDir::renamed(const InputError& e) const {
+  return with_dir_renamed(e, staging_, dir_);
 }
 
 void StagingDir::commit() {

@@ -26,6 +26,11 @@ void forget_input(const std::filesystem::path& path);
 /// Throws InputError "TARGET: output would replace an input" when `target` is a noted input.
 void check_not_an_input(const std::filesystem::path& target);
 
+/// The error `e` with every `from/` in its message read as `to/` (a temporary directory named as
+/// the final one it stands for).
+InputError with_dir_renamed(const InputError& e, const std::filesystem::path& from,
+                            const std::filesystem::path& to);
+
 /// fsync of a file or directory; throws InputError naming it (a full disk shows here).
 void sync_to_disk(const std::filesystem::path& path);
 /// sync_to_disk(from), rename onto `to`, sync the directory of `to`.

@@ -301,18 +301,20 @@ void write_pvd_series(const std::filesystem::path& pvd_path, const Trajectory& t
   } cleanup{tmp_dir.temp_path()};
   std::vector<std::pair<double, std::string>> pe, ce, ke;
   char name[64];
-  for (std::size_t i = 0; i < t.frames.size(); ++i) {
-    std::snprintf(name, sizeof name, "particles_%06zu.vtu", i);
-    write_vtu_particles(tmp_dir.temp_path() / name, t.frames[i]);
-    pe.emplace_back(t.frames[i].time, dir_name + "/" + name);
-    std::snprintf(name, sizeof name, "contacts_%06zu.vtp", i);
-    write_vtp_contacts(tmp_dir.temp_path() / name, t.frames[i]);
-    ce.emplace_back(t.frames[i].time, dir_name + "/" + name);
-    if (!any_clumps) continue;
-    std::snprintf(name, sizeof name, "clumps_%06zu.vtu", i);
-    write_vtu_clumps(tmp_dir.temp_path() / name, t.frames[i]);
-    ke.emplace_back(t.frames[i].time, dir_name + "/" + name);
-  }
+  for (std::size_t i = 0; i < t.frames.size(); ++i) try {
+      std::snprintf(name, sizeof name, "particles_%06zu.vtu", i);
+      write_vtu_particles(tmp_dir.temp_path() / name, t.frames[i]);
+      pe.emplace_back(t.frames[i].time, dir_name + "/" + name);
+      std::snprintf(name, sizeof name, "contacts_%06zu.vtp", i);
+      write_vtp_contacts(tmp_dir.temp_path() / name, t.frames[i]);
+      ce.emplace_back(t.frames[i].time, dir_name + "/" + name);
+      if (!any_clumps) continue;
+      std::snprintf(name, sizeof name, "clumps_%06zu.vtu", i);
+      write_vtu_clumps(tmp_dir.temp_path() / name, t.frames[i]);
+      ke.emplace_back(t.frames[i].time, dir_name + "/" + name);
+    } catch (const InputError& e) {
+      throw with_dir_renamed(e, tmp_dir.temp_path(), dir);  // named as the directory it stands for
+    }
   // Everything is written under temporary names before anything is renamed (a full disk leaves
   // no file under its final name).
   const auto contacts = write_pvd_file(contacts_pvd, ce);

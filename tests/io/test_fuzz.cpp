@@ -584,6 +584,8 @@ TEST(HostileInputs, FailedWritesLeaveNoOutputAndOneLine) {
     const std::string err = gs::test::slurp(log / "e");
     EXPECT_EQ(err.rfind("error: " + out.string() + "/", 0), 0u) << err;
     EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
+    EXPECT_EQ(err.find(".tmp-"), std::string::npos) << err;  // final names, not temporaries
+    EXPECT_EQ(err.find(".staging-"), std::string::npos) << err;
     EXPECT_EQ(gs::test::slurp(log / "o"), "");
     std::vector<std::string> left;
     for (const auto& e : std::filesystem::recursive_directory_iterator(out))
