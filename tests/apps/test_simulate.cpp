@@ -862,7 +862,11 @@ TEST(Simulate, ResumeEdgeCasesEditedScenesAndConcurrentRuns) {
       << err;
   EXPECT_EQ(gs::read_hdf5_trajectory(edited / "drop.h5").frames.back().step, 9000);
 
-  // Two runs into one directory.
+  // Two runs into one directory (the first one long enough to be still running).
+  std::string long_run = slurp(scene);
+  long_run.replace(long_run.find("steps = 8000"), 12, "steps = 100000000");
+  std::ofstream(dir / "long.toml") << long_run;
+  const std::string long_scene = (dir / "long.toml").string();
   const auto busy = dir / "busy";
   const pid_t first = fork();
   ASSERT_GE(first, 0);
@@ -870,7 +874,8 @@ TEST(Simulate, ResumeEdgeCasesEditedScenesAndConcurrentRuns) {
     const int devnull = ::open("/dev/null", O_WRONLY);
     dup2(devnull, 1);
     dup2(devnull, 2);
-    execl(kExe.c_str(), kExe.c_str(), "simulate", scene.c_str(), "-q", "-o", busy.c_str(), nullptr);
+    execl(kExe.c_str(), kExe.c_str(), "simulate", long_scene.c_str(), "-q", "-o", busy.c_str(),
+          nullptr);
     _exit(127);
   }
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
