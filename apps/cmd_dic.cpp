@@ -4,6 +4,7 @@
 #include <CLI/CLI.hpp>
 #include <iostream>
 #include <opencv2/imgcodecs.hpp>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -82,13 +83,17 @@ void run_dic(const DicArgs& a) {
   opt.strain_window_radius = a.strain_window / 2;
   opt.incremental = a.incremental;
 
-  if (!roi.empty()) {
-    try {
-      (void)dic::make_grid(images[0].rows, images[0].cols, radius, a.step, roi);
-    } catch (const std::invalid_argument& e) {
-      throw InputError(a.roi, e.what());
-    }
+  dic::PoiGrid grid;
+  try {
+    grid = dic::make_grid(images[0].rows, images[0].cols, radius, a.step, roi);
+  } catch (const std::invalid_argument& e) {
+    throw InputError(a.roi.empty() ? a.images[0] : a.roi, e.what());
   }
+  // A plane-fit window wider than the grid fits nothing: every strain would be NaN.
+  if (a.strain_window > std::min(grid.nx, grid.ny))
+    throw InputError("--strain-window", "larger than the POI grid",
+                     std::to_string(a.strain_window) + " POIs; grid " + std::to_string(grid.nx) +
+                         " x " + std::to_string(grid.ny));
   dic::SequenceResult result;
   try {
     result = dic::correlate_sequence(images, roi, opt);
@@ -107,18 +112,25 @@ void run_dic(const DicArgs& a) {
   info.image_rows = images[0].rows;
   info.image_cols = images[0].cols;
   const std::filesystem::path out(a.output);
-  dic::write_dic_hdf5(out, result, info);
-  for (std::size_t k = 0; k < result.frames.size(); ++k) {
-    char suffix[32];
-    std::snprintf(suffix, sizeof suffix, "_%04zu", k + 1);
-    const auto base = out.parent_path() / (out.stem().string() + suffix);
-    if (!a.no_csv) dic::write_dic_csv(base.string() + ".csv", result, k, info);
-    if (!a.no_vtk) dic::write_dic_vti(base.string() + ".vti", result, k, info);
-    std::size_t nvalid = 0;
-    for (const auto v : result.frames[k].valid) nvalid += v;
-    std::cout << a.images[k + 1] << ": " << nvalid << "/" << result.frames[k].valid.size()
-              << " valid POIs\n";
-  }
+  // The HDF5, CSV and VTI files appear together or not at all.
+  StagingDir staging(out.has_parent_path() ? out.parent_path() : std::filesystem::path("."));
+  std::ostringstream report;  // printed once everything is in place
+  staging.write([&] {
+    dic::write_dic_hdf5(staging / out.filename(), result, info);
+    for (std::size_t k = 0; k < result.frames.size(); ++k) {
+      char suffix[32];
+      std::snprintf(suffix, sizeof suffix, "_%04zu", k + 1);
+      const auto base = staging / (out.stem().string() + suffix);
+      if (!a.no_csv) dic::write_dic_csv(base.string() + ".csv", result, k, info);
+      if (!a.no_vtk) dic::write_dic_vti(base.string() + ".vti", result, k, info);
+      std::size_t nvalid = 0;
+      for (const auto v : result.frames[k].valid) nvalid += v;
+      report << a.images[k + 1] << ": " << nvalid << "/" << result.frames[k].valid.size()
+             << " valid POIs\n";
+    }
+  });
+  staging.commit();
+  std::cout << report.str();
   std::cout << "wrote " << out.string() << " (subset " << a.subset << " px, step " << a.step
             << " px, VSG " << info.vsg_px << " px)\n";
 }
@@ -161,24 +173,23 @@ void run_render(const RenderArgs& a) {
   ro.seed = a.seed;
   std::vector<dic::GroundTruth> truth;
   const double full = a.bits == 8 ? 255.0 : 65535.0;
-  for (std::size_t k = 0; k < reader.frame_count(); ++k) {
-    const Frame f = k == 0 ? ref : reader.frame(k);
-    const cv::Mat img = dic::render_frame(f, cam, ro);
-    cv::Mat q;
-    img.convertTo(q, a.bits == 8 ? CV_8U : CV_16U, full / 255.0);  // rounds and saturates
-    char name[64];
-    std::snprintf(name, sizeof name, "frame_%04zu.%s", k, a.format.c_str());
-    const std::filesystem::path target = std::filesystem::path(a.out_dir) / name;
-    AtomicOutput out(target);
-    const std::string tmp =
-        out.temp_path().string() + "." + a.format;  // imwrite needs the extension
-    if (!cv::imwrite(tmp, q)) throw InputError(target.string(), "cannot write image");
-    std::filesystem::rename(tmp, out.temp_path());
-    out.commit();
-    truth.push_back(dic::ground_truth(ref, f, cam));
-  }
-  dic::write_ground_truth_hdf5(std::filesystem::path(a.out_dir) / "ground_truth.h5", cam, a.view,
-                               truth);
+  StagingDir staging(a.out_dir);
+  staging.write([&] {
+    for (std::size_t k = 0; k < reader.frame_count(); ++k) {
+      const Frame f = k == 0 ? ref : reader.frame(k);
+      const cv::Mat img = dic::render_frame(f, cam, ro);
+      cv::Mat q;
+      img.convertTo(q, a.bits == 8 ? CV_8U : CV_16U, full / 255.0);  // rounds and saturates
+      char name[64];
+      std::snprintf(name, sizeof name, "frame_%04zu.%s", k, a.format.c_str());
+      const std::filesystem::path target = std::filesystem::path(a.out_dir) / name;
+      const std::filesystem::path staged = staging / name;  // imwrite needs the extension
+      dic::write_image(staged, q, target.string());
+      truth.push_back(dic::ground_truth(ref, f, cam));
+    }
+    dic::write_ground_truth_hdf5(staging / "ground_truth.h5", cam, a.view, truth);
+  });
+  staging.commit();  // the frames and their ground truth appear together or not at all
   std::cout << "rendered " << reader.frame_count() << " frames " << cam.cols << "x" << cam.rows
             << " px (" << a.px_per_d50 << " px per d50) to " << a.out_dir << "\n";
 }
@@ -225,7 +236,9 @@ void register_dic(CLI::App& app) {
   c->add_option("--zncc-min", args->zncc_min, "POIs below this ZNCC are invalid")
       ->capture_default_str();
   c->add_option("--search", args->search, "seed search half-width, px")->capture_default_str();
-  c->add_option("--threads", args->threads, "threads (0 = OpenMP default)")->capture_default_str();
+  c->add_option("--threads", args->threads, "threads (0 = OpenMP default, at most 1024)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 1024));
   c->add_flag("--no-csv", args->no_csv, "do not write CSV tables");
   c->add_flag("--no-vtk", args->no_vtk, "do not write VTK images");
   c->callback([args] { run_dic(*args); });

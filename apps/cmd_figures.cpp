@@ -1,4 +1,6 @@
 // `granoscope figures INPUT -o DIR`: runs the shipped matplotlib scripts over a run's outputs.
+#include <unistd.h>
+
 #include <iostream>
 #include <memory>
 
@@ -29,11 +31,17 @@ void register_figures(CLI::App& app) {
     if (!is_hdf5_file(*in))
       throw InputError(
           *in, "figures need an HDF5 file written by granoscope (use `granoscope convert` first)");
+    const std::string python = find_python();
+    // The script's own failure here is a Python traceback: check the directory first.
+    std::filesystem::create_directories(*out, ec);
+    if (ec) throw InputError(*out, "cannot create output directory", ec.message());
+    if (::access(out->c_str(), W_OK | X_OK) != 0)
+      throw InputError(*out, "output directory is not writable");
     const auto script = figures_dir() / "granoscope_figures.py";
     if (!std::filesystem::exists(script, ec))
       throw InputError(script.string(), "figure scripts not found");
-    std::vector<std::string> argv{find_python(), script.string(),       *in, "-o", *out,
-                                  "--frame",     std::to_string(*frame)};
+    std::vector<std::string> argv{python,    script.string(),       *in, "-o", *out,
+                                  "--frame", std::to_string(*frame)};
     if (!type->empty()) {
       argv.push_back("--type");
       argv.push_back(*type);

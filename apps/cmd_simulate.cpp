@@ -2,12 +2,18 @@
 // test (specimen preparation, then triaxial / plane-strain compression or direct shear) —
 // writing an HDF5 trajectory (frames with contacts and walls), a monitor history, the test's
 // macroscopic curve (CSV), the prepared specimen, and checkpoints it resumes from bit-for-bit.
+#include <fcntl.h>
+#include <sys/file.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <iostream>
+#include <limits>
 #include <map>
 #include <memory>
 #include <optional>
@@ -51,8 +57,12 @@ class CsvOutput {
     check();
   }
   void resume(std::size_t rows) {
+    // Killed between the final renames: this output was renamed already, the run not finished.
+    std::error_code ec;
+    if (!fs::exists(partial_) && fs::exists(path_)) fs::rename(path_, partial_, ec);
     if (!fs::exists(partial_)) throw InputError(partial_.string(), "missing output to resume");
     const std::string old = text::read_text_file(partial_);
+    forget_input(partial_);
     const auto lines = text::split_lines(old);
     if (lines.size() < rows + 1)
       throw InputError(partial_.string(), "output shorter than its checkpoint",
@@ -72,12 +82,16 @@ class CsvOutput {
     out_.flush();
     check();
   }
+  /// flush() and fsync: the rows a checkpoint counts are on disk before its index is.
+  void sync() {
+    flush();
+    sync_to_disk(partial_);
+  }
   void finish() {
     if (!out_.is_open()) return;
     out_.close();
-    std::error_code ec;
-    fs::rename(partial_, path_, ec);
-    if (ec) throw InputError(path_.string(), "cannot rename output into place", ec.message());
+    if (out_.fail()) throw InputError(partial_.string(), "cannot write output");
+    rename_durably(partial_, path_);
   }
   const fs::path& path() const { return path_; }
 
@@ -89,6 +103,61 @@ class CsvOutput {
   std::ofstream out_;
   std::size_t rows_ = 0;
 };
+
+/// An exclusive lock on the output directory for the whole run (a second `simulate` into the same
+/// directory mixed its trajectory and history with the first's). Released when the process ends.
+class DirectoryLock {
+ public:
+  explicit DirectoryLock(const fs::path& dir) : path_(dir / ".simulate.lock") {
+    fd_ = ::open(path_.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    if (fd_ < 0) throw InputError(path_.string(), "cannot create lock file", std::strerror(errno));
+    if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
+      char buf[32] = {};
+      const auto n = ::pread(fd_, buf, sizeof buf - 1, 0);
+      ::close(fd_);
+      fd_ = -1;
+      throw InputError(dir.string(), "output directory is in use by another simulate run",
+                       n > 0 ? "pid " + std::string(buf, static_cast<std::size_t>(n)) : "");
+    }
+    const std::string pid = std::to_string(::getpid());
+    if (::ftruncate(fd_, 0) == 0 && ::pwrite(fd_, pid.data(), pid.size(), 0) < 0) {
+    }
+  }
+  DirectoryLock(const DirectoryLock&) = delete;
+  DirectoryLock& operator=(const DirectoryLock&) = delete;
+  ~DirectoryLock() {
+    if (fd_ < 0) return;
+    std::error_code ec;
+    fs::remove(path_, ec);  // (while still held)
+    ::close(fd_);
+  }
+
+ private:
+  fs::path path_;
+  int fd_ = -1;
+};
+
+/// Temporaries of a killed run (`*.tmp-PID-N` of atomic writes, `.staging-*` directories): with
+/// the directory locked, nothing else is writing them.
+void remove_stale_temporaries(const fs::path& dir) {
+  std::error_code ec;
+  std::vector<fs::path> stale;
+  for (const auto& e : fs::directory_iterator(dir, ec)) {
+    const std::string n = e.path().filename().string();
+    if (n.find(".tmp-") != std::string::npos || n.rfind(".staging-", 0) == 0)
+      stale.push_back(e.path());
+  }
+  for (const auto& p : stale) fs::remove_all(p, ec);
+}
+
+/// The scene a run was started with, kept beside its checkpoints.
+const char* kSceneCopy = "checkpoint-scene.toml";
+
+std::string flat_scene(const solver::Scene& scene) {
+  for (const auto& [k, v] : scene.parameters)
+    if (k == "scene.toml") return v;
+  return {};
+}
 
 using Index = std::map<std::string, std::string>;
 
@@ -104,6 +173,7 @@ void write_index(const fs::path& path, const Index& index) {
 
 Index read_index(const fs::path& path) {
   std::istringstream in(text::read_text_file(path, 1 << 16));
+  forget_input(path);  // our own state, replaced at the next checkpoint
   Index index;
   std::string k, v;
   while (in >> k >> v) index[k] = v;
@@ -212,8 +282,11 @@ void run(const Args& a) {
   std::error_code ec;
   fs::create_directories(out, ec);
   if (ec) throw InputError(out.string(), "cannot create output directory", ec.message());
+  const DirectoryLock lock(out);
+  remove_stale_temporaries(out);
   const fs::path traj = out / scene.output.trajectory;
   const fs::path ckpt_index = out / "checkpoint.txt";
+  const fs::path scene_copy = out / kSceneCopy;
   const bool tty = isatty(STDERR_FILENO) && !a.quiet;
 
   if (scene.config.dt > scene.dt_pwave)
@@ -276,9 +349,11 @@ void run(const Args& a) {
     last_frame_step = sim.step_count();
   };
   auto checkpoint = [&](std::int64_t s) {
-    history.flush();
-    if (curve.open()) curve.flush();
-    if (prep_curve.open()) prep_curve.flush();
+    // Everything the index counts reaches the disk before the index does (power loss).
+    history.sync();
+    if (curve.open()) curve.sync();
+    if (prep_curve.open()) prep_curve.sync();
+    if (writer) sync_to_disk(partial_path(traj));
     Index next{{"step", std::to_string(s)},
                {"programme", std::to_string(k)},
                {"frames", std::to_string(writer ? writer->frames_written() : 0)},
@@ -296,11 +371,35 @@ void run(const Args& a) {
   };
 
   if (a.resume) {
-    if (!fs::exists(ckpt_index))
+    if (!fs::exists(ckpt_index)) {
+      // Killed during the final cleanup (the index goes first): the run is complete.
+      if (fs::exists(traj) && !fs::exists(partial_path(traj))) {
+        for (const auto& e : fs::directory_iterator(out, ec)) {
+          const std::string n = e.path().filename().string();
+          if (n.rfind("checkpoint-", 0) == 0) fs::remove(e.path(), ec);
+        }
+        std::printf("%s: the run is complete (%s); nothing to resume\n", scene.name.c_str(),
+                    traj.string().c_str());
+        return;
+      }
       throw InputError(ckpt_index.string(), "no checkpoint to resume from");
+    }
+    if (fs::exists(scene_copy)) {
+      std::vector<std::string> changed;
+      for (const auto& key :
+           solver::scene_differences(text::read_text_file(scene_copy, 1 << 26), flat_scene(scene)))
+        if (key != "solver.steps") changed.push_back(key);  // more (or fewer) steps: safe
+      if (!changed.empty()) {
+        std::string keys;
+        for (const auto& k : changed) keys += (keys.empty() ? "" : ", ") + k;
+        throw InputError(a.scene,
+                         "scene differs from the run being resumed (rerun without --resume)", keys);
+      }
+    }
     ck = read_index(ckpt_index);
     const fs::path state = out / ck["state"];
     const std::string extra = sim.load_checkpoint(state);
+    forget_input(state);
     if (sim.step_count() != as_int(ck, "step", ckpt_index))
       throw InputError(state.string(), "checkpoint step differs from its index",
                        std::to_string(sim.step_count()));
@@ -313,6 +412,9 @@ void run(const Args& a) {
     last_frame_step = as_int(ck, "last_frame_step", ckpt_index);
     last_curve_step = as_int(ck, "last_curve_step", ckpt_index);
     const auto frames = static_cast<std::size_t>(as_int(ck, "frames", ckpt_index));
+    // Killed between the final renames: the trajectory was renamed, the run not finished.
+    if (frames > 0 && !fs::exists(partial_path(traj)) && fs::exists(traj))
+      fs::rename(traj, partial_path(traj), ec);
     if (frames > 0)
       writer.emplace(TrajectoryWriter::resume(traj, frames, {.discard_unfinished = false}));
     history.resume(static_cast<std::size_t>(as_int(ck, "history_rows", ckpt_index)));
@@ -327,6 +429,15 @@ void run(const Args& a) {
     std::cerr << "resuming " << scene.name << " from step " << sim.step_count() << " ("
               << programmes[k]->name() << ")\n";
   } else {
+    {
+      AtomicOutput copy(scene_copy);
+      {
+        std::ofstream o(copy.temp_path());
+        o << flat_scene(scene);
+        if (!o.flush()) throw InputError(scene_copy.string(), "cannot write output");
+      }
+      copy.commit();
+    }
     history.create(history_header(sim));
     programmes[0]->start(sim);
     open_curve(0);
@@ -342,6 +453,27 @@ void run(const Args& a) {
   const auto t0 = std::chrono::steady_clock::now();
   auto last_print = t0;
   const std::int64_t first = sim.step_count();
+  // stderr not a terminal (a log, CI): one line when a phase starts and at each 10 % of it.
+  const bool log_progress = !tty && !a.quiet;
+  std::size_t logged_phase = programmes.size();
+  int logged_tenth = -1;
+  auto log_line = [&](bool phase_start) {
+    const double prog = std::clamp(programmes[k]->progress(sim), 0.0, 1.0);
+    const int tenth = static_cast<int>(prog * 10.0 + 1e-9);
+    if (logged_phase == k && !phase_start && tenth <= logged_tenth) return;
+    if (logged_phase == k && phase_start) return;
+    logged_phase = k;
+    logged_tenth = tenth;
+    const double el = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    const double rate = static_cast<double>(sim.step_count() - first) / std::max(el, 1e-9);
+    const double done_frac = (static_cast<double>(k) + prog) / programmes.size();
+    const double eta = done_frac > 0 ? el * (1 - done_frac) / done_frac : 0;
+    std::fprintf(stderr, "%s %zu/%zu: step %lld  %.0f%%  %.3g steps/s  ETA %.0f s\n",
+                 programmes[k]->name().c_str(), k + 1, programmes.size(),
+                 static_cast<long long>(sim.step_count()), 100.0 * prog, rate, eta);
+    std::fflush(stderr);
+  };
+  if (log_progress) log_line(true);
   try {
     while (true) {
       if (programmes[k]->finished(sim)) {
@@ -363,6 +495,7 @@ void run(const Args& a) {
         curve_row();
         last_frame = programmes[k]->frame_index(sim);
         write_frame();
+        if (log_progress) log_line(true);
         continue;
       }
       if (stop_at && sim.step_count() >= *stop_at) break;
@@ -383,6 +516,7 @@ void run(const Args& a) {
         }
       }
       if (s % scene.output.checkpoint_every == 0) checkpoint(s);
+      if (log_progress && s % 64 == 0) log_line(false);
       if (tty) {
         const auto now = std::chrono::steady_clock::now();
         if (now - last_print > std::chrono::milliseconds(500)) {
@@ -416,8 +550,10 @@ void run(const Args& a) {
   curve.finish();
   prep_curve.finish();
   if (writer) writer->finish();
-  fs::remove(out / ck["state"], ec);
+  // The index first: a kill from here on leaves a complete run, which --resume recognises.
   fs::remove(ckpt_index, ec);
+  fs::remove(out / ck["state"], ec);
+  fs::remove(scene_copy, ec);
   const double el = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const double ps = static_cast<double>(s - first) * static_cast<double>(sim.particles().size());
   const auto& e = sim.energy();
@@ -444,8 +580,10 @@ void register_simulate(CLI::App& app) {
   cmd->add_option("--steps", a->steps,
                   "stop at this step (a plain scene: its number of steps; a laboratory test "
                   "ends earlier if its programme ends first)")
-      ->check(CLI::NonNegativeNumber);
-  cmd->add_option("--threads", a->threads, "override the thread count")->check(CLI::PositiveNumber);
+      ->check(CLI::Range(std::int64_t{0}, std::numeric_limits<std::int64_t>::max()));
+  cmd->add_option("--threads", a->threads,
+                  "override the thread count (1 to " + std::to_string(solver::kMaxThreads) + ")")
+      ->check(CLI::Range(1, solver::kMaxThreads));
   cmd->add_flag("--resume", a->resume, "continue from the last checkpoint in the output directory");
   cmd->add_flag("-q,--quiet", a->quiet, "no progress line");
   cmd->callback([a] { run(*a); });

@@ -35,8 +35,20 @@ bool has_packages(const std::string& py) {
 }  // namespace
 
 std::string find_python() {
+  // An interpreter named by the user is used or refused, never passed over in silence.
+  if (const char* env = std::getenv("GRANOSCOPE_PYTHON"); env && *env) {
+    const std::string py = env;
+    if (py.find('\'') == std::string::npos && has_packages(py)) return py;
+    std::error_code ec;
+    const bool named_file = py.find('/') != std::string::npos;
+    throw std::runtime_error(
+        "GRANOSCOPE_PYTHON: " +
+        std::string(named_file && !std::filesystem::exists(py, ec)
+                        ? "no such interpreter"
+                        : "not a Python 3 that imports matplotlib, numpy and h5py") +
+        " (" + py + ")");
+  }
   std::vector<std::string> candidates;
-  if (const char* env = std::getenv("GRANOSCOPE_PYTHON"); env && *env) candidates.emplace_back(env);
   candidates.emplace_back("/usr/bin/python3");
   candidates.emplace_back("python3");
   std::string tried;

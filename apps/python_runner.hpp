@@ -9,7 +9,8 @@ namespace gs::cli {
 
 /// $GRANOSCOPE_PYTHON, else /usr/bin/python3 (Debian's, which has the packages), else python3
 /// on PATH: the first that imports matplotlib, numpy and h5py. Throws std::runtime_error naming
-/// the interpreters tried when none does.
+/// the interpreters tried when none does, or naming $GRANOSCOPE_PYTHON when it is set and unusable
+/// (it is never passed over for another).
 std::string find_python();
 
 /// The directory holding the figure scripts: $GRANOSCOPE_FIGURES_DIR, else

@@ -4,8 +4,11 @@
 #include <vtkCellArray.h>
 #include <vtkCellData.h>
 #include <vtkDoubleArray.h>
+#include <vtkErrorCode.h>
 #include <vtkImageData.h>
+#include <vtkLogger.h>
 #include <vtkNew.h>
+#include <vtkObject.h>
 #include <vtkPointData.h>
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
@@ -97,12 +100,16 @@ vtkNew<vtkPoints> to_points(const std::vector<Eigen::Vector3d>& points) {
 
 template <class Writer, class Data>
 void write_vtk(const std::filesystem::path& path, Data& data) {
+  vtkObject::GlobalWarningDisplayOff();  // VTK's own multi-line report: ours is one line
+  vtkLogger::SetStderrVerbosity(vtkLogger::VERBOSITY_OFF);
   AtomicOutput out(path);
   vtkNew<Writer> w;
   w->SetFileName(out.temp_path().string().c_str());
   w->SetInputData(data);
   w->SetDataModeToBinary();
-  if (w->Write() != 1) throw InputError(path.string(), "cannot write VTK output");
+  if (w->Write() != 1 || w->GetErrorCode() != 0)
+    throw InputError(path.string(), "cannot write VTK output",
+                     vtkErrorCode::GetStringFromErrorCode(w->GetErrorCode()));
   out.commit();
 }
 
@@ -110,10 +117,12 @@ void write_vtk(const std::filesystem::path& path, Data& data) {
 
 struct H5FieldFile::Impl {
   explicit Impl(const std::filesystem::path& path)
-      : out(path),
+      : quiet((H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr), true)),  // our one line, not HDF5's
+        out(path),
         name(path.string()),
         file(H5Fcreate(out.temp_path().string().c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT),
              H5Fclose, path.string(), "create") {}
+  bool quiet;
   AtomicOutput out;
   std::string name;
   Handle file;

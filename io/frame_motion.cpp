@@ -1,5 +1,8 @@
 #include "frame_motion.hpp"
 
+#include <algorithm>
+#include <limits>
+
 #include <filesystem>
 #include <unordered_map>
 
@@ -65,12 +68,41 @@ FrameMotion motion_between(const Frame& from, const Frame& to, const std::string
   return m;
 }
 
+namespace {
+
+// The geometry of the analyses (cell volumes ~ extent^3, Delaunay predicates, quality measures)
+// over- or underflows outside these lengths, and cells then keep zero gradients without a word
+// (coordinates scaled by 1e150 or 1e-300). Metres: a granular specimen lies well inside.
+constexpr double kMinExtent = 1e-90, kMaxExtent = 1e90;
+
+FrameMotion checked(FrameMotion m, const std::string& path) {
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+  Eigen::Vector3d hi = -lo;
+  double umax = 0;
+  for (std::size_t i = 0; i < m.x.size(); ++i) {
+    lo = lo.cwiseMin(m.x[i]);
+    hi = hi.cwiseMax(m.x[i]);
+    umax = std::max(umax, m.u[i].cwiseAbs().maxCoeff());
+  }
+  if (m.x.size() < 2) return m;
+  const double extent = (hi - lo).maxCoeff();  // (a norm would underflow at 1e-300)
+  if (!(extent >= kMinExtent && extent <= kMaxExtent))
+    throw InputError(path, "particle positions span a length the geometry cannot handle",
+                     value_str(extent) + " m; 1e-90 to 1e90");
+  if (!(umax <= kMaxExtent))
+    throw InputError(path, std::string("particle ") + m.kind + " too large for the geometry",
+                     value_str(umax));
+  return m;
+}
+
+}  // namespace
+
 FrameMotion read_frame_motion(const std::string& path, long from, std::optional<long> to) {
   const std::size_t n = frame_count(path);
   check_index(path, from, n, "reference frame");
   if (to) check_index(path, *to, n, "target frame");
   Frame ref = read_frame(path, from);
-  if (to) return motion_between(ref, read_frame(path, *to), path);
+  if (to) return checked(motion_between(ref, read_frame(path, *to), path), path);
   FrameMotion m;
   m.kind = "velocity";
   for (std::size_t i = 0; i < ref.particles.size(); ++i) {
@@ -79,7 +111,7 @@ FrameMotion read_frame_motion(const std::string& path, long from, std::optional<
     m.u.push_back(ref.particles[i].velocity);
   }
   m.frame = std::move(ref);
-  return m;
+  return checked(std::move(m), path);
 }
 
 }  // namespace gs

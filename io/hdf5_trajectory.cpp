@@ -3,12 +3,14 @@
 
 #include <hdf5.h>
 
+#include <algorithm>
 #include <array>
 #include <cstring>
 #include <fstream>
 #include <system_error>
 #include <vector>
 
+#include "atomic_file.hpp"
 #include "errors.hpp"
 
 namespace gs {
@@ -306,6 +308,57 @@ std::string read_string_attr(hid_t attr, const std::string& file, const std::str
   return s;
 }
 
+// ---------------------------------------------------------------- what a reader refuses
+
+/// The object at `path` (absolute, "/a/b") is reached through hard links only: an external link
+/// (into another file), a soft or user-defined link is refused before anything follows it.
+void require_hard_links(hid_t file, const std::string& path, const std::string& name) {
+  std::size_t at = 1;
+  while (at <= path.size()) {
+    const auto slash = path.find('/', at);
+    const std::string prefix = path.substr(0, slash);
+    H5L_info_t info;
+    if (H5Lexists(file, prefix.c_str(), H5P_DEFAULT) <= 0) return;  // (reported by the caller)
+    if (H5Lget_info(file, prefix.c_str(), &info, H5P_DEFAULT) < 0)
+      throw InputError(name, "cannot read link", prefix);
+    if (info.type == H5L_TYPE_EXTERNAL)
+      throw InputError(name, "external link not followed", prefix);
+    if (info.type != H5L_TYPE_HARD)
+      throw InputError(name, "soft or user-defined link not followed", prefix);
+    if (slash == std::string::npos) break;
+    at = slash + 1;
+  }
+}
+
+/// The dataset's raw data lies in this file, in chunks filtered only by shuffle, deflate and
+/// Fletcher-32 (what the writer uses; deflate compresses at most 1032:1), and the rows it
+/// declares fit in the bytes it stores: a few kilobytes never claim 10^8 particles.
+void check_dataset_storage(hid_t ds, hsize_t rows, hsize_t row_bytes, const std::string& path,
+                           const std::string& name) {
+  Hid dcpl(H5Dget_create_plist(ds), H5Pclose);
+  if (!dcpl.valid()) throw InputError(name, "cannot read dataset properties", path);
+  const H5D_layout_t layout = H5Pget_layout(dcpl.get());
+  if (layout == H5D_VIRTUAL) throw InputError(name, "virtual dataset not followed", path);
+  if (H5Pget_external_count(dcpl.get()) > 0)
+    throw InputError(name, "dataset with external raw data not followed", path);
+  const int nfilters = H5Pget_nfilters(dcpl.get());
+  for (int k = 0; k < nfilters; ++k) {
+    unsigned flags = 0;
+    std::size_t nelem = 0;
+    const H5Z_filter_t f = H5Pget_filter2(dcpl.get(), static_cast<unsigned>(k), &flags, &nelem,
+                                          nullptr, 0, nullptr, nullptr);
+    if (f != H5Z_FILTER_DEFLATE && f != H5Z_FILTER_SHUFFLE && f != H5Z_FILTER_FLETCHER32)
+      throw InputError(name, "dataset uses an unsupported filter",
+                       path + " filter " + std::to_string(f));
+  }
+  const hsize_t stored = H5Dget_storage_size(ds);
+  const long double logical = static_cast<long double>(rows) * static_cast<long double>(row_bytes);
+  if (logical > 1100.0L * static_cast<long double>(stored) + 1048576.0L)
+    throw InputError(
+        name, "dataset declares more rows than the file stores",
+        path + ": " + std::to_string(rows) + " rows in " + std::to_string(stored) + " bytes");
+}
+
 // ---------------------------------------------------------------- appendable dataset
 
 struct Appendable {
@@ -331,10 +384,16 @@ struct Appendable {
   }
 };
 
-template <class T, class F>
-std::vector<T> gather(const std::size_t n, std::size_t width, F&& fill) {
-  std::vector<T> v(n * width);
-  for (std::size_t i = 0; i < n; ++i) fill(i, v.data() + i * width);
+/// `width` values of T per row, over the rows `rows_of(frame)` of `nf` frames in order.
+template <class T, class Rows, class F>
+std::vector<T> gather_rows(const Frame* fr, std::size_t nf, std::size_t width, Rows rows_of,
+                           F fill) {
+  std::size_t total = 0;
+  for (std::size_t j = 0; j < nf; ++j) total += rows_of(fr[j]).size();
+  std::vector<T> v(total * width);
+  std::size_t at = 0;
+  for (std::size_t j = 0; j < nf; ++j)
+    for (const auto& r : rows_of(fr[j])) fill(r, &v[width * at++]);
   return v;
 }
 
@@ -465,97 +524,167 @@ struct TrajectoryWriter::Impl {
       throw InputError(name(), "cannot write attribute", "schema_version");
   }
 
-  void append(const Frame& f) {
+  /// Appends `nf` frames: each dataset is extended and written once for the whole batch (10^6
+  /// frames convert in linear time), the commit marker /frames/end last.
+  void append(const Frame* fr, std::size_t nf) {
+    if (nf == 0) return;
     const std::string n = name();
-    const auto& P = f.particles;
-    const auto& C = f.contacts;
-    const auto& W = f.walls;
-    const auto& K = f.clumps;
-    const std::size_t np = P.size(), nc = C.size(), nw = W.size(), nk = K.size();
-    auto wr = [&](int col, const auto& vec, std::size_t rows) {
-      ds[col].append(vec.data(), rows, n);
+    const auto P = [](const Frame& f) -> const auto& {
+      return f.particles;
     };
-    wr(P_ID, gather<std::int64_t>(np, 1, [&](auto i, auto* o) { *o = P[i].id; }), np);
-    wr(P_POS, gather<double>(np, 3, [&](auto i, auto* o) { put3(o, P[i].position); }), np);
-    wr(P_RAD, gather<double>(np, 1, [&](auto i, auto* o) { *o = P[i].radius; }), np);
-    wr(P_VEL, gather<double>(np, 3, [&](auto i, auto* o) { put3(o, P[i].velocity); }), np);
-    wr(P_ANGVEL, gather<double>(np, 3, [&](auto i, auto* o) { put3(o, P[i].angular_velocity); }),
-       np);
-    wr(P_ORI, gather<double>(np, 4, [&](auto i, auto* o) { put_quat(o, P[i].orientation); }), np);
-    wr(P_ROT, gather<double>(np, 3, [&](auto i, auto* o) { put3(o, P[i].rotation); }), np);
-    wr(P_MASS, gather<double>(np, 1, [&](auto i, auto* o) { *o = P[i].mass; }), np);
-    wr(P_CLUMP, gather<std::int64_t>(np, 1, [&](auto i, auto* o) { *o = P[i].clump_id; }), np);
-    wr(P_MAT, gather<std::int32_t>(np, 1, [&](auto i, auto* o) { *o = P[i].material_id; }), np);
+    const auto C = [](const Frame& f) -> const auto& {
+      return f.contacts;
+    };
+    const auto W = [](const Frame& f) -> const auto& {
+      return f.walls;
+    };
+    const auto K = [](const Frame& f) -> const auto& {
+      return f.clumps;
+    };
+    const auto L = [](const Frame& f) -> const auto& {
+      return f.facet_loads;
+    };
+    auto wr = [&](int col, const auto& vec, std::size_t width) {
+      ds[col].append(vec.data(), vec.size() / width, n);
+    };
+    wr(P_ID, gather_rows<std::int64_t>(fr, nf, 1, P, [](const auto& r, auto* o) { *o = r.id; }), 1);
+    wr(P_POS,
+       gather_rows<double>(fr, nf, 3, P, [](const auto& r, auto* o) { put3(o, r.position); }), 3);
+    wr(P_RAD, gather_rows<double>(fr, nf, 1, P, [](const auto& r, auto* o) { *o = r.radius; }), 1);
+    wr(P_VEL,
+       gather_rows<double>(fr, nf, 3, P, [](const auto& r, auto* o) { put3(o, r.velocity); }), 3);
+    wr(P_ANGVEL,
+       gather_rows<double>(fr, nf, 3, P,
+                           [](const auto& r, auto* o) { put3(o, r.angular_velocity); }),
+       3);
+    wr(P_ORI,
+       gather_rows<double>(fr, nf, 4, P,
+                           [](const auto& r, auto* o) { put_quat(o, r.orientation); }),
+       4);
+    wr(P_ROT,
+       gather_rows<double>(fr, nf, 3, P, [](const auto& r, auto* o) { put3(o, r.rotation); }), 3);
+    wr(P_MASS, gather_rows<double>(fr, nf, 1, P, [](const auto& r, auto* o) { *o = r.mass; }), 1);
+    wr(P_CLUMP,
+       gather_rows<std::int64_t>(fr, nf, 1, P, [](const auto& r, auto* o) { *o = r.clump_id; }), 1);
+    wr(P_MAT,
+       gather_rows<std::int32_t>(fr, nf, 1, P, [](const auto& r, auto* o) { *o = r.material_id; }),
+       1);
 
-    wr(C_ID1, gather<std::int64_t>(nc, 1, [&](auto i, auto* o) { *o = C[i].id1; }), nc);
-    wr(C_ID2, gather<std::int64_t>(nc, 1, [&](auto i, auto* o) { *o = C[i].id2; }), nc);
-    wr(C_POINT, gather<double>(nc, 3, [&](auto i, auto* o) { put3(o, C[i].point); }), nc);
-    wr(C_NORMAL, gather<double>(nc, 3, [&](auto i, auto* o) { put3(o, C[i].normal); }), nc);
-    wr(C_FN, gather<double>(nc, 3, [&](auto i, auto* o) { put3(o, C[i].normal_force); }), nc);
-    wr(C_FS, gather<double>(nc, 3, [&](auto i, auto* o) { put3(o, C[i].shear_force); }), nc);
-    wr(C_MB, gather<double>(nc, 3, [&](auto i, auto* o) { put3(o, C[i].bending_moment); }), nc);
-    wr(C_MT, gather<double>(nc, 3, [&](auto i, auto* o) { put3(o, C[i].twisting_moment); }), nc);
-    wr(C_OVERLAP, gather<double>(nc, 1, [&](auto i, auto* o) { *o = C[i].overlap; }), nc);
+    wr(C_ID1, gather_rows<std::int64_t>(fr, nf, 1, C, [](const auto& r, auto* o) { *o = r.id1; }),
+       1);
+    wr(C_ID2, gather_rows<std::int64_t>(fr, nf, 1, C, [](const auto& r, auto* o) { *o = r.id2; }),
+       1);
+    wr(C_POINT, gather_rows<double>(fr, nf, 3, C, [](const auto& r, auto* o) { put3(o, r.point); }),
+       3);
+    wr(C_NORMAL,
+       gather_rows<double>(fr, nf, 3, C, [](const auto& r, auto* o) { put3(o, r.normal); }), 3);
+    wr(C_FN,
+       gather_rows<double>(fr, nf, 3, C, [](const auto& r, auto* o) { put3(o, r.normal_force); }),
+       3);
+    wr(C_FS,
+       gather_rows<double>(fr, nf, 3, C, [](const auto& r, auto* o) { put3(o, r.shear_force); }),
+       3);
+    wr(C_MB,
+       gather_rows<double>(fr, nf, 3, C, [](const auto& r, auto* o) { put3(o, r.bending_moment); }),
+       3);
+    wr(C_MT,
+       gather_rows<double>(fr, nf, 3, C,
+                           [](const auto& r, auto* o) { put3(o, r.twisting_moment); }),
+       3);
+    wr(C_OVERLAP, gather_rows<double>(fr, nf, 1, C, [](const auto& r, auto* o) { *o = r.overlap; }),
+       1);
 
-    wr(W_ID, gather<std::int64_t>(nw, 1, [&](auto i, auto* o) { *o = W[i].id; }), nw);
+    wr(W_ID, gather_rows<std::int64_t>(fr, nf, 1, W, [](const auto& r, auto* o) { *o = r.id; }), 1);
     wr(W_KIND,
-       gather<std::int32_t>(nw, 1,
-                            [&](auto i, auto* o) { *o = static_cast<std::int32_t>(W[i].kind); }),
-       nw);
-    wr(W_A, gather<double>(nw, 3, [&](auto i, auto* o) { put3(o, W[i].a); }), nw);
-    wr(W_B, gather<double>(nw, 3, [&](auto i, auto* o) { put3(o, W[i].b); }), nw);
-    wr(W_FORCE, gather<double>(nw, 3, [&](auto i, auto* o) { put3(o, W[i].force); }), nw);
-    wr(W_TORQUE, gather<double>(nw, 3, [&](auto i, auto* o) { put3(o, W[i].torque); }), nw);
+       gather_rows<std::int32_t>(
+           fr, nf, 1, W, [](const auto& r, auto* o) { *o = static_cast<std::int32_t>(r.kind); }),
+       1);
+    wr(W_A, gather_rows<double>(fr, nf, 3, W, [](const auto& r, auto* o) { put3(o, r.a); }), 3);
+    wr(W_B, gather_rows<double>(fr, nf, 3, W, [](const auto& r, auto* o) { put3(o, r.b); }), 3);
+    wr(W_FORCE, gather_rows<double>(fr, nf, 3, W, [](const auto& r, auto* o) { put3(o, r.force); }),
+       3);
+    wr(W_TORQUE,
+       gather_rows<double>(fr, nf, 3, W, [](const auto& r, auto* o) { put3(o, r.torque); }), 3);
 
-    wr(K_ID, gather<std::int64_t>(nk, 1, [&](auto i, auto* o) { *o = K[i].id; }), nk);
+    wr(K_ID, gather_rows<std::int64_t>(fr, nf, 1, K, [](const auto& r, auto* o) { *o = r.id; }), 1);
     wr(K_TEMPLATE,
-       gather<char>(nk, kClumpTemplateBytes,
-                    [&](auto i, auto* o) {
-                      std::memcpy(o, K[i].template_name.data(), K[i].template_name.size());
-                    }),
-       nk);
-    wr(K_POS, gather<double>(nk, 3, [&](auto i, auto* o) { put3(o, K[i].position); }), nk);
-    wr(K_ORI, gather<double>(nk, 4, [&](auto i, auto* o) { put_quat(o, K[i].orientation); }), nk);
-    wr(K_VEL, gather<double>(nk, 3, [&](auto i, auto* o) { put3(o, K[i].velocity); }), nk);
-    wr(K_ANGVEL, gather<double>(nk, 3, [&](auto i, auto* o) { put3(o, K[i].angular_velocity); }),
-       nk);
-    wr(K_MASS, gather<double>(nk, 1, [&](auto i, auto* o) { *o = K[i].mass; }), nk);
-    wr(K_INERTIA, gather<double>(nk, 3, [&](auto i, auto* o) { put3(o, K[i].principal_inertia); }),
-       nk);
+       gather_rows<char>(fr, nf, kClumpTemplateBytes, K,
+                         [](const auto& r, auto* o) {
+                           std::memcpy(o, r.template_name.data(), r.template_name.size());
+                         }),
+       kClumpTemplateBytes);
+    wr(K_POS,
+       gather_rows<double>(fr, nf, 3, K, [](const auto& r, auto* o) { put3(o, r.position); }), 3);
+    wr(K_ORI,
+       gather_rows<double>(fr, nf, 4, K,
+                           [](const auto& r, auto* o) { put_quat(o, r.orientation); }),
+       4);
+    wr(K_VEL,
+       gather_rows<double>(fr, nf, 3, K, [](const auto& r, auto* o) { put3(o, r.velocity); }), 3);
+    wr(K_ANGVEL,
+       gather_rows<double>(fr, nf, 3, K,
+                           [](const auto& r, auto* o) { put3(o, r.angular_velocity); }),
+       3);
+    wr(K_MASS, gather_rows<double>(fr, nf, 1, K, [](const auto& r, auto* o) { *o = r.mass; }), 1);
+    wr(K_INERTIA,
+       gather_rows<double>(fr, nf, 3, K,
+                           [](const auto& r, auto* o) { put3(o, r.principal_inertia); }),
+       3);
 
-    const auto& L = f.facet_loads;
-    const hsize_t nl = L.size();
-    wr(L_WALL, gather<std::int64_t>(nl, 1, [&](auto i, auto* o) { *o = L[i].wall_id; }), nl);
-    wr(L_FACET, gather<std::int32_t>(nl, 1, [&](auto i, auto* o) { *o = L[i].facet; }), nl);
-    wr(L_CENTROID, gather<double>(nl, 3, [&](auto i, auto* o) { put3(o, L[i].centroid); }), nl);
-    wr(L_FORCE, gather<double>(nl, 3, [&](auto i, auto* o) { put3(o, L[i].force); }), nl);
+    wr(L_WALL,
+       gather_rows<std::int64_t>(fr, nf, 1, L, [](const auto& r, auto* o) { *o = r.wall_id; }), 1);
+    wr(L_FACET,
+       gather_rows<std::int32_t>(fr, nf, 1, L, [](const auto& r, auto* o) { *o = r.facet; }), 1);
+    wr(L_CENTROID,
+       gather_rows<double>(fr, nf, 3, L, [](const auto& r, auto* o) { put3(o, r.centroid); }), 3);
+    wr(L_FORCE, gather_rows<double>(fr, nf, 3, L, [](const auto& r, auto* o) { put3(o, r.force); }),
+       3);
 
-    const std::int8_t two_d = f.two_d ? 1 : 0, periodic = f.domain.periodic ? 1 : 0;
-    double lo[3], hi[3], cell[9];
-    put3(lo, f.domain.lo);
-    put3(hi, f.domain.hi);
-    for (int r = 0; r < 3; ++r)
-      for (int c = 0; c < 3; ++c) cell[r * 3 + c] = f.domain.cell(r, c);
-    ds[F_TIME].append(&f.time, 1, n);
-    ds[F_STEP].append(&f.step, 1, n);
-    ds[F_DT].append(&f.dt, 1, n);
-    ds[F_TWOD].append(&two_d, 1, n);
-    ds[F_LO].append(lo, 1, n);
-    ds[F_HI].append(hi, 1, n);
-    ds[F_PERIODIC].append(&periodic, 1, n);
-    ds[F_CELL].append(cell, 1, n);
-    const auto clump_end = static_cast<std::int64_t>(ds[K_ID].rows);
-    ds[F_CLUMP_END].append(&clump_end, 1, n);
-    const auto facet_end = static_cast<std::int64_t>(ds[L_WALL].rows);
-    ds[F_FACET_END].append(&facet_end, 1, n);
+    std::vector<double> time(nf), dt(nf), lo(3 * nf), hi(3 * nf), cell(9 * nf);
+    std::vector<std::int64_t> step(nf), clump_end(nf), facet_end(nf), end(3 * nf);
+    std::vector<std::int8_t> two_d(nf), periodic(nf);
+    // The row counts before this batch were taken from the datasets just written.
+    std::int64_t rows[5] = {
+        static_cast<std::int64_t>(ds[P_ID].rows), static_cast<std::int64_t>(ds[C_ID1].rows),
+        static_cast<std::int64_t>(ds[W_ID].rows), static_cast<std::int64_t>(ds[K_ID].rows),
+        static_cast<std::int64_t>(ds[L_WALL].rows)};
+    for (std::size_t j = nf; j-- > 0;) {  // back from the totals
+      const Frame& f = fr[j];
+      time[j] = f.time;
+      step[j] = f.step;
+      dt[j] = f.dt;
+      two_d[j] = f.two_d ? 1 : 0;
+      periodic[j] = f.domain.periodic ? 1 : 0;
+      put3(&lo[3 * j], f.domain.lo);
+      put3(&hi[3 * j], f.domain.hi);
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c) cell[9 * j + r * 3 + c] = f.domain.cell(r, c);
+      end[3 * j] = rows[0];
+      end[3 * j + 1] = rows[1];
+      end[3 * j + 2] = rows[2];
+      clump_end[j] = rows[3];
+      facet_end[j] = rows[4];
+      rows[0] -= static_cast<std::int64_t>(f.particles.size());
+      rows[1] -= static_cast<std::int64_t>(f.contacts.size());
+      rows[2] -= static_cast<std::int64_t>(f.walls.size());
+      rows[3] -= static_cast<std::int64_t>(f.clumps.size());
+      rows[4] -= static_cast<std::int64_t>(f.facet_loads.size());
+    }
+    ds[F_TIME].append(time.data(), nf, n);
+    ds[F_STEP].append(step.data(), nf, n);
+    ds[F_DT].append(dt.data(), nf, n);
+    ds[F_TWOD].append(two_d.data(), nf, n);
+    ds[F_LO].append(lo.data(), nf, n);
+    ds[F_HI].append(hi.data(), nf, n);
+    ds[F_PERIODIC].append(periodic.data(), nf, n);
+    ds[F_CELL].append(cell.data(), nf, n);
+    ds[F_CLUMP_END].append(clump_end.data(), nf, n);
+    ds[F_FACET_END].append(facet_end.data(), nf, n);
     flush();
-    // Commit marker: the frame exists for readers once its end offsets are on disk.
-    const std::int64_t end[3] = {static_cast<std::int64_t>(ds[P_ID].rows),
-                                 static_cast<std::int64_t>(ds[C_ID1].rows),
-                                 static_cast<std::int64_t>(ds[W_ID].rows)};
-    ds[F_END].append(end, 1, n);
+    // Commit marker: the frames exist for readers once their end offsets are on disk.
+    ds[F_END].append(end.data(), nf, n);
     flush();
-    ++frames;
+    frames += nf;
   }
 
   void close() {
@@ -573,6 +702,7 @@ TrajectoryWriter::TrajectoryWriter(std::filesystem::path path, const RunMetadata
                                    Options options)
     : impl_(std::make_unique<Impl>()) {
   impl_->final_path = std::move(path);
+  check_not_an_input(impl_->final_path);
   impl_->file_path = partial_path(impl_->final_path);
   impl_->options = options;
   try {
@@ -668,15 +798,28 @@ TrajectoryWriter::~TrajectoryWriter() {
   }
 }
 
-void TrajectoryWriter::append(const Frame& frame) {
-  const std::string name = impl_->final_path.string();
+namespace {
+// What append() refuses before any row is written.
+void check_appendable(const Frame& frame, const std::string& name) {
   validate_frame(frame, name);
-  for (const auto& k : frame.clumps)  // before any row is written
+  for (const auto& k : frame.clumps)
     if (k.template_name.size() > kClumpTemplateBytes)
       throw InputError(
           name, "clump template name longer than " + std::to_string(kClumpTemplateBytes) + " bytes",
           k.template_name);
-  impl_->append(frame);
+}
+}  // namespace
+
+void TrajectoryWriter::append(const Frame& frame) {
+  check_appendable(frame, impl_->final_path.string());
+  impl_->append(&frame, 1);
+}
+
+void TrajectoryWriter::append(const std::vector<Frame>& frames) {
+  for (const auto& f : frames) check_appendable(f, impl_->final_path.string());
+  constexpr std::size_t kBatch = 4096;  // frames per write: bounded memory, one flush per batch
+  for (std::size_t b = 0; b < frames.size(); b += kBatch)
+    impl_->append(frames.data() + b, std::min(kBatch, frames.size() - b));
 }
 
 std::size_t TrajectoryWriter::frames_written() const {
@@ -685,10 +828,7 @@ std::size_t TrajectoryWriter::frames_written() const {
 
 void TrajectoryWriter::finish() {
   impl_->close();
-  std::error_code ec;
-  std::filesystem::rename(impl_->file_path, impl_->final_path, ec);
-  if (ec)
-    throw InputError(impl_->final_path.string(), "cannot rename output into place", ec.message());
+  rename_durably(impl_->file_path, impl_->final_path);
   impl_->finished = true;
 }
 
@@ -747,6 +887,7 @@ struct TrajectoryReader::Impl {
           Hid(H5Fopen(file_name.c_str(), H5F_ACC_RDONLY | H5F_ACC_SWMR_READ, fapl.get()), H5Fclose);
     }
     if (!file.valid()) throw InputError(file_name, "cannot open HDF5 file (corrupt or truncated)");
+    note_input(path);
 
     // Root attributes.
     auto attr_string = [&](const char* nm) {
@@ -764,6 +905,7 @@ struct TrajectoryReader::Impl {
     meta.code_version = attr_string("code_version");
     meta.provenance = attr_string("provenance");
     {
+      require_hard_links(file.get(), "/metadata", file_name);
       Hid g(H5Gopen2(file.get(), "metadata", H5P_DEFAULT), H5Gclose);
       if (!g.valid()) throw InputError(file_name, "missing group", "/metadata");
       H5O_info_t info;
@@ -794,6 +936,7 @@ struct TrajectoryReader::Impl {
     for (int i = 0; i < N_COLS; ++i) {
       const auto& c = columns()[i];
       if (!has(i)) continue;  // added after this file's schema_version: no rows
+      require_hard_links(file.get(), col_path(c), file_name);
       ds[i] = Hid(H5Dopen2(file.get(), col_path(c).c_str(), H5P_DEFAULT), H5Dclose);
       if (!ds[i].valid()) throw InputError(file_name, "missing dataset", col_path(c));
       Hid space(H5Dget_space(ds[i].get()), H5Sclose);
@@ -812,6 +955,8 @@ struct TrajectoryReader::Impl {
       const H5T_class_t want = is_string(c) ? H5T_STRING : want_float ? H5T_FLOAT : H5T_INTEGER;
       if (cls != want || (is_string(c) && H5Tis_variable_str(type.get()) > 0))
         throw InputError(file_name, "dataset has wrong type", col_path(c));
+      check_dataset_storage(ds[i].get(), dims[0], row_width(c) * H5Tget_size(c.mem_type()),
+                            col_path(c), file_name);
       rows[i] = dims[0];
     }
     n = rows[F_END];
@@ -1038,7 +1183,7 @@ Trajectory read_hdf5_trajectory(const std::filesystem::path& path) {
 
 void write_hdf5_trajectory(const std::filesystem::path& path, const Trajectory& trajectory) {
   TrajectoryWriter w(path, trajectory.metadata, TrajectoryWriter::Options{});
-  for (const auto& f : trajectory.frames) w.append(f);
+  w.append(trajectory.frames);
   w.finish();
 }
 

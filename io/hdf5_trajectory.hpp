@@ -45,6 +45,9 @@ class TrajectoryWriter {
 
   /// Appends one frame and flushes it to disk.
   void append(const Frame& frame);
+  /// Appends frames in batches (each dataset written once per batch, one flush per batch): the
+  /// way to write a whole trajectory in time linear in its length.
+  void append(const std::vector<Frame>& frames);
   std::size_t frames_written() const;
   /// Closes the file and renames `<path>.partial` to `<path>`.
   void finish();

@@ -19,6 +19,7 @@ struct Block {
   std::vector<std::string> columns;
   std::vector<std::vector<std::string_view>> rows;
   std::size_t first_row_line = 0;
+  std::size_t line = 0;  // of its ITEM: TIMESTEP
 };
 
 // Parses ITEM: blocks. `entries_item` is "ATOMS" (custom dump) or "ENTRIES" (local dump).
@@ -42,6 +43,7 @@ std::vector<Block> parse_blocks(const std::string& text, const std::string& name
       throw InputError(name, "line " + std::to_string(i + 1) + ": expected ITEM: TIMESTEP",
                        std::string(l.substr(0, 40)));
     Block b;
+    b.line = i + 1;
     b.step = text::to_int(text::trim(need_line(i + 1)), name, i + 2, "timestep");
     i += 2;
     const std::string count_hdr = std::string("ITEM: NUMBER OF ") + count_item;
@@ -87,6 +89,17 @@ std::vector<Block> parse_blocks(const std::string& text, const std::string& name
     blocks.push_back(std::move(b));
   }
   if (blocks.empty()) throw InputError(name, "no ITEM: TIMESTEP block (not a LIGGGHTS dump)");
+  // Frames (and the pairs matched to them) are keyed by timestep: a repeated one would put every
+  // pair on the last frame of that step.
+  std::map<std::int64_t, std::size_t> seen;
+  for (const auto& b : blocks) {
+    const auto [it, fresh] = seen.emplace(b.step, b.line);
+    if (!fresh)
+      throw InputError(name,
+                       "line " + std::to_string(b.line) + ": timestep repeats the block at line " +
+                           std::to_string(it->second),
+                       std::to_string(b.step));
+  }
   return blocks;
 }
 

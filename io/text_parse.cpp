@@ -6,6 +6,7 @@
 #include <fstream>
 #include <system_error>
 
+#include "atomic_file.hpp"
 #include "errors.hpp"
 
 namespace gs::text {
@@ -20,6 +21,7 @@ std::string read_file_bytes(const std::filesystem::path& path, std::size_t max_b
   if (size > max_bytes) throw InputError(name, "file too large", std::to_string(size) + " bytes");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(name, "cannot open file");
+  note_input(path);
   std::string s(size, '\0');
   in.read(s.data(), static_cast<std::streamsize>(size));
   if (static_cast<std::size_t>(in.gcount()) != size) throw InputError(name, "short read");
@@ -29,6 +31,8 @@ std::string read_file_bytes(const std::filesystem::path& path, std::size_t max_b
 std::string read_text_file(const std::filesystem::path& path, std::size_t max_bytes) {
   const std::string name = path.string();
   std::string s = read_file_bytes(path, max_bytes);
+  // A UTF-8 byte-order mark (spreadsheets write one) is not part of the first field.
+  if (s.rfind("\xEF\xBB\xBF", 0) == 0) s.erase(0, 3);
   if (s.find('\0') != std::string::npos)
     throw InputError(name, "binary content in a text file",
                      "NUL byte at offset " + std::to_string(s.find('\0')));

@@ -11,7 +11,7 @@
 namespace gs::text {
 
 /// Whole file as text. Throws InputError for a missing file, a directory, a file over
-/// `max_bytes`, or binary content (NUL bytes).
+/// `max_bytes`, or binary content (NUL bytes). A leading UTF-8 byte-order mark is dropped.
 std::string read_text_file(const std::filesystem::path& path, std::size_t max_bytes = 1ull << 32);
 /// The whole file as bytes (binary allowed), with read_text_file's checks and messages.
 std::string read_file_bytes(const std::filesystem::path& path, std::size_t max_bytes = 1ull << 32);

@@ -1,6 +1,7 @@
 #include "trajectory_io.hpp"
 
 #include <fstream>
+#include <new>
 
 #include "errors.hpp"
 #include "hdf5_trajectory.hpp"
@@ -67,7 +68,8 @@ SnapshotFormat output_format(const std::filesystem::path& path) {
                    e.empty() ? "no extension" : e);
 }
 
-Trajectory read_snapshots(const std::filesystem::path& path, const ImportOptions& opt) {
+namespace {
+Trajectory read_any(const std::filesystem::path& path, const ImportOptions& opt) {
   const std::string name = path.string();
   auto single = [&](Frame f, const std::string& provenance) {
     Trajectory t;
@@ -102,6 +104,15 @@ Trajectory read_snapshots(const std::filesystem::path& path, const ImportOptions
     }
   }
   throw InputError(name, "unknown file type");
+}
+}  // namespace
+
+Trajectory read_snapshots(const std::filesystem::path& path, const ImportOptions& opt) {
+  try {
+    return read_any(path, opt);
+  } catch (const std::bad_alloc&) {  // the readers bound what a file may claim; this is the rest
+    throw InputError(path.string(), "not enough memory to read the file");
+  }
 }
 
 void write_snapshots(const std::filesystem::path& path, const Trajectory& t, long frame) {

@@ -19,9 +19,11 @@
 #include <limits>
 #include <regex>
 
+#include "atomic_file.hpp"
 #include "errors.hpp"
 #include "text_parse.hpp"
 #include "vtk_io.hpp"
+#include "vtk_xml_check.hpp"
 
 namespace gs {
 
@@ -47,6 +49,8 @@ void run_reader(Reader* r, const std::filesystem::path& path) {
   std::error_code ec;
   if (!std::filesystem::exists(path, ec)) throw InputError(name, "no such file");
   if (!std::filesystem::is_regular_file(path, ec)) throw InputError(name, "not a regular file");
+  check_vtk_xml_structure(path);  // what VTK would trust: counts, sizes, nesting
+  note_input(path);
   ErrorSink sink;
   vtkNew<vtkCallbackCommand> cb;
   cb->SetCallback(&ErrorSink::on_error);
@@ -54,7 +58,11 @@ void run_reader(Reader* r, const std::filesystem::path& path) {
   r->AddObserver(vtkCommand::ErrorEvent, cb);
   r->AddObserver(vtkCommand::WarningEvent, cb);
   r->SetFileName(name.c_str());
-  r->Update();
+  try {
+    r->Update();
+  } catch (const std::bad_alloc&) {
+    throw InputError(name, "not enough memory to read the file");
+  }
   if (!sink.first.empty() || r->GetErrorCode() != 0)
     throw InputError(name, "cannot read VTK XML file",
                      sink.first.empty() ? "reader error" : sink.first);
@@ -243,6 +251,11 @@ Trajectory read_pvd_series(const std::filesystem::path& pvd_path) {
     const std::string xml = text::read_text_file(p, 1u << 26);
     if (xml.find("<VTKFile") == std::string::npos || xml.find("Collection") == std::string::npos)
       throw InputError(p.string(), "not a ParaView collection (.pvd)");
+    // A collection cut short lists only some of its frames: it must close.
+    if (xml.find("</Collection>") == std::string::npos ||
+        xml.find("</VTKFile>") == std::string::npos)
+      throw InputError(p.string(),
+                       "truncated collection (no closing </Collection> and </VTKFile>)");
     std::vector<std::pair<double, std::filesystem::path>> out;
     static const std::regex ds(R"(<DataSet\b([^>]*)>)");
     static const std::regex ts(R"(timestep\s*=\s*"([^"]*)\")"), fl(R"(file\s*=\s*"([^"]*)\")");

@@ -1,9 +1,13 @@
 // ParaView output through VTK's XML writers (binary appended, zlib, Float64/Int64 arrays).
+#include <vtkCallbackCommand.h>
 #include <vtkCellArray.h>
 #include <vtkCellData.h>
+#include <vtkCommand.h>
 #include <vtkDoubleArray.h>
+#include <vtkErrorCode.h>
 #include <vtkFieldData.h>
 #include <vtkIntArray.h>
+#include <vtkLogger.h>
 #include <vtkNew.h>
 #include <vtkPointData.h>
 #include <vtkPoints.h>
@@ -18,6 +22,7 @@
 #include <cstdio>
 #include <fstream>
 #include <map>
+#include <memory>
 #include <unordered_map>
 
 #include "atomic_file.hpp"
@@ -43,14 +48,40 @@ void add_field(vtkFieldData* fd, const char* name, std::initializer_list<double>
   fd->AddArray(a);
 }
 
+// VTK's own error output (several lines through vtkOutputWindow and vtkLogger) is silenced; the
+// first message becomes part of our one line.
+struct WriterErrors {
+  std::string first;
+  static void on_error(vtkObject*, unsigned long, void* client, void* call) {
+    auto* self = static_cast<WriterErrors*>(client);
+    if (self->first.empty() && call) {
+      std::string m = static_cast<const char*>(call);
+      m = m.substr(0, m.find('\n'));
+      self->first = m.substr(0, 160);
+    }
+  }
+};
+
 template <class Writer>
 void write_xml(Writer* w, const std::filesystem::path& path) {
+  vtkObject::GlobalWarningDisplayOff();
+  vtkLogger::SetStderrVerbosity(vtkLogger::VERBOSITY_OFF);
   AtomicOutput out(path);
+  WriterErrors sink;
+  vtkNew<vtkCallbackCommand> cb;
+  cb->SetCallback(&WriterErrors::on_error);
+  cb->SetClientData(&sink);
+  w->AddObserver(vtkCommand::ErrorEvent, cb);
   w->SetFileName(out.temp_path().c_str());
   w->SetDataModeToAppended();
   w->EncodeAppendedDataOff();
   w->SetCompressorTypeToZLib();
-  if (w->Write() != 1) throw InputError(path.string(), "VTK writer failed");
+  const int ok = w->Write();
+  if (ok != 1 || w->GetErrorCode() != 0 || !sink.first.empty())
+    throw InputError(path.string(), "VTK writer failed",
+                     w->GetErrorCode() != 0
+                         ? std::string(vtkErrorCode::GetStringFromErrorCode(w->GetErrorCode()))
+                         : (sink.first.empty() ? std::string("write error") : sink.first));
   out.commit();
 }
 
@@ -229,11 +260,12 @@ std::filesystem::path clumps_sibling(const std::filesystem::path& path) {
 
 namespace {
 
-void write_pvd_file(const std::filesystem::path& path,
-                    const std::vector<std::pair<double, std::string>>& entries) {
-  AtomicOutput out(path);
+/// The collection under a temporary name; the caller commits it.
+std::unique_ptr<AtomicOutput> write_pvd_file(
+    const std::filesystem::path& path, const std::vector<std::pair<double, std::string>>& entries) {
+  auto out = std::make_unique<AtomicOutput>(path);
   {
-    std::ofstream o(out.temp_path());
+    std::ofstream o(out->temp_path());
     o << "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n  <Collection>\n";
     char buf[64];
     for (const auto& [t, file] : entries) {
@@ -243,7 +275,7 @@ void write_pvd_file(const std::filesystem::path& path,
     o << "  </Collection>\n</VTKFile>\n";
     if (!o.flush()) throw InputError(path.string(), "write failed");
   }
-  out.commit();
+  return out;
 }
 
 }  // namespace
@@ -269,27 +301,35 @@ void write_pvd_series(const std::filesystem::path& pvd_path, const Trajectory& t
   } cleanup{tmp_dir.temp_path()};
   std::vector<std::pair<double, std::string>> pe, ce, ke;
   char name[64];
-  for (std::size_t i = 0; i < t.frames.size(); ++i) {
-    std::snprintf(name, sizeof name, "particles_%06zu.vtu", i);
-    write_vtu_particles(tmp_dir.temp_path() / name, t.frames[i]);
-    pe.emplace_back(t.frames[i].time, dir_name + "/" + name);
-    std::snprintf(name, sizeof name, "contacts_%06zu.vtp", i);
-    write_vtp_contacts(tmp_dir.temp_path() / name, t.frames[i]);
-    ce.emplace_back(t.frames[i].time, dir_name + "/" + name);
-    if (!any_clumps) continue;
-    std::snprintf(name, sizeof name, "clumps_%06zu.vtu", i);
-    write_vtu_clumps(tmp_dir.temp_path() / name, t.frames[i]);
-    ke.emplace_back(t.frames[i].time, dir_name + "/" + name);
-  }
+  for (std::size_t i = 0; i < t.frames.size(); ++i) try {
+      std::snprintf(name, sizeof name, "particles_%06zu.vtu", i);
+      write_vtu_particles(tmp_dir.temp_path() / name, t.frames[i]);
+      pe.emplace_back(t.frames[i].time, dir_name + "/" + name);
+      std::snprintf(name, sizeof name, "contacts_%06zu.vtp", i);
+      write_vtp_contacts(tmp_dir.temp_path() / name, t.frames[i]);
+      ce.emplace_back(t.frames[i].time, dir_name + "/" + name);
+      if (!any_clumps) continue;
+      std::snprintf(name, sizeof name, "clumps_%06zu.vtu", i);
+      write_vtu_clumps(tmp_dir.temp_path() / name, t.frames[i]);
+      ke.emplace_back(t.frames[i].time, dir_name + "/" + name);
+    } catch (const InputError& e) {
+      throw with_dir_renamed(e, tmp_dir.temp_path(), dir);  // named as the directory it stands for
+    }
+  // Everything is written under temporary names before anything is renamed (a full disk leaves
+  // no file under its final name).
+  const auto contacts = write_pvd_file(contacts_pvd, ce);
+  const auto clumps = any_clumps ? write_pvd_file(clumps_pvd, ke) : nullptr;
+  const auto particles = write_pvd_file(pvd_path, pe);
+  sync_to_disk(tmp_dir.temp_path());
   std::filesystem::remove_all(dir, ec);
   tmp_dir.commit();
   cleanup.armed = false;
-  write_pvd_file(contacts_pvd, ce);
-  if (any_clumps)
-    write_pvd_file(clumps_pvd, ke);
+  contacts->commit();
+  if (clumps)
+    clumps->commit();
   else
     std::filesystem::remove(clumps_pvd, ec);  // a stale series would name files just replaced
-  write_pvd_file(pvd_path, pe);
+  particles->commit();
 }
 
 }  // namespace gs

@@ -2,6 +2,7 @@
 
 #include <toml++/toml.h>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <iterator>
 #include <map>
@@ -449,6 +450,54 @@ void read_fill(const Reader& r, Scene& s) {
 
 }  // namespace
 
+namespace {
+// Two spheres at one centre have no contact normal: the engine skips the pair and they pass
+// through each other without a word. (Members of one clump may share a centre.)
+void check_distinct_centres(const Reader& r, const std::vector<Particle>& particles) {
+  // Members of one clump may share a centre.
+  std::map<std::array<double, 3>, const Particle*> at;
+  for (const auto& p : particles) {
+    const auto [it, fresh] =
+        at.emplace(std::array<double, 3>{p.position.x(), p.position.y(), p.position.z()}, &p);
+    const Particle& q = *it->second;
+    if (fresh || (p.clump_id >= 0 && p.clump_id == q.clump_id)) continue;
+    r.fail("particles",
+           "particles " + std::to_string(q.id) + " and " + std::to_string(p.id) +
+               " have the same centre",
+           value_str(p.position.x()) + ", " + value_str(p.position.y()) + ", " +
+               value_str(p.position.z()));
+  }
+}
+
+// Outputs stay inside the output directory, and none replaces another: each is a plain file
+// name (no directory part, no "..", not empty), all distinct, and none is the checkpoint index.
+// Checked before anything runs (a clash used to show only after the whole run; an absolute
+// trajectory path replaced a file anywhere on disk).
+void check_output_names(const Reader& r, const Scene& s) {
+  auto plain = [&](const std::string& key, const std::string& v) {
+    if (v.empty()) r.fail(key, "must not be empty");
+    if (v.find('/') != std::string::npos || v.find('\\') != std::string::npos || v == "." ||
+        v == ".." || v.find('\0') != std::string::npos)
+      r.fail(key, "must be a file name inside the output directory (no directory part)", v);
+  };
+  plain("scene.name", s.name);
+  const std::vector<std::pair<std::string, std::string>> outs = {
+      {"output.trajectory", s.output.trajectory},
+      {"output.history", s.output.history},
+      {"output.curve", s.output.curve},
+      {"output.specimen", s.output.specimen},
+      {"output.preparation", s.output.preparation},
+      {"(checkpoint index)", "checkpoint.txt"}};
+  for (std::size_t i = 0; i < outs.size(); ++i) {
+    if (i + 1 < outs.size()) plain(outs[i].first, outs[i].second);
+    for (std::size_t j = 0; j < i; ++j)
+      if (outs[i].second == outs[j].second)
+        r.fail(outs[i].first, "names the same file as " + outs[j].first, outs[i].second);
+  }
+}
+
+}  // namespace
+
 Scene load_scene(const std::filesystem::path& path) {
   const std::string file = path.string();
   std::error_code ec;
@@ -569,7 +618,11 @@ Scene load_scene(const std::filesystem::path& path) {
     r.fail("solver.damping", "outside [0, 1)", value_str(s.config.damping));
   s.config.gravity = r.vec3(sol, "solver", "gravity_m_s2", false, Eigen::Vector3d::Zero());
   s.steps = r.integer(sol, "solver", "steps", s.test.empty(), 0, 0);
-  s.config.threads = static_cast<int>(r.integer(sol, "solver", "threads", false, 1, 1));
+  const std::int64_t threads = r.integer(sol, "solver", "threads", false, 1, 1);
+  if (threads > kMaxThreads)
+    r.fail("solver.threads", "must be at most " + std::to_string(kMaxThreads),
+           std::to_string(threads));
+  s.config.threads = static_cast<int>(threads);
   s.config.skin = r.number(sol, "solver", "skin_m", false, 0);
   s.config.max_overlap_ratio = r.positive(sol, "solver", "max_overlap_ratio", false, 0.1);
   s.config.max_energy_residual = r.positive(sol, "solver", "max_energy_residual", false, 0.2);
@@ -590,6 +643,7 @@ Scene load_scene(const std::filesystem::path& path) {
   s.output.curve_every = r.integer(out, "output", "curve_every", false, s.output.curve_every, 1);
   s.output.specimen = r.string(out, "output", "specimen", false, s.output.specimen);
   s.output.preparation = r.string(out, "output", "preparation", false, s.output.preparation);
+  check_output_names(r, s);
   if (out && out->contains("facet_forces")) {
     const auto* v = (*out)["facet_forces"].as_boolean();
     if (!v) r.fail("output.facet_forces", "expected true or false");
@@ -801,10 +855,43 @@ Scene load_scene(const std::filesystem::path& path) {
   }
   if (!s.open_after_fill.empty() && !s.fill)
     r.fail("[[mesh]].off_after_fill", "there is no [fill] section");
+  // (The particles of a [fill] are placed later, layer by layer.)
+  check_distinct_centres(
+      r, {s.particles.begin(), s.particles.begin() + (s.fill ? s.fill_first : s.particles.size())});
   std::ostringstream flat;
   flat << root;
   s.parameters.emplace_back("scene.toml", flat.str());
   return s;
+}
+
+namespace {
+void flatten(const toml::table& t, const std::string& prefix,
+             std::map<std::string, std::string>& out) {
+  for (const auto& [k, v] : t) {
+    const std::string key =
+        prefix.empty() ? std::string(k.str()) : prefix + "." + std::string(k.str());
+    if (const auto* sub = v.as_table()) {
+      flatten(*sub, key, out);
+    } else {
+      std::ostringstream os;
+      v.visit([&](auto&& x) { os << x; });
+      out[key] = os.str();
+    }
+  }
+}
+}  // namespace
+
+std::vector<std::string> scene_differences(const std::string& a, const std::string& b) {
+  std::map<std::string, std::string> fa, fb;
+  flatten(toml::parse(a), "", fa);
+  flatten(toml::parse(b), "", fb);
+  std::vector<std::string> keys;
+  for (const auto& [k, v] : fa)
+    if (!fb.count(k) || fb.at(k) != v) keys.push_back(k);
+  for (const auto& [k, v] : fb)
+    if (!fa.count(k)) keys.push_back(k);
+  std::sort(keys.begin(), keys.end());
+  return keys;
 }
 
 }  // namespace gs::solver

@@ -22,6 +22,9 @@
 
 namespace gs::solver {
 
+/// The most threads a scene or `simulate --threads` may ask for (a million crashed the run).
+inline constexpr int kMaxThreads = 1024;
+
 struct OutputSpec {
   std::string trajectory = "trajectory.h5";
   std::int64_t every = 1000;            // steps between trajectory frames
@@ -123,5 +126,9 @@ class FixedSteps final : public LoadingProgramme {
 
 /// Reads and checks a scene file. Throws InputError "FILE: key: what (value)".
 Scene load_scene(const std::filesystem::path& path);
+
+/// Dotted keys whose values differ between two scenes given as TOML text (keys present in only
+/// one included), sorted. What `simulate --resume` compares with the scene of the run it resumes.
+std::vector<std::string> scene_differences(const std::string& a, const std::string& b);
 
 }  // namespace gs::solver

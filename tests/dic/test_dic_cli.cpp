@@ -458,6 +458,12 @@ TEST_F(DicCli, BadInputsGiveOneLineErrors) {
   expect_one_line_error(
       granoscope("dic " + p("ref.png") + " " + p("def.png") + " --subset 30 -o " + p("o.h5"), dir),
       "--subset: must be an odd number of px >= 5 (30)");
+  // Issue 15: a plane-fit window wider than the 15 x 13 POI grid gave all-NaN strains, exit 0.
+  const auto wide = granoscope("dic " + p("ref.png") + " " + p("def.png") +
+                                   " --subset 21 --step 4 --strain-window 15 -o " + p("o.h5"),
+                               dir);
+  EXPECT_EQ(wide.rc, 2);
+  EXPECT_EQ(wide.err, "error: --strain-window: larger than the POI grid (15 POIs; grid 15 x 13)\n");
   EXPECT_FALSE(fs::exists(dir / "o.h5"));
 }
 
@@ -467,9 +473,10 @@ TEST_F(DicCli, HelpListsTheOptionsWithTheirDefaults) {
   const CliRun dic = granoscope("dic --help", dir);
   EXPECT_EQ(dic.rc, 0);
   EXPECT_EQ(dic.err, "");
-  for (const char* opt : {"--subset INT=31", "--step INT=2", "--roi TEXT", "--incremental",
-                          "--strain-window INT=15", "--strain TEXT=green", "--zncc-min FLOAT=0.9",
-                          "--search INT=30", "--threads INT=0", "--no-csv", "--no-vtk"})
+  for (const char* opt :
+       {"--subset INT=31", "--step INT=2", "--roi TEXT", "--incremental", "--strain-window INT=15",
+        "--strain TEXT=green", "--zncc-min FLOAT=0.9", "--search INT=30",
+        "--threads INT:INT in [0 - 1024]=0", "--no-csv", "--no-vtk"})
     EXPECT_NE(dic.out.find(opt), std::string::npos) << opt << "\n" << dic.out;
   const CliRun render = granoscope("render --help", dir);
   EXPECT_EQ(render.rc, 0);
