@@ -26,6 +26,15 @@ void print_info(const std::string& file, const std::string& format, std::size_t 
               static_cast<long long>(s0), static_cast<long long>(s1));
   std::printf("bounding box: [%.6g, %.6g, %.6g] .. [%.6g, %.6g, %.6g] m (last frame)\n", lo.x(),
               lo.y(), lo.z(), hi.x(), hi.y(), hi.z());
+  if (last.domain.periodic) {
+    const Eigen::Matrix3d& h = last.domain.cell;
+    std::printf(
+        "cell:         periodic, H = [%.6g %.6g %.6g; %.6g %.6g %.6g; %.6g %.6g %.6g] m "
+        "(columns: base vectors), volume %.6g m^3 (last frame)\n",
+        h(0, 0), h(0, 1), h(0, 2), h(1, 0), h(1, 1), h(1, 2), h(2, 0), h(2, 1), h(2, 2),
+        h.determinant());
+  }
+  if (last.two_d) std::printf("dimension:    2D (in the xy plane)\n");
   if (!last.particles.empty())
     std::printf("d50:          %.6g m (by volume, last frame)\n", analysis::d50(last));
   std::printf("walls:        %zu\n", last.walls.size());

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <sstream>
 
@@ -112,6 +113,21 @@ TEST(SimulatePeriodic, YadePlanarCaseFromASceneFile) {
   EXPECT_LT(std::sqrt(diff / norm), 1e-9);
   EXPECT_EQ(hist.num(rh, "contacts"), ref.num(rr, "contacts"));
   EXPECT_EQ(hist.num(rh, "cell_hzz_m"), 0.008);
+  // `info` reports the cell and the dimension.
+  const auto info = dir / "info.txt";
+  ASSERT_EQ(std::system((kExe + " info " + (dir / "out" / "trajectory.h5").string() + " > " +
+                         info.string() + " 2>&1")
+                            .c_str()),
+            0);
+  const std::string text = slurp(info);
+  // (after 300 steps of L = diag(2, −2, 0)/s: H_xx = 0.0478324·(1 + 2·dt)^299 = 0.0479168, …)
+  char cell_line[160];
+  std::snprintf(cell_line, sizeof cell_line,
+                "cell:         periodic, H = [%.6g 0 0; 0 %.6g 0; 0 0 0.008] m",
+                0.04783235800060865 * std::pow(1 + 2 * 2.95e-6, 299),
+                0.04783235800060865 * std::pow(1 - 2 * 2.95e-6, 299));
+  EXPECT_NE(text.find(cell_line), std::string::npos) << cell_line << "\n" << text;
+  EXPECT_NE(text.find("dimension:    2D"), std::string::npos) << text;
   // Frames carry the cell, the 2D flag and positions wrapped into the cell.
   const auto t = gs::read_hdf5_trajectory(dir / "out" / "trajectory.h5");
   ASSERT_FALSE(t.frames.empty());
