@@ -317,7 +317,7 @@ void NeighborList::build_periodic(const ParticleState& p, const PeriodicCell& ce
   period_.resize(n);
   cell_of_particle_.resize(n);
   cell_start_.assign(ncells + 1, 0);
-  std::vector<Eigen::Vector3d> wrapped(n);
+  wrapped_.resize(n);
   for (std::size_t i = 0; i < n; ++i) {
     if (gone(i)) continue;
     Eigen::Vector3d s = inv * p.pos[i];
@@ -328,7 +328,7 @@ void NeighborList::build_periodic(const ParticleState& p, const PeriodicCell& ce
       s[k] -= fl;
       c[k] = std::min(dims[k] - 1, std::max(0, static_cast<int>(std::floor(s[k] * dims[k]))));
     }
-    wrapped[i] = cell.hsize * s;
+    wrapped_[i] = cell.hsize * s;
     cell_of_particle_[i] = index_of(c[0], c[1], c[2]);
     ++cell_start_[cell_of_particle_[i] + 1];
   }
@@ -338,26 +338,32 @@ void NeighborList::build_periodic(const ParticleState& p, const PeriodicCell& ce
   const bool clumped = p.clump.size() == n;
   for (std::size_t i = 0; i < n; ++i) {
     if (gone(i)) continue;
-    const Eigen::Vector3d& x = wrapped[i];
+    const Eigen::Vector3d& x = wrapped_[i];
     slots_[cell_fill_[cell_of_particle_[i]]++] = {
         x[0], x[1], x[2], p.radius[i], static_cast<std::uint32_t>(i), clumped ? p.clump[i] : -1};
   }
   found_periodic_.clear();
-  for_each_slot_pair(dims, wraps, cell_start_,
-                     [&](std::uint32_t s, std::uint32_t t, const Eigen::Vector3i& shift) {
-                       const Slot &a = slots_[s], &b = slots_[t];
-                       if (a.clump >= 0 && a.clump == b.clump) return;
-                       const Eigen::Vector3d offset = cell.hsize * shift.cast<double>();
-                       const double reach = a.r + b.r + skin;
-                       const double dx = b.x + offset[0] - a.x, dy = b.y + offset[1] - a.y,
-                                    dz = b.z + offset[2] - a.z;
-                       if (!(dx * dx + dy * dy + dz * dz < reach * reach * (1 + 1e-12))) return;
-                       const Eigen::Vector3i cd = shift + period_[a.index] - period_[b.index];
-                       if (a.index < b.index)
-                         found_periodic_.push_back({a.index, b.index, cd});
-                       else
-                         found_periodic_.push_back({b.index, a.index, -cd});
-                     });
+  Eigen::Vector3i last_shift = Eigen::Vector3i::Zero();
+  Eigen::Vector3d offset = Eigen::Vector3d::Zero();
+  for_each_slot_pair(
+      dims, wraps, cell_start_,
+      [&](std::uint32_t s, std::uint32_t t, const Eigen::Vector3i& shift) {
+        const Slot &a = slots_[s], &b = slots_[t];
+        if (a.clump >= 0 && a.clump == b.clump) return;
+        if (shift != last_shift) {  // (the stencil visits a neighbour cell's slots in a row)
+          last_shift = shift;
+          offset = cell.hsize * shift.cast<double>();
+        }
+        const double reach = a.r + b.r + skin;
+        const double dx = b.x + offset[0] - a.x, dy = b.y + offset[1] - a.y,
+                     dz = b.z + offset[2] - a.z;
+        if (!(dx * dx + dy * dy + dz * dz < reach * reach * (1 + 1e-12))) return;
+        const Eigen::Vector3i cd = shift + period_[a.index] - period_[b.index];
+        if (a.index < b.index)
+          found_periodic_.push_back({a.index, b.index, cd});
+        else
+          found_periodic_.push_back({b.index, a.index, -cd});
+      });
   std::sort(found_periodic_.begin(), found_periodic_.end(),
             [](const auto& x, const auto& y) { return x.a != y.a ? x.a < y.a : x.b < y.b; });
   pairs.resize(found_periodic_.size());

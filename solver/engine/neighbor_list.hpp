@@ -76,7 +76,8 @@ struct NeighborList {
     Eigen::Vector3i cd;
   };
   std::vector<PeriodicPair> found_periodic_;
-  std::vector<Eigen::Vector3i> period_;  // floor(H⁻¹·x) of each particle at the build
+  std::vector<Eigen::Vector3i> period_;   // floor(H⁻¹·x) of each particle at the build
+  std::vector<Eigen::Vector3d> wrapped_;  // positions wrapped into the cell at the build
   void build_periodic(const ParticleState& p, const PeriodicCell& cell, bool planar_z);
 };
 

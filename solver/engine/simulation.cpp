@@ -399,13 +399,13 @@ void Simulation::attach_histories(const std::vector<ContactHistory>& old,
     });
     for (const std::uint32_t k : deferred_) hist_[k].real = false;
     pass_pairs_.reserve(np);
-    std::vector<std::uint8_t> is_deferred(np, 0);
-    for (const std::uint32_t k : deferred_) is_deferred[k] = 1;
+    is_deferred_.assign(np, 0);
+    for (const std::uint32_t k : deferred_) is_deferred_[k] = 1;
     for (std::size_t k = 0; k < np; ++k)
-      if (!is_deferred[k]) pass_pairs_.push_back(static_cast<std::uint32_t>(k));
+      if (!is_deferred_[k]) pass_pairs_.push_back(static_cast<std::uint32_t>(k));
     pass_wall_pairs_.clear();
     for (const std::uint32_t k : wall_pairs_)
-      if (!is_deferred[k]) pass_wall_pairs_.push_back(k);
+      if (!is_deferred_[k]) pass_wall_pairs_.push_back(k);
   }
   if (std::max(1, cfg_.threads) == 1) return;  // (the per-particle lists serve threads only)
   // Pairs of each particle in pair order (entry = pair << 1 | 1 when the particle is the
@@ -583,8 +583,8 @@ void Simulation::accumulate_walls() {
   put(F::C2X, g.point - m2.pos);
   B.v[F::FRESH][j] = h.real ? 0 : 1;
   if (periodic_)  // (a pair inside the cell: no shift; +0 either way)
-    put(F::SVX, b < kWallBase && !nl_.cell_dist[k].isZero() ? cell_.shift_vel(nl_.cell_dist[k])
-                                                            : V3());
+    put(F::SVX,
+        b < kWallBase && !nl_.cell_dist[k].isZero() ? cell_.shift_vel(nl_.cell_dist[k]) : V3());
   put(F::ONX, V3(h.normal));
   put(F::SX, V3(h.shear_force));
   put(F::BX, V3(h.bending));
@@ -676,8 +676,8 @@ int Simulation::fill_batch(std::size_t& i, std::size_t end, ContactBatch& batch,
       const double reach = p_.radius[a] + p_.radius[b];
       if (periodic_) {  // (the image of b)
         const Eigen::Vector3i& cd = nl_.cell_dist[k];
-        const V3 d = (cd.isZero() ? V3(p_.pos[b]) : V3(p_.pos[b]) + cell_.shift_pos(cd)) -
-                     V3(p_.pos[a]);
+        const V3 d =
+            (cd.isZero() ? V3(p_.pos[b]) : V3(p_.pos[b]) + cell_.shift_pos(cd)) - V3(p_.pos[a]);
         in_reach = !(squared_norm(d) > reach * reach * (1 + 1e-12));
       } else {
         in_reach = !((p_.pos[b] - p_.pos[a]).squaredNorm() > reach * reach);

@@ -244,6 +244,7 @@ class Simulation {
   // would have marked it).
   std::vector<std::uint32_t> pass_pairs_, pass_wall_pairs_, deferred_, admitted_;
   std::size_t deferred_next_ = 0;
+  std::vector<std::uint8_t> is_deferred_;  // (scratch of attach_histories)
   bool facet_forces_ = false;
   std::vector<std::uint32_t> pair_facet_;  // closest facet of each wall pair (facet forces on)
   std::vector<ContactParams> params_;

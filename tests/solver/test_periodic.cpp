@@ -8,6 +8,7 @@
 #include <random>
 
 #include "packing_csv.hpp"
+#include "periodic_case.hpp"
 #include "reference_case.hpp"
 #include "simulation.hpp"
 
@@ -18,12 +19,7 @@ namespace {
 
 solver::SimulationConfig config(double damping = 0.2) {
   solver::SimulationConfig c;
-  c.material.young_ec = 3.0e7;
-  c.material.stiffness_ratio = 0.3;
-  c.material.friction_deg = 25.0;
-  c.material.density = 2550.0;
-  c.material.rolling_beta = 0.5;
-  c.material.rolling_eta = 0.3;
+  c.material = test::periodic_material();
   c.damping = damping;
   c.dt = 2e-6;
   return c;

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "periodic_case.hpp"
 #include "yade_reference.hpp"
 
 using namespace gs;
@@ -41,13 +42,7 @@ PeriodicCase periodic_case(bool planar) {
 
 solver::SimulationConfig periodic_config(double dt) {
   solver::SimulationConfig c;
-  c.material.young_ec = 3.0e7;
-  c.material.stiffness_ratio = 0.3;
-  c.material.friction_deg = 25.0;
-  c.material.density = 2550.0;
-  c.material.rolling_beta = 0.5;
-  c.material.rolling_eta = 0.3;
-  c.material.rolling_radius = solver::RollingRadius::Min;
+  c.material = test::periodic_material();
   c.damping = 0.05;
   c.dt = dt;
   c.max_overlap_ratio = 0.5;
