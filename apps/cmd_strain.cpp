@@ -256,9 +256,11 @@ void run_voidcells(const VoidArgs& a) {
                            std::to_string(cells.euler()) + ", expected",
                        std::to_string(cells.expected_euler));
     }
-    // Periodic images move with the cell: from velocities the cell velocity gradient given on
-    // the command line (default 0: fixed cell); between frames the change of the cell.
+    // Periodic images move with the cell: from velocities the cell velocity gradient the frame
+    // records (or the one given on the command line); between frames the change of the cell.
     Eigen::Matrix2d rate = Eigen::Matrix2d::Zero();
+    if (f.domain.periodic && !a.to)
+      rate = f.domain.velocity_gradient.topLeftCorner<2, 2>() * f.domain.cell.topLeftCorner<2, 2>();
     if (a.cell_gradient.size() == 4) {
       if (a.to) throw InputError(a.input, "--cell-velocity-gradient is for velocities, not --to");
       const Eigen::Matrix2d lc{{a.cell_gradient[0], a.cell_gradient[1]},
@@ -382,7 +384,7 @@ void register_analyze_strain(CLI::App& app) {
     s->add_option("--vtu", a->vtu, "also write the void-cell polygons with cell data (VTU)");
     s->add_option("--cell-velocity-gradient", a->cell_gradient,
                   "periodic cell, velocity mode: cell velocity gradient L11 L12 L21 L22 (1/s); "
-                  "images of a particle move with v + L (cell shift)")
+                  "images of a particle move with v + L (cell shift) (default: the frame's)")
         ->expected(4);
     s->callback([a] { run_voidcells(*a); });
   }

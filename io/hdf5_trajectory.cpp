@@ -139,6 +139,7 @@ enum Col : int {
   F_HI,
   F_PERIODIC,
   F_CELL,
+  F_CELL_VELGRAD,
   F_CLUMP_END,
   F_FACET_END,
   F_END,
@@ -192,6 +193,7 @@ const std::vector<Column>& columns() {
       {"frames", "domain_hi", t_f64, {3}, kFrameChunk},
       {"frames", "periodic", t_i8, {}, kFrameChunk},
       {"frames", "cell", t_f64, {3, 3}, kFrameChunk},
+      {"frames", "cell_velocity_gradient", t_f64, {3, 3}, kFrameChunk, 3},
       {"frames", "clump_end", t_i64, {}, kFrameChunk, 2},
       {"frames", "facet_end", t_i64, {}, kFrameChunk, 2},
       {"frames", "end", t_i64, {3}, kFrameChunk},
@@ -505,19 +507,26 @@ struct TrajectoryWriter::Impl {
     if (H5Fflush(file.get(), H5F_SCOPE_LOCAL) < 0) throw InputError(name(), "cannot flush");
   }
 
-  /// Schema 1 -> current, before resuming: the datasets added since (empty clump rows, and a
-  /// /frames/clump_end of zeros for the frames already written), then the version attribute.
-  void upgrade_from_v1() {
-    for (const char* g : {"clumps", "facet_loads"}) {
-      Hid grp(H5Gcreate2(file.get(), g, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose);
-      if (!grp.valid()) throw InputError(name(), "cannot create group", g);
-    }
+  /// Schema 1 or 2 -> current, before resuming: the datasets added since (empty clump rows,
+  /// and frame-table columns of zeros for the frames already written: clump_end, facet_end,
+  /// the cell velocity gradient), then the version attribute.
+  void upgrade_from(long long version) {
+    if (version < 2)
+      for (const char* g : {"clumps", "facet_loads"}) {
+        Hid grp(H5Gcreate2(file.get(), g, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose);
+        if (!grp.valid()) throw InputError(name(), "cannot create group", g);
+      }
     for (const auto& c : columns())
-      if (c.since > 1) create_dataset(file.get(), c, options.deflate_level, name());
+      if (c.since > version) create_dataset(file.get(), c, options.deflate_level, name());
     open_datasets();
-    const std::vector<std::int64_t> zeros(ds[F_END].rows, 0);
-    ds[F_CLUMP_END].append(zeros.data(), zeros.size(), name());
-    ds[F_FACET_END].append(zeros.data(), zeros.size(), name());
+    const std::size_t nf = ds[F_END].rows;
+    if (version < 2) {
+      const std::vector<std::int64_t> zeros(nf, 0);
+      ds[F_CLUMP_END].append(zeros.data(), zeros.size(), name());
+      ds[F_FACET_END].append(zeros.data(), zeros.size(), name());
+    }
+    const std::vector<double> zeros9(9 * nf, 0.0);
+    ds[F_CELL_VELGRAD].append(zeros9.data(), nf, name());
     Hid a(H5Aopen(file.get(), "schema_version", H5P_DEFAULT), H5Aclose);
     const long long v = kTrajectorySchemaVersion;
     if (!a.valid() || H5Awrite(a.get(), H5T_NATIVE_LLONG, &v) < 0)
@@ -640,7 +649,7 @@ struct TrajectoryWriter::Impl {
     wr(L_FORCE, gather_rows<double>(fr, nf, 3, L, [](const auto& r, auto* o) { put3(o, r.force); }),
        3);
 
-    std::vector<double> time(nf), dt(nf), lo(3 * nf), hi(3 * nf), cell(9 * nf);
+    std::vector<double> time(nf), dt(nf), lo(3 * nf), hi(3 * nf), cell(9 * nf), velgrad(9 * nf);
     std::vector<std::int64_t> step(nf), clump_end(nf), facet_end(nf), end(3 * nf);
     std::vector<std::int8_t> two_d(nf), periodic(nf);
     // The row counts before this batch were taken from the datasets just written.
@@ -658,7 +667,10 @@ struct TrajectoryWriter::Impl {
       put3(&lo[3 * j], f.domain.lo);
       put3(&hi[3 * j], f.domain.hi);
       for (int r = 0; r < 3; ++r)
-        for (int c = 0; c < 3; ++c) cell[9 * j + r * 3 + c] = f.domain.cell(r, c);
+        for (int c = 0; c < 3; ++c) {
+          cell[9 * j + r * 3 + c] = f.domain.cell(r, c);
+          velgrad[9 * j + r * 3 + c] = f.domain.velocity_gradient(r, c);
+        }
       end[3 * j] = rows[0];
       end[3 * j + 1] = rows[1];
       end[3 * j + 2] = rows[2];
@@ -678,6 +690,7 @@ struct TrajectoryWriter::Impl {
     ds[F_HI].append(hi.data(), nf, n);
     ds[F_PERIODIC].append(periodic.data(), nf, n);
     ds[F_CELL].append(cell.data(), nf, n);
+    ds[F_CELL_VELGRAD].append(velgrad.data(), nf, n);
     ds[F_CLUMP_END].append(clump_end.data(), nf, n);
     ds[F_FACET_END].append(facet_end.data(), nf, n);
     flush();
@@ -734,8 +747,8 @@ TrajectoryWriter TrajectoryWriter::resume(std::filesystem::path path, std::size_
   }
   if (!impl->file.valid()) throw InputError(impl->name(), "cannot reopen trajectory to resume");
   const long long version = read_schema_version(impl->file.get());
-  if (version == 1) {
-    impl->upgrade_from_v1();
+  if (version == 1 || version == 2) {
+    impl->upgrade_from(version);
   } else if (version != kTrajectorySchemaVersion) {
     throw InputError(impl->name(), "cannot resume, unsupported schema_version",
                      std::to_string(version));
@@ -843,7 +856,7 @@ struct TrajectoryReader::Impl {
   std::size_t n = 0;
   long long version = 0;
   // Per-frame tables, read once (clump_end: zeros for a version 1 file).
-  std::vector<double> time, dt, lo, hi, cell;
+  std::vector<double> time, dt, lo, hi, cell, cell_velgrad;
   std::vector<std::int64_t> step, end, clump_end, facet_end;
   std::vector<std::int8_t> two_d, periodic;
 
@@ -971,6 +984,7 @@ struct TrajectoryReader::Impl {
     hi = read_rows<double>(F_HI, 0, n);
     periodic = read_rows<std::int8_t>(F_PERIODIC, 0, n);
     cell = read_rows<double>(F_CELL, 0, n);
+    cell_velgrad = read_rows<double>(F_CELL_VELGRAD, 0, n);  // (zeros before version 3)
     end = read_rows<std::int64_t>(F_END, 0, n);
     clump_end = read_rows<std::int64_t>(F_CLUMP_END, 0, n);
     facet_end = read_rows<std::int64_t>(F_FACET_END, 0, n);
@@ -1056,7 +1070,10 @@ Frame TrajectoryReader::frame(std::size_t i) const {
   f.domain.hi = get3(&m.hi[i * 3]);
   f.domain.periodic = m.periodic[i] != 0;
   for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c) f.domain.cell(r, c) = m.cell[i * 9 + r * 3 + c];
+    for (int c = 0; c < 3; ++c) {
+      f.domain.cell(r, c) = m.cell[i * 9 + r * 3 + c];
+      f.domain.velocity_gradient(r, c) = m.cell_velgrad[i * 9 + r * 3 + c];
+    }
 
   {
     const auto [b, cnt] = m.range(i, 0);

@@ -1,5 +1,5 @@
-// HDF5 trajectory format (docs/format.md, schema_version 2; version 1 files, which have no
-// /clumps group, are read too): plain chunked, compressed, checksummed arrays, one row block per
+// HDF5 trajectory format (docs/format.md, schema_version 3; version 1 files, which have no
+// /clumps group, and version 2 files, which have no cell velocity gradient, are read too): plain chunked, compressed, checksummed arrays, one row block per
 // frame, appended frame by frame. The frame index /frames/end is appended last and flushed, so a
 // run killed mid-write leaves every completed frame readable (HDF5 single-writer/multiple-reader
 // mode keeps the file consistent).
@@ -15,7 +15,7 @@
 namespace gs {
 
 /// Version written. 2 added the clump bodies (/clumps, /frames/clump_end); 1 is still read.
-inline constexpr int kTrajectorySchemaVersion = 2;
+inline constexpr int kTrajectorySchemaVersion = 3;
 /// Bytes of the fixed-length clump template names (/clumps/template); longer names are rejected.
 inline constexpr std::size_t kClumpTemplateBytes = 64;
 inline constexpr const char* kTrajectoryFormatName = "granoscope-trajectory";
@@ -35,8 +35,8 @@ class TrajectoryWriter {
   TrajectoryWriter(std::filesystem::path path, const RunMetadata& metadata, Options options);
   TrajectoryWriter(std::filesystem::path path, const RunMetadata& metadata);
   /// Re-opens an existing `<path>.partial` to append further frames, first dropping every frame
-  /// after the first `keep_frames` ones. A schema_version 1 file is upgraded in place to the
-  /// current version (its frames have no clump bodies).
+  /// after the first `keep_frames` ones. A schema_version 1 or 2 file is upgraded in place to
+  /// the current version (its frames have no clump bodies, or a zero cell velocity gradient).
   static TrajectoryWriter resume(std::filesystem::path path, std::size_t keep_frames,
                                  Options options);
   TrajectoryWriter(TrajectoryWriter&&) noexcept;
@@ -76,7 +76,7 @@ class TrajectoryReader {
   /// Clump bodies of frame i (0 for a schema_version 1 file).
   std::size_t clump_count(std::size_t i) const;
   double time(std::size_t i) const;
-  /// The file's schema_version (1 or 2).
+  /// The file's schema_version (1, 2 or 3).
   int schema_version() const;
 
  private:

@@ -90,6 +90,7 @@ void validate_frame(const Frame& f, const std::string& source) {
   check_finite(source, "domain lo", f.domain.lo);
   check_finite(source, "domain hi", f.domain.hi);
   check_finite(source, "periodic cell", f.domain.cell);
+  check_finite(source, "cell velocity gradient", f.domain.velocity_gradient);
   std::unordered_set<std::int64_t> ids;
   ids.reserve(f.particles.size());
   for (const auto& p : f.particles) {

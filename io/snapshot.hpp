@@ -65,6 +65,9 @@ struct Domain {
   Eigen::Vector3d hi = Eigen::Vector3d::Zero();
   bool periodic = false;
   Eigen::Matrix3d cell = Eigen::Matrix3d::Identity();
+  /// Periodic cell: its velocity gradient L (1/s) at this instant, dC/dt = L·C (YADE's
+  /// O.cell.velGrad); the particles' velocities include the mean flow L·x. Zero otherwise.
+  Eigen::Matrix3d velocity_gradient = Eigen::Matrix3d::Zero();
 };
 
 /// A rigid clump body (seed 003 §2.4, seed 004 §4.3) at one instant: its members are the

@@ -166,6 +166,9 @@ Frame read_vtu_particles(const std::filesystem::path& path) {
   }
   if (fd && fd->GetArray("cell"))
     for (int k = 0; k < 9; ++k) f.domain.cell(k / 3, k % 3) = field_scalar(fd, "cell", k, 0.0);
+  if (fd && fd->GetArray("cell_velocity_gradient"))
+    for (int k = 0; k < 9; ++k)
+      f.domain.velocity_gradient(k / 3, k % 3) = field_scalar(fd, "cell_velocity_gradient", k, 0.0);
   validate_frame(f, name);
   return f;
 }

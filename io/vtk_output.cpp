@@ -139,6 +139,9 @@ void write_vtu_particles(const std::filesystem::path& path, const Frame& f) {
   const auto& c = f.domain.cell;
   add_field(fd, "cell",
             {c(0, 0), c(0, 1), c(0, 2), c(1, 0), c(1, 1), c(1, 2), c(2, 0), c(2, 1), c(2, 2)});
+  const auto& l = f.domain.velocity_gradient;
+  add_field(fd, "cell_velocity_gradient",
+            {l(0, 0), l(0, 1), l(0, 2), l(1, 0), l(1, 1), l(1, 2), l(2, 0), l(2, 1), l(2, 2)});
   vtkNew<vtkXMLUnstructuredGridWriter> w;
   w->SetInputData(g);
   write_xml(w.Get(), path);

@@ -239,7 +239,10 @@ void Simulation::set_cell_servo(const CellServo& servo) {
   if (!periodic_) throw std::invalid_argument("a cell servo needs a periodic cell");
   if (!servo.target.allFinite()) throw std::invalid_argument("cell servo target is not finite");
   const bool any = servo.stress[0] || servo.stress[1] || servo.stress[2];
-  if (any && (!(servo.gain > 0) || !std::isfinite(servo.gain)))
+  if (!(servo.stiffness_fraction >= 0 && servo.stiffness_fraction <= 1))
+    throw std::invalid_argument("cell servo stiffness fraction must be in [0, 1] (" +
+                                std::to_string(servo.stiffness_fraction) + ")");
+  if (any && servo.stiffness_fraction == 0 && (!(servo.gain > 0) || !std::isfinite(servo.gain)))
     throw std::invalid_argument("cell servo gain must be positive (" + std::to_string(servo.gain) +
                                 ")");
   if (any && (!(servo.max_rate > 0) || !std::isfinite(servo.max_rate)))
@@ -290,6 +293,20 @@ Eigen::Matrix3d Simulation::cell_stress() const {
   }
   const double volume = periodic_ ? cell_.volume() : 0.0;
   return volume > 0 ? Eigen::Matrix3d(sigma / volume) : sigma;
+}
+
+Eigen::Vector3d Simulation::cell_stiffness() const {
+  Eigen::Vector3d k = Eigen::Vector3d::Zero();
+  for (std::size_t c = 0; c < hist_.size(); ++c) {
+    const auto& h = hist_[c];
+    if (!h.real || h.b >= kWallBase) continue;
+    Eigen::Vector3d branch = p_.pos[h.a] - p_.pos[h.b];
+    if (periodic_) branch -= cell_.hsize * nl_.cell_dist[c].cast<double>();
+    const Eigen::Array3d n2 = h.normal.array().square();
+    k.array() += branch.array().square() * (params_[c].kn * n2 + params_[c].ks * (1 - n2));
+  }
+  const double volume = periodic_ ? cell_.volume() : 0.0;
+  return volume > 0 ? Eigen::Vector3d(k / volume) : k;
 }
 
 void Simulation::rebuild_neighbors() {
@@ -911,10 +928,20 @@ void Simulation::step() {
     const Eigen::Matrix3d sigma = cell_stress();
     Eigen::Matrix3d l = servo_base_gradient_;
     const CellServo& sv = *cell_servo_;
-    for (int i = 0; i < 3; ++i)
-      l(i, i) = sv.stress[i]
-                    ? std::clamp(sv.gain * (sv.target[i] - sigma(i, i)), -sv.max_rate, sv.max_rate)
-                    : sv.target[i];
+    Eigen::Vector3d gain = Eigen::Vector3d::Constant(sv.gain);
+    if (sv.stiffness_fraction > 0) {
+      const Eigen::Vector3d k = cell_stiffness();
+      for (int i = 0; i < 3; ++i)
+        gain[i] = k[i] > 0 ? sv.stiffness_fraction / (k[i] * dt)
+                           : std::numeric_limits<double>::infinity();
+    }
+    for (int i = 0; i < 3; ++i) {
+      const double error = sv.target[i] - sigma(i, i);
+      l(i, i) = !sv.stress[i] ? sv.target[i]
+                : std::isinf(gain[i])
+                    ? (error > 0 ? sv.max_rate : error < 0 ? -sv.max_rate : 0.0)
+                    : std::clamp(gain[i] * error, -sv.max_rate, sv.max_rate);
+    }
     cell_.set_velocity_gradient(l);
   }
   if (!(max_overlap_ratio <= cfg_.max_overlap_ratio))
@@ -1172,6 +1199,7 @@ Frame Simulation::frame() const {
   if (periodic_) {  // the cell, with the positions wrapped into it
     f.domain.periodic = true;
     f.domain.cell = cell_.hsize;
+    f.domain.velocity_gradient = cell_.vel_grad;  // the one the velocities carry
     f.domain.lo = Eigen::Vector3d::Zero();
     f.domain.hi = cell_.hsize.rowwise().sum();
     f.two_d = planar_;
@@ -1186,7 +1214,8 @@ Frame Simulation::frame() const {
 // ------------------------------------------------------------------ checkpoints
 
 namespace {
-constexpr char kMagic[8] = {'G', 'S', 'C', 'K', 'P', 'T', '0', '6'};
+constexpr char kMagic[8] = {'G', 'S', 'C', 'K', 'P', 'T', '0', '7'};
+constexpr char kMagicV06[8] = {'G', 'S', 'C', 'K', 'P', 'T', '0', '6'};  // (no cell servo)
 constexpr char kMagicV05[8] = {'G', 'S', 'C', 'K', 'P', 'T', '0', '5'};  // (no periodic cell)
 constexpr char kMagicV04[8] = {'G', 'S', 'C', 'K', 'P', 'T', '0', '4'};  // (no wall rotation)
 constexpr char kMagicV03[8] = {'G', 'S', 'C', 'K', 'P', 'T', '0', '3'};  // (no clumps)
@@ -1280,6 +1309,15 @@ void Simulation::save_checkpoint(const std::filesystem::path& path,
       put(o, cell_.prev_vel_grad);
       put(o, cell_.prev_hsize);
       put(o, cell_.vgrad_times_prev_h);
+      put(o, static_cast<std::uint8_t>(cell_servo_.has_value()));
+      if (cell_servo_) {
+        for (const bool b : cell_servo_->stress) put(o, static_cast<std::uint8_t>(b));
+        put(o, cell_servo_->target);
+        put(o, cell_servo_->gain);
+        put(o, cell_servo_->max_rate);
+        put(o, cell_servo_->stiffness_fraction);
+        put(o, servo_base_gradient_);
+      }
     }
     put(o, static_cast<std::uint64_t>(extra.size()));
     o.write(extra.data(), static_cast<std::streamsize>(extra.size()));
@@ -1297,7 +1335,8 @@ std::string Simulation::load_checkpoint(const std::filesystem::path& path) {
   const bool v03 = in && std::memcmp(magic, kMagicV03, 8) == 0;
   const bool v04 = in && std::memcmp(magic, kMagicV04, 8) == 0;
   const bool v05 = in && std::memcmp(magic, kMagicV05, 8) == 0;
-  if (!in || (!v03 && !v04 && !v05 && std::memcmp(magic, kMagic, 8) != 0))
+  const bool v06 = in && std::memcmp(magic, kMagicV06, 8) == 0;
+  if (!in || (!v03 && !v04 && !v05 && !v06 && std::memcmp(magic, kMagic, 8) != 0))
     throw InputError(file, "not a granoscope checkpoint");
   get(in, step_, file);
   get(in, time_, file);
@@ -1384,6 +1423,27 @@ std::string Simulation::load_checkpoint(const std::filesystem::path& path) {
     get(in, cell_.prev_vel_grad, file);
     get(in, cell_.prev_hsize, file);
     get(in, cell_.vgrad_times_prev_h, file);
+    std::uint8_t has_servo = 0;
+    if (!v06) {  // (a v06 checkpoint keeps the scene's servo, set before loading)
+      get(in, has_servo, file);
+      if (has_servo > 1) throw InputError(file, "corrupt checkpoint (cell servo flag)");
+      if (has_servo) {
+        CellServo sv;
+        for (auto& b : sv.stress) {
+          std::uint8_t v = 0;
+          get(in, v, file);
+          b = v != 0;
+        }
+        get(in, sv.target, file);
+        get(in, sv.gain, file);
+        get(in, sv.max_rate, file);
+        get(in, sv.stiffness_fraction, file);
+        get(in, servo_base_gradient_, file);
+        cell_servo_ = sv;
+      } else {
+        cell_servo_.reset();
+      }
+    }
     if (!cell_.hsize.allFinite() || !(cell_.hsize.determinant() > 0))
       throw InputError(file, "corrupt checkpoint (periodic cell)");
   }

@@ -25,11 +25,17 @@ namespace gs::solver {
 /// either strain-rate controlled (L_ii = target, 1/s) or stress controlled: after each step
 /// L_ii = clamp(gain·(target − σ_ii), ±max_rate) with σ the cell stress (Pa, compression
 /// negative), taking effect in the next step as any velocity gradient does.
+/// With `stiffness_fraction` f > 0 the gain of axis i is f/(K_ii·dt) instead, K_ii the affine
+/// stiffness of the contacts, K_ii = (1/V) Σ l_i² (kn n_i² + ks (1 − n_i²)) (l the branch
+/// vector, n the normal): the step's strain then removes the fraction f of the stress error
+/// were the assembly to deform affinely (the stiffness-scaled servo of YADE's walls, for the
+/// cell; a stress axis with no contact moves at max_rate).
 struct CellServo {
   std::array<bool, 3> stress = {false, false, false};  // true: axis i is stress controlled
   Eigen::Vector3d target = Eigen::Vector3d::Zero();    // Pa (stress axes) or 1/s (rate axes)
   double gain = 0;                                     // 1/(Pa·s)
   double max_rate = 0;                                 // 1/s, |L_ii| of a stress axis
+  double stiffness_fraction = 0;  // > 0: gain_i = fraction/(K_ii·dt), `gain` unused
 };
 
 struct SimulationConfig {
@@ -169,6 +175,12 @@ class Simulation {
   /// YADE's utils.getStress() in a periodic cell: (1/det H)·Σ (Fn + Fs) ⊗ (x1 − x2 − H·cellDist)
   /// over the real contacts (Pa, compression negative; seed 000 eq 12, Love–Weber).
   Eigen::Matrix3d cell_stress() const;
+  /// The affine stiffness of the contacts along each axis (Pa): K_ii of CellServo.
+  Eigen::Vector3d cell_stiffness() const;
+  /// The cell servo in force, if any.
+  const std::optional<CellServo>& cell_servo() const { return cell_servo_; }
+  /// Stops the cell servo; the velocity gradient stays the last one set.
+  void clear_cell_servo() { cell_servo_.reset(); }
   /// Controls the cell's diagonal from now on; the off-diagonal gradient is the last one set
   /// (set_velocity_gradient). Throws without a cell, or on a bad gain, rate limit or target.
   void set_cell_servo(const CellServo& servo);

@@ -61,6 +61,40 @@ std::vector<std::unique_ptr<LoadingProgramme>> scene_programmes(Scene& s) {
   const double test_friction = s.config.material.friction_deg;
   std::optional<SpecimenGauge> gauge;
   std::unique_ptr<LoadingProgramme> test;
+  if (s.test == "biaxial_periodic") {
+    // Seed 002 §4: disks in a square doubly periodic cell, of the thickness asked for.
+    const SpecimenSpec& sp = *s.specimen;
+    std::mt19937_64 rng(sp.seed);
+    try {
+      const auto d = draw_diameter_count(sp.sizes, static_cast<std::size_t>(sp.count), rng);
+      double area = 0;
+      for (const double x : d) area += 0.25 * M_PI * x * x;
+      const double side = std::sqrt(area / sp.cloud_solid_fraction);
+      s.particles = random_disk_packing_periodic(d, side, side, 0.5 * sp.thickness_m, rng);
+      auto& c = s.cell.emplace();
+      c.hsize = Eigen::Vector3d(side, side, sp.thickness_m).asDiagonal();
+      c.planar = true;
+      c.disks = sp.disks;
+    } catch (const std::invalid_argument& e) {
+      throw InputError(s.file.string(), std::string("[specimen]: ") + e.what());
+    }
+    if (s.preparation) {
+      try {
+        out.push_back(std::make_unique<SpecimenPreparation>(
+            *s.preparation, cell_gauge(2, s.preparation->max_cell_rate_1_s), test_friction));
+      } catch (const std::invalid_argument& e) {
+        throw InputError(s.file.string(), std::string("[preparation]: ") + e.what());
+      }
+    }
+    if (s.biaxial_periodic.d50_m <= 0 && sp.sizes.d50_m > 0)
+      s.biaxial_periodic.d50_m = sp.sizes.d50_m;
+    try {
+      out.push_back(std::make_unique<PeriodicBiaxial>(s.biaxial_periodic));
+    } catch (const std::invalid_argument& e) {
+      throw InputError(s.file.string(), std::string("[biaxial_periodic]: ") + e.what());
+    }
+    return out;
+  }
   if (s.test == "triaxial" || s.test == "plane_strain") {
     Eigen::Vector3d lo, hi;
     if (s.specimen) {

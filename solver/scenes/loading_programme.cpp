@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <iostream>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 
@@ -87,6 +88,20 @@ double coordination_number(const Simulation& sim) {
   const std::size_t n = sim.particles().size();
   return n == 0 ? 0.0
                 : 2.0 * static_cast<double>(sim.sphere_contact_count()) / static_cast<double>(n);
+}
+
+double cell_void_ratio(const Simulation& sim) {
+  const auto& p = sim.particles();
+  const Eigen::Matrix3d& h = sim.cell().hsize;
+  const bool plane = sim.planar();
+  double solid = 0;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    if (p.removed[i] != 0) continue;
+    const double r = p.radius[i];
+    solid += plane ? M_PI * r * r : 4.0 / 3.0 * M_PI * r * r * r;
+  }
+  const double v = plane ? h.topLeftCorner<2, 2>().determinant() : h.determinant();
+  return solid > 0 ? v / solid - 1 : std::numeric_limits<double>::quiet_NaN();
 }
 
 double elastic_energy(Simulation& sim) {

@@ -109,6 +109,10 @@ struct InertialWarning {
 /// Coordination number Z = 2·(sphere–sphere contacts) / particles (walls not counted).
 double coordination_number(const Simulation& sim);
 
+/// Void ratio of a periodic cell: (V − V_s)/V_s with V the cell's volume and V_s the particles'
+/// (2D: the cell's area and the disks' areas).
+double cell_void_ratio(const Simulation& sim);
+
 /// A−B in the energy ledger's sense: the elastic energy stored in the contacts (J).
 double elastic_energy(Simulation& sim);
 

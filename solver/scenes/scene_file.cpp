@@ -135,7 +135,7 @@ struct Reader {
 };
 
 void read_lab_sections(const Reader& r, const toml::table& root, Scene& s) {
-  for (const char* name : {"triaxial", "plane_strain", "direct_shear"}) {
+  for (const char* name : {"triaxial", "plane_strain", "direct_shear", "biaxial_periodic"}) {
     if (root.contains(name) && s.test != name)
       r.fail(std::string("[") + name + "]", "does not match scene.test", s.test);
   }
@@ -184,6 +184,36 @@ void read_lab_sections(const Reader& r, const toml::table& root, Scene& s) {
     x.sledge_gain = r.positive(t, "plane_strain", "sledge_gain", false, x.sledge_gain);
     x.inertial_warning =
         r.positive(t, "plane_strain", "inertial_warning", false, x.inertial_warning);
+  } else if (s.test == "biaxial_periodic") {
+    const char* sec = "biaxial_periodic";
+    const auto* t = r.table(sec, true);
+    r.only(t, sec,
+           {"lateral_stress_Pa", "strain_rate_1_s", "max_strain", "frame_every_strain",
+            "frame_strains", "servo_fraction", "max_rate_1_s", "inertial_warning"});
+    auto& x = s.biaxial_periodic;
+    x.lateral_stress_Pa = r.positive(t, sec, "lateral_stress_Pa", true, 0);
+    x.strain_rate_1_s = r.positive(t, sec, "strain_rate_1_s", true, 0);
+    x.max_strain = r.positive(t, sec, "max_strain", true, 0);
+    if (x.max_strain >= 1)
+      r.fail("biaxial_periodic.max_strain", "must be below 1", value_str(x.max_strain));
+    x.frame_every_strain = r.number(t, sec, "frame_every_strain", false, x.frame_every_strain);
+    if (x.frame_every_strain < 0)
+      r.fail("biaxial_periodic.frame_every_strain", "negative", value_str(x.frame_every_strain));
+    if (t->contains("frame_strains")) {
+      const auto* arr = (*t)["frame_strains"].as_array();
+      if (!arr) r.fail("biaxial_periodic.frame_strains", "expected an array of strains");
+      for (const auto& v : *arr) {
+        const auto e = v.value<double>();
+        if (!e || !(*e > 0) || !(*e < 1))
+          r.fail("biaxial_periodic.frame_strains", "expected strains in (0, 1)");
+        x.frame_strains.push_back(*e);
+      }
+    }
+    x.servo_fraction = r.positive(t, sec, "servo_fraction", false, x.servo_fraction);
+    if (x.servo_fraction > 1)
+      r.fail("biaxial_periodic.servo_fraction", "must be at most 1", value_str(x.servo_fraction));
+    x.max_rate_1_s = r.positive(t, sec, "max_rate_1_s", false, x.max_rate_1_s);
+    x.inertial_warning = r.positive(t, sec, "inertial_warning", false, x.inertial_warning);
   } else if (s.test == "direct_shear") {
     const auto* t = r.table("direct_shear", true);
     r.only(
@@ -209,11 +239,12 @@ void read_lab_sections(const Reader& r, const toml::table& root, Scene& s) {
     r.only(prep, "preparation",
            {"pressure_Pa", "void_ratio", "core_inset_m", "friction_start_deg", "friction_factor",
             "stage_steps", "check_every", "stress_tolerance", "unbalanced_force", "kinetic_ratio",
-            "servo_gain", "max_wall_speed_m_s", "deposition", "max_steps"});
-    // Default: the stress of the test (σc, or σn of the direct shear).
-    const double test_stress = s.test == "triaxial"       ? s.triaxial.confining_Pa
-                               : s.test == "plane_strain" ? s.plane_strain.confining_Pa
-                                                          : s.direct_shear.normal_stress_Pa;
+            "servo_gain", "max_wall_speed_m_s", "max_rate_1_s", "deposition", "max_steps"});
+    // Default: the stress of the test (σc, σn of the direct shear, σ11 of the biaxial test).
+    const double test_stress = s.test == "triaxial"           ? s.triaxial.confining_Pa
+                               : s.test == "plane_strain"     ? s.plane_strain.confining_Pa
+                               : s.test == "biaxial_periodic" ? s.biaxial_periodic.lateral_stress_Pa
+                                                              : s.direct_shear.normal_stress_Pa;
     p.pressure_Pa = r.number(prep, "preparation", "pressure_Pa", false, test_stress);
     if (p.pressure_Pa < 0) r.fail("preparation.pressure_Pa", "negative", value_str(p.pressure_Pa));
     p.void_ratio_target = r.number(prep, "preparation", "void_ratio", false,
@@ -237,6 +268,16 @@ void read_lab_sections(const Reader& r, const toml::table& root, Scene& s) {
     p.deposition =
         prep && prep->contains("deposition") ? (*prep)["deposition"].value_or(false) : false;
     p.max_steps = r.integer(prep, "preparation", "max_steps", false, 0, 0);
+    p.max_cell_rate_1_s =
+        r.positive(prep, "preparation", "max_rate_1_s", false, p.max_cell_rate_1_s);
+    if (s.test == "biaxial_periodic") {
+      if (p.deposition) r.fail("preparation.deposition", "not in a periodic cell");
+      if (p.servo_gain > 1)
+        r.fail("preparation.servo_gain", "a cell's servo gain is a fraction in (0, 1]",
+               value_str(p.servo_gain));
+    } else if (prep && prep->contains("max_rate_1_s")) {
+      r.fail("preparation.max_rate_1_s", "is for a periodic cell (scene.test = \"biaxial_periodic\")");
+    }
     if (p.pressure_Pa == 0 && !p.deposition)
       r.fail("preparation.pressure_Pa", "missing (or set deposition = true)");
   } else if (prep) {
@@ -517,7 +558,8 @@ Scene load_scene(const std::filesystem::path& path) {
     static const char* sections[] = {"scene",          "material",     "solver",      "output",
                                      "walls",          "specimen",     "preparation", "triaxial",
                                      "plane_strain",   "direct_shear", "mesh",        "outlet",
-                                     "clump_template", "clumps",       "fill",        "cell"};
+                                     "clump_template", "clumps",       "fill",        "cell",
+                                     "biaxial_periodic"};
     if (std::find(std::begin(sections), std::end(sections), k.str()) == std::end(sections))
       r.fail("[" + std::string(k.str()) + "]", "unknown section");
   }
@@ -526,8 +568,10 @@ Scene load_scene(const std::filesystem::path& path) {
   s.name = r.string(scene, "scene", "name", true, "");
   s.test = r.string(scene, "scene", "test", false, "");
   if (!s.test.empty() && s.test != "triaxial" && s.test != "plane_strain" &&
-      s.test != "direct_shear")
-    r.fail("scene.test", "expected \"triaxial\", \"plane_strain\" or \"direct_shear\"", s.test);
+      s.test != "direct_shear" && s.test != "biaxial_periodic")
+    r.fail("scene.test",
+           "expected \"triaxial\", \"plane_strain\", \"direct_shear\" or \"biaxial_periodic\"",
+           s.test);
   const auto* specimen = r.table("specimen", false);
   const bool has_packing = scene->contains("packing");
   // A plain scene may start empty when clumps or a filling bring its particles.
@@ -546,6 +590,8 @@ Scene load_scene(const std::filesystem::path& path) {
   }
   if (specimen && has_packing) r.fail("[specimen]", "give either scene.packing or [specimen]");
   if (specimen && s.test.empty()) r.fail("[specimen]", "needs scene.test");
+  if (s.test == "biaxial_periodic" && !specimen)
+    r.fail("[specimen]", "missing (the periodic biaxial test generates its disks)");
   s.parameters.emplace_back("scene.name", s.name);
   s.wall_friction_deg = r.number(scene, "scene", "wall_friction_deg", false, 0.0);
 
@@ -580,11 +626,28 @@ Scene load_scene(const std::filesystem::path& path) {
           "max_overlap_ratio", "max_energy_residual"});
   if (specimen) {
     auto& sp = s.specimen.emplace();
-    r.only(specimen, "specimen",
-           {"size_m", "dmin_m", "dmax_m", "distribution", "void_ratio", "seed",
-            "cloud_solid_fraction"});
-    sp.size_m = r.vec3(specimen, "specimen", "size_m", true, {});
-    if ((sp.size_m.array() <= 0).any()) r.fail("specimen.size_m", "must be positive");
+    const bool periodic2d = s.test == "biaxial_periodic";
+    if (periodic2d)
+      r.only(specimen, "specimen",
+             {"count", "two_d", "thickness_m", "dmin_m", "dmax_m", "distribution", "d50_m",
+              "uniformity", "void_ratio", "seed", "cloud_solid_fraction"});
+    else
+      r.only(specimen, "specimen",
+             {"size_m", "dmin_m", "dmax_m", "distribution", "d50_m", "uniformity", "void_ratio",
+              "seed", "cloud_solid_fraction"});
+    if (periodic2d) {
+      sp.count = r.integer(specimen, "specimen", "count", true, 0, 3);
+      if (sp.count > 10000000)
+        r.fail("specimen.count", "more than 10 million disks", std::to_string(sp.count));
+      const std::string two_d = r.string(specimen, "specimen", "two_d", false, "disks");
+      if (two_d != "disks" && two_d != "spheres_in_plane")
+        r.fail("specimen.two_d", "expected \"disks\" or \"spheres_in_plane\"", two_d);
+      sp.disks = two_d == "disks";
+      sp.sizes.mass_exponent = sp.disks ? 2 : 3;
+    } else {
+      sp.size_m = r.vec3(specimen, "specimen", "size_m", true, {});
+      if ((sp.size_m.array() <= 0).any()) r.fail("specimen.size_m", "must be positive");
+    }
     sp.sizes.dmin_m = r.positive(specimen, "specimen", "dmin_m", true, 0);
     sp.sizes.dmax_m = r.positive(specimen, "specimen", "dmax_m", true, 0);
     if (sp.sizes.dmax_m < sp.sizes.dmin_m)
@@ -594,15 +657,37 @@ Scene load_scene(const std::filesystem::path& path) {
       sp.sizes.distribution = SizeDistribution::Uniform;
     else if (dist == "linear")
       sp.sizes.distribution = SizeDistribution::Linear;
+    else if (dist == "graded")
+      sp.sizes.distribution = SizeDistribution::Graded;
     else
-      r.fail("specimen.distribution", "expected \"uniform\" or \"linear\"", dist);
+      r.fail("specimen.distribution", "expected \"uniform\", \"linear\" or \"graded\"", dist);
+    if (dist == "graded") {
+      sp.sizes.d50_m = r.positive(specimen, "specimen", "d50_m", true, 0);
+      sp.sizes.uniformity = r.positive(specimen, "specimen", "uniformity", true, 0);
+      try {
+        fit_graded(sp.sizes);
+      } catch (const std::invalid_argument& e) {
+        r.fail("specimen.uniformity", e.what(), value_str(sp.sizes.uniformity));
+      }
+    } else {
+      for (const char* k : {"d50_m", "uniformity"})
+        if (specimen->contains(k))
+          r.fail(std::string("specimen.") + k, "only for distribution = \"graded\"");
+    }
     sp.void_ratio = r.positive(specimen, "specimen", "void_ratio", false, sp.void_ratio);
     sp.seed = static_cast<std::uint64_t>(r.integer(specimen, "specimen", "seed", false, 1, 0));
-    sp.cloud_solid_fraction =
-        r.positive(specimen, "specimen", "cloud_solid_fraction", false, sp.cloud_solid_fraction);
-    if (sp.cloud_solid_fraction >= 0.45)
-      r.fail("specimen.cloud_solid_fraction", "too dense for random sequential addition (< 0.45)",
+    sp.cloud_solid_fraction = r.positive(specimen, "specimen", "cloud_solid_fraction", false,
+                                         periodic2d ? 0.45 : sp.cloud_solid_fraction);
+    const double cloud_limit = periodic2d ? 0.6 : 0.45;  // random sequential addition jams
+    if (sp.cloud_solid_fraction >= cloud_limit)
+      r.fail("specimen.cloud_solid_fraction",
+             std::string("too dense for random sequential addition (< ") +
+                 (periodic2d ? "0.6 in 2D)" : "0.45)"),
              value_str(sp.cloud_solid_fraction));
+    if (periodic2d) {
+      sp.thickness_m =
+          r.positive(specimen, "specimen", "thickness_m", false, 2 * sp.sizes.dmax_m);
+    }
   }
   double auto_dt_safety = 0;  // "auto": dt is set at the end, once clumps and fillings are in
   if (sol->contains("dt_s") && (*sol)["dt_s"].is_string()) {
@@ -786,7 +871,7 @@ Scene load_scene(const std::filesystem::path& path) {
     // Periodic cell (docs/scenes.md "[cell]"; YADE's O.cell.hSize and O.cell.velGrad).
     r.only(cell, "cell",
            {"size_m", "hsize_m", "velocity_gradient_1_s", "two_d", "control", "target",
-            "servo_gain", "max_rate_1_s"});
+            "servo_gain", "servo_fraction", "max_rate_1_s"});
     auto& c = s.cell.emplace();
     if (cell->contains("size_m") == cell->contains("hsize_m"))
       r.fail("cell", "give one of size_m and hsize_m");
@@ -821,7 +906,15 @@ Scene load_scene(const std::filesystem::path& path) {
       }
       sv.target = r.vec3(cell, "cell", "target", true, {});
       const bool any = sv.stress[0] || sv.stress[1] || sv.stress[2];
-      sv.gain = any ? r.positive(cell, "cell", "servo_gain", true, 0) : 0.0;
+      if (cell->contains("servo_gain") && cell->contains("servo_fraction"))
+        r.fail("cell.servo_fraction", "give one of servo_gain and servo_fraction");
+      if (any && cell->contains("servo_fraction")) {
+        sv.stiffness_fraction = r.positive(cell, "cell", "servo_fraction", true, 0);
+        if (sv.stiffness_fraction > 1)
+          r.fail("cell.servo_fraction", "must be at most 1", value_str(sv.stiffness_fraction));
+      } else {
+        sv.gain = any ? r.positive(cell, "cell", "servo_gain", true, 0) : 0.0;
+      }
       sv.max_rate = any ? r.positive(cell, "cell", "max_rate_1_s", true, 0) : 0.0;
       for (int i = 0; i < 3; ++i)
         if (c.vel_grad(i, i) != 0)
@@ -829,13 +922,16 @@ Scene load_scene(const std::filesystem::path& path) {
                  "its diagonal is the servo's (cell.control): give 0 there",
                  value_str(c.vel_grad(i, i)));
     } else {
-      for (const char* k : {"target", "servo_gain", "max_rate_1_s"})
+      for (const char* k : {"target", "servo_gain", "servo_fraction", "max_rate_1_s"})
         if (cell->contains(k)) r.fail(std::string("cell.") + k, "needs cell.control");
     }
     if (root.contains("walls") || root.contains("mesh"))
       r.fail("[cell]", "walls and meshes in a periodic cell are not supported");
     if (root.contains("clumps")) r.fail("[cell]", "clumps in a periodic cell are not supported");
-    if (!s.test.empty()) r.fail("[cell]", "a periodic cell runs a plain scene (no scene.test)");
+    if (!s.test.empty())
+      r.fail("[cell]", s.test == "biaxial_periodic"
+                           ? "the periodic biaxial test makes its own cell; remove [cell]"
+                           : "a periodic cell runs a plain scene (no scene.test)");
   }
   if (const auto* outlet = r.table("outlet", false)) {
     r.only(outlet, "outlet", {"keep_lo_m", "keep_hi_m"});

@@ -13,6 +13,7 @@
 #include "direct_shear.hpp"
 #include "layered_filling.hpp"
 #include "loading_programme.hpp"
+#include "periodic_biaxial.hpp"
 #include "plane_strain_compression.hpp"
 #include "simulation.hpp"
 #include "snapshot.hpp"
@@ -46,6 +47,11 @@ struct SpecimenSpec {
   double void_ratio = 0.55;  // sets the number of spheres: Σ V = V_box / (1 + e)
   std::uint64_t seed = 1;
   double cloud_solid_fraction = 0.3;  // density of the loose cloud they are placed in
+  // The periodic biaxial test (2D): a number of disks instead of size_m and void_ratio (which
+  // is then the preparation's target only), in a square cell of this thickness (m).
+  std::int64_t count = 0;
+  bool disks = true;  // two_d = "disks" (true disks) or "spheres_in_plane"
+  double thickness_m = 0;
 };
 
 struct Scene {
@@ -81,7 +87,7 @@ struct Scene {
   double dt_pwave = 0;  // YADE's PWaveTimeStep of the packing (s)
 
   // Laboratory tests (docs/scenes.md): empty `test` is a plain run of `steps` steps.
-  std::string test;  // "", "triaxial", "plane_strain", "direct_shear"
+  std::string test;  // "", "triaxial", "plane_strain", "direct_shear", "biaxial_periodic"
   std::optional<SpecimenSpec> specimen;
   std::optional<PreparationSpec> preparation;
   double wall_friction_deg = 0;  // smooth walls by default (seed 004 §4.1.2, seed 000 §3)
@@ -89,6 +95,7 @@ struct Scene {
   PlaneStrainSpec plane_strain;
   DirectShearSpec direct_shear;
   ShearBoxGeometry shear_box;
+  PeriodicBiaxialSpec biaxial_periodic;
 };
 
 /// Generates the specimen when the scene asks for one, builds the walls of its test and returns

@@ -17,6 +17,10 @@ SpecimenPreparation::SpecimenPreparation(PreparationSpec spec, SpecimenGauge gau
     throw std::invalid_argument("friction_factor must be in (0, 1)");
   if (spec_.pressure_Pa == 0 && !spec_.deposition)
     throw std::invalid_argument("preparation needs a pressure or deposition");
+  if (gauge_.cell_axes > 0 && (spec_.deposition || !(spec_.pressure_Pa > 0)))
+    throw std::invalid_argument("a periodic cell is prepared by compaction (a pressure, no deposition)");
+  if (gauge_.cell_axes > 0 && spec_.servo_gain > 1)
+    throw std::invalid_argument("servo_gain of a cell is a fraction in (0, 1]");
 }
 
 double box_void_ratio(const ParticleState& p, const Eigen::Vector3d& lo,
@@ -33,12 +37,23 @@ double box_void_ratio(const ParticleState& p, const Eigen::Vector3d& lo,
   return (hi - lo).prod() / solid - 1;
 }
 
+SpecimenGauge cell_gauge(int axes, double max_rate_1_s) {
+  if (axes != 2 && axes != 3) throw std::invalid_argument("a cell gauge servoes 2 or 3 axes");
+  if (!(max_rate_1_s > 0)) throw std::invalid_argument("cell servo rate limit must be positive");
+  SpecimenGauge g;
+  g.cell_axes = axes;
+  g.cell_max_rate_1_s = max_rate_1_s;
+  return g;
+}
+
 double SpecimenPreparation::void_ratio(const Simulation& sim) const {
+  if (gauge_.cell_axes > 0) return cell_void_ratio(sim);
   const auto [lo, hi] = gauge_.box(sim);
   return box_void_ratio(sim.particles(), lo, hi);
 }
 
 double SpecimenPreparation::core_void_ratio(const Simulation& sim) const {
+  if (gauge_.cell_axes > 0) return cell_void_ratio(sim);  // (no walls: the core is the cell)
   auto [lo, hi] = gauge_.box(sim);
   lo.array() += spec_.core_inset_m;
   hi.array() -= spec_.core_inset_m;
@@ -58,15 +73,38 @@ void SpecimenPreparation::start(Simulation& sim) {
   } else {
     stage_ = kCompaction;
   }
+  if (gauge_.cell_axes > 0) {  // the engine's stiffness-scaled servo, for every stage
+    CellServo sv;
+    for (int i = 0; i < gauge_.cell_axes; ++i) {
+      sv.stress[static_cast<std::size_t>(i)] = true;
+      sv.target[i] = -spec_.pressure_Pa;  // (the cell's stress is compression negative)
+    }
+    sv.stiffness_fraction = spec_.servo_gain;
+    sv.max_rate = gauge_.cell_max_rate_1_s;
+    sim.set_cell_servo(sv);
+  }
+}
+
+Eigen::VectorXd SpecimenPreparation::servo_stresses(const Simulation& sim) const {
+  if (gauge_.cell_axes > 0) {
+    const Eigen::Matrix3d s = sim.cell_stress();
+    return -s.diagonal().head(gauge_.cell_axes);
+  }
+  Eigen::VectorXd out(static_cast<Eigen::Index>(gauge_.servo_walls.size()));
+  for (std::size_t k = 0; k < gauge_.servo_walls.size(); ++k) {
+    const auto w = gauge_.servo_walls[k];
+    out[static_cast<Eigen::Index>(k)] =
+        wall_stress(sim, w, gauge_.inward(sim, w), gauge_.area_m2(sim, w));
+  }
+  return out;
 }
 
 bool SpecimenPreparation::equilibrium(Simulation& sim, bool with_stress) const {
   if (with_stress) {
-    for (const auto w : gauge_.servo_walls) {
-      const double s = wall_stress(sim, w, gauge_.inward(sim, w), gauge_.area_m2(sim, w));
-      if (!(std::abs(s - spec_.pressure_Pa) <= spec_.stress_tolerance * spec_.pressure_Pa))
+    const Eigen::VectorXd s = servo_stresses(sim);
+    for (const double v : s)
+      if (!(std::abs(v - spec_.pressure_Pa) <= spec_.stress_tolerance * spec_.pressure_Pa))
         return false;
-    }
   }
   const double unb = sim.unbalanced_force();
   if (!(unb <= spec_.unbalanced_force)) return false;
@@ -139,6 +177,8 @@ double SpecimenPreparation::progress(const Simulation& sim) const {
 std::string SpecimenPreparation::curve_header() const {
   std::string h =
       "step,time_s,stage,friction_deg,void_ratio,core_void_ratio,unbalanced_force,kinetic_J";
+  for (int i = 0; i < gauge_.cell_axes; ++i)
+    h += std::string(",cell_stress_") + "xyz"[i] + "xyz"[i] + "_Pa";
   for (std::size_t k = 0; k < gauge_.servo_walls.size(); ++k)
     h += ",wall" + std::to_string(gauge_.servo_walls[k]) + "_stress_Pa";
   return h;
@@ -151,9 +191,8 @@ std::string SpecimenPreparation::curve_row(const Simulation& sim) const {
                 static_cast<long long>(stage_), friction_, void_ratio(sim), core_void_ratio(sim),
                 sim.unbalanced_force(), sim.kinetic_energy());
   std::string row = buf;
-  for (const auto w : gauge_.servo_walls) {
-    std::snprintf(buf, sizeof buf, ",%.9g",
-                  wall_stress(sim, w, gauge_.inward(sim, w), gauge_.area_m2(sim, w)));
+  for (const double v : servo_stresses(sim)) {
+    std::snprintf(buf, sizeof buf, ",%.9g", v);
     row += buf;
   }
   return row;
@@ -161,6 +200,14 @@ std::string SpecimenPreparation::curve_row(const Simulation& sim) const {
 
 std::string SpecimenPreparation::summary(const Simulation& sim) const {
   char buf[256];
+  if (gauge_.cell_axes > 0) {
+    std::snprintf(buf, sizeof buf,
+                  "preparation: %lld steps, void ratio %.4f of the cell (target %.4f); friction "
+                  "lowered to %.3g deg",
+                  static_cast<long long>(sim.step_count() - first_step_), void_ratio(sim),
+                  spec_.void_ratio_target, lowest_friction_);
+    return buf;
+  }
   std::snprintf(buf, sizeof buf,
                 "preparation: %lld steps, void ratio %.4f in the core (%.4g m from the walls; "
                 "target %.4f), %.4f over the whole box; friction lowered to %.3g deg",

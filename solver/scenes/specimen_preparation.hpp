@@ -28,6 +28,7 @@ struct PreparationSpec {
   double kinetic_ratio = 1e-3;      // kinetic / elastic energy threshold
   double servo_gain = 0.25;         // fraction of the stress error removed per step
   double max_wall_speed_m_s = 0.1;
+  double max_cell_rate_1_s = 1.0;  // a periodic cell's |L_ii| limit
   double core_inset_m = 0;  // void ratio of the core box inset by this from the walls (0: whole
                             // box); walls loosen the layer of grains they touch
   bool deposition = false;  // first let the cloud settle under gravity
@@ -43,7 +44,16 @@ struct SpecimenGauge {
   std::vector<std::size_t> servo_walls;
   std::function<Eigen::Vector3d(const Simulation&, std::size_t wall)> inward;
   std::function<double(const Simulation&, std::size_t wall)> area_m2;
+  /// A periodic cell instead of walls (no servo walls, no box): the servo drives the cell's
+  /// first `cell_axes` diagonal components (2: the plane; 3) to −σc (Simulation::set_cell_servo
+  /// with stiffness_fraction = servo_gain, max_rate = cell_max_rate_1_s), the void ratio is the
+  /// cell's (cell_void_ratio).
+  int cell_axes = 0;
+  double cell_max_rate_1_s = 1.0;
 };
+
+/// The gauge of a periodic cell servo-controlled on `axes` axes.
+SpecimenGauge cell_gauge(int axes, double max_rate_1_s);
 
 /// Void ratio of the box [lo, hi] from the exact sphere–box intersection volumes.
 double box_void_ratio(const ParticleState& p, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi);
@@ -73,6 +83,9 @@ class SpecimenPreparation final : public LoadingProgramme {
 
  private:
   bool equilibrium(Simulation& sim, bool with_stress) const;
+  /// The stresses the servo holds (compression positive, Pa): each servo wall's, or the cell's
+  /// diagonal.
+  Eigen::VectorXd servo_stresses(const Simulation& sim) const;
   void next_stage(Simulation& sim);
 
   PreparationSpec spec_;
