@@ -2,8 +2,10 @@
 // distribution moments) on small synthetic configurations.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
+#include <string>
 
 #include "cuboid_walls.hpp"
 #include "flexible_membrane.hpp"
@@ -117,6 +119,212 @@ TEST(SpecimenGeneration, OverfullBoxIsAClearError) {
   EXPECT_THROW(random_sequential_packing({0.02}, Eigen::Vector3d::Zero(),
                                          Eigen::Vector3d::Constant(0.01), rng),
                std::invalid_argument);
+}
+
+// Kuhn's specimen (seed 002 §4, Kuhn 1999): "1002 irregularly arranged circular disks ...
+// largest and smallest having diameters 1.4 and 0.45 times the weight-median diameter D50. The
+// coefficient of uniformity D60/D10 was 1.7". Diameters in units of D50 = 1 mm.
+SizeSpec kuhn_sizes(int mass_exponent) {
+  SizeSpec s{0.45e-3, 1.4e-3, SizeDistribution::Graded};
+  s.d50_m = 1e-3;
+  s.uniformity = 1.7;
+  s.mass_exponent = mass_exponent;
+  return s;
+}
+
+/// Diameter finer than which `fraction` of the sample's mass (∝ dᵏ) lies.
+double empirical_mass_quantile(std::vector<double> d, int k, double fraction) {
+  std::sort(d.begin(), d.end());
+  double total = 0;
+  for (const double x : d) total += std::pow(x, k);
+  double finer = 0;
+  for (const double x : d) {
+    finer += std::pow(x, k);
+    if (finer >= fraction * total) return x;
+  }
+  return d.back();
+}
+
+TEST(SpecimenGeneration, GradedFitReachesKuhnsD50AndUniformity) {
+  for (const int k : {2, 3}) {
+    SizeSpec s = kuhn_sizes(k);
+    fit_graded(s);
+    EXPECT_GT(s.fit_sigma_m, 0.0);
+    ASSERT_TRUE(s.graded_table);
+    const double d10 = mass_quantile(s, 0.1), d50 = mass_quantile(s, 0.5),
+                 d60 = mass_quantile(s, 0.6);
+    EXPECT_NEAR(d50 / 1e-3, 1.0, 1e-9) << "k = " << k;
+    EXPECT_NEAR(d60 / d10, 1.7, 1e-9) << "k = " << k;
+    EXPECT_NEAR(mass_fraction_finer(s, d50), 0.5, 1e-12);
+    EXPECT_NEAR(mass_fraction_finer(s, d10), 0.1, 1e-12);
+    EXPECT_EQ(mass_fraction_finer(s, s.dmin_m), 0.0);
+    EXPECT_EQ(mass_fraction_finer(s, s.dmax_m), 1.0);
+    EXPECT_EQ(mass_quantile(s, 0.0), s.dmin_m);
+    EXPECT_EQ(mass_quantile(s, 1.0), s.dmax_m);
+    // The curve is a truncated normal: its mass density ratio at two diameters is the
+    // Gaussian's, exp(−((b − μ)² − (a − μ)²)/(2σ²)) (finite differences of the curve, O(h²)).
+    const double h = 1e-7, a = 0.6e-3, b = 1.2e-3;
+    const double fa = mass_fraction_finer(s, a + h) - mass_fraction_finer(s, a - h);
+    const double fb = mass_fraction_finer(s, b + h) - mass_fraction_finer(s, b - h);
+    const double m = s.fit_mu_m, sg = s.fit_sigma_m;
+    EXPECT_NEAR(fb / fa, std::exp(-((b - m) * (b - m) - (a - m) * (a - m)) / (2 * sg * sg)), 1e-5);
+  }
+  // The fit depends on the grading curve by mass only, not on k.
+  SizeSpec s2 = kuhn_sizes(2), s3 = kuhn_sizes(3);
+  fit_graded(s2);
+  fit_graded(s3);
+  EXPECT_EQ(s2.fit_mu_m, s3.fit_mu_m);
+  EXPECT_EQ(s2.fit_sigma_m, s3.fit_sigma_m);
+}
+
+TEST(SpecimenGeneration, GradedFitOutsideTheReachableRangeIsAClearError) {
+  auto message = [](SizeSpec s) {
+    try {
+      fit_graded(s);
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  SizeSpec s = kuhn_sizes(2);
+  s.d50_m = 0.45e-3;  // at dmin
+  EXPECT_NE(message(s).find("strictly between"), std::string::npos) << message(s);
+  s.d50_m = 1.5e-3;  // above dmax
+  EXPECT_NE(message(s).find("strictly between"), std::string::npos);
+  s = kuhn_sizes(2);
+  s.uniformity = 1.0;
+  EXPECT_NE(message(s).find("exceed 1"), std::string::npos);
+  // Uniform by mass on [0.45, 1.4] has D60/D10 = 1.02/0.545 = 1.87; with D50 = 1 the σ → ∞
+  // limit is a little above: 2.0 is out of reach, and the message says how far one can go.
+  s.uniformity = 2.0;
+  const std::string m = message(s);
+  EXPECT_NE(m.find("achievable"), std::string::npos) << m;
+  EXPECT_NE(m.find("D60/D10 = 2"), std::string::npos) << m;
+  // Just below the limit the fit succeeds; the reported limit itself is refused.
+  const auto at = m.find("between 1 and ");
+  ASSERT_NE(at, std::string::npos);
+  const double limit = std::stod(m.substr(at + 14));
+  EXPECT_GT(limit, 1.87);
+  EXPECT_LT(limit, 2.0);
+  s.uniformity = limit * (1 - 1e-6);
+  EXPECT_NO_THROW(fit_graded(s));
+  s.uniformity = limit * (1 + 1e-9);
+  EXPECT_THROW(fit_graded(s), std::invalid_argument);
+  // With D50 mid-range the limit is the grading curve uniform by mass: D60/D10 = 1.02/0.545.
+  s.d50_m = 0.925e-3;
+  s.uniformity = 2.0;
+  const std::string mid = message(s);
+  ASSERT_NE(mid.find("between 1 and "), std::string::npos) << mid;
+  EXPECT_NEAR(std::stod(mid.substr(mid.find("between 1 and ") + 14)), 1.02 / 0.545, 1e-9);
+  // Drawing from a Graded spec whose table is missing or stale is refused.
+  std::mt19937_64 rng(1);
+  SizeSpec unfitted = kuhn_sizes(2);
+  EXPECT_THROW(draw_diameter(unfitted, rng), std::invalid_argument);
+  EXPECT_THROW(mass_quantile(unfitted, 0.5), std::invalid_argument);
+  fit_graded(unfitted);
+  unfitted.uniformity = 1.6;
+  EXPECT_THROW(draw_diameter(unfitted, rng), std::invalid_argument);
+}
+
+TEST(SpecimenGeneration, GradedSampleFollowsTheFittedCurveByMass) {
+  for (const int k : {2, 3}) {
+    SizeSpec s = kuhn_sizes(k);
+    fit_graded(s);
+    std::mt19937_64 rng(17);
+    const auto d = draw_diameter_count(s, 200000, rng);
+    ASSERT_EQ(d.size(), 200000u);
+    EXPECT_TRUE(std::is_sorted(d.begin(), d.end(), std::greater<>()));
+    EXPECT_GE(d.back(), s.dmin_m);
+    EXPECT_LE(d.front(), s.dmax_m);
+    for (const double q : {0.1, 0.5, 0.6})
+      EXPECT_NEAR(empirical_mass_quantile(d, k, q) / mass_quantile(s, q), 1.0, 0.005)
+          << "k = " << k << ", D" << 100 * q;
+    // Same seed, same draws (also through a spec without a table, fitted on a copy).
+    std::mt19937_64 again(17);
+    SizeSpec bare = kuhn_sizes(k);
+    EXPECT_EQ(draw_diameter_count(bare, 200000, again), d);
+  }
+}
+
+TEST(SpecimenGeneration, LinearGradingCurveForDisks) {
+  // Mass ∝ d²: number density ∝ d⁻², and the mass-weighted median is (dmin + dmax)/2.
+  SizeSpec s{0.45e-3, 1.4e-3, SizeDistribution::Linear};
+  s.mass_exponent = 2;
+  std::mt19937_64 rng(23);
+  const auto d = draw_diameter_count(s, 200000, rng);
+  EXPECT_GE(d.back(), s.dmin_m);
+  EXPECT_LE(d.front(), s.dmax_m);
+  EXPECT_NEAR(empirical_mass_quantile(d, 2, 0.5) / (0.5 * (s.dmin_m + s.dmax_m)), 1.0, 0.005);
+  EXPECT_NEAR(empirical_mass_quantile(d, 2, 0.25) / mass_quantile(s, 0.25), 1.0, 0.005);
+  EXPECT_EQ(mass_quantile(s, 0.5), 0.5 * (s.dmin_m + s.dmax_m));
+  // The k = 3 draw is the inverse transform (dmin⁻² − u·(dmin⁻² − dmax⁻²))^(−1/2), bit for bit.
+  const SizeSpec s3{0.00125, 0.00375, SizeDistribution::Linear};
+  std::mt19937_64 a(3), b(3);
+  const double lo = 1 / (s3.dmin_m * s3.dmin_m), hi = 1 / (s3.dmax_m * s3.dmax_m);
+  for (int i = 0; i < 100; ++i)
+    ASSERT_EQ(draw_diameter(s3, a), 1 / std::sqrt(lo - uniform01(b) * (lo - hi)));
+  // Uniform by number: the mass fraction finer grows as d^(k+1).
+  SizeSpec u{1.0, 2.0, SizeDistribution::Uniform};
+  u.mass_exponent = 2;
+  EXPECT_NEAR(mass_fraction_finer(u, 1.5), (1.5 * 1.5 * 1.5 - 1) / 7, 1e-15);
+  EXPECT_NEAR(mass_quantile(u, (1.5 * 1.5 * 1.5 - 1) / 7), 1.5, 1e-15);
+}
+
+TEST(SpecimenGeneration, PeriodicDiskPackingOfKuhnsSpecimen) {
+  SizeSpec s = kuhn_sizes(2);
+  fit_graded(s);
+  std::mt19937_64 rng(1002);
+  const auto d = draw_diameter_count(s, 1002, rng);
+  double solid = 0;
+  for (const double x : d) solid += M_PI / 4 * x * x;
+  const double l = std::sqrt(solid / 0.5);  // area fraction 0.5
+  const auto p = random_disk_packing_periodic(d, l, l, 0.25e-3, rng);
+  ASSERT_EQ(p.size(), 1002u);
+  std::vector<double> radii;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    EXPECT_EQ(p[i].id, static_cast<std::int64_t>(i));
+    EXPECT_EQ(2 * p[i].radius, d[i]);
+    EXPECT_EQ(p[i].position.z(), 0.25e-3);
+    EXPECT_GE(p[i].position.x(), 0.0);
+    EXPECT_LT(p[i].position.x(), l);
+    EXPECT_GE(p[i].position.y(), 0.0);
+    EXPECT_LT(p[i].position.y(), l);
+    radii.push_back(p[i].radius);
+    for (std::size_t j = 0; j < i; ++j) {  // brute force under the minimum image
+      const double ex = std::remainder(p[i].position.x() - p[j].position.x(), l);
+      const double ey = std::remainder(p[i].position.y() - p[j].position.y(), l);
+      const double reach = p[i].radius + p[j].radius;
+      ASSERT_GE(ex * ex + ey * ey, reach * reach) << "disks " << i << " and " << j << " overlap";
+    }
+  }
+  EXPECT_NEAR(disk_void_ratio(radii, l * l), 1.0, 1e-12);
+  // Some disks reach across the cell's edges (the periodic images matter).
+  int across = 0;
+  for (const auto& q : p) across += q.position.x() < q.radius || q.position.x() > l - q.radius;
+  EXPECT_GT(across, 0);
+  // Same seed, same packing; another seed, another packing.
+  std::mt19937_64 again(1002), other(1003);
+  const auto p2 =
+      random_disk_packing_periodic(draw_diameter_count(s, 1002, again), l, l, 0.25e-3, again);
+  for (std::size_t i = 0; i < p.size(); ++i) ASSERT_EQ(p2[i].position, p[i].position);
+  const auto p3 = random_disk_packing_periodic(d, l, l, 0.25e-3, other);
+  EXPECT_NE(p3[0].position, p[0].position);
+}
+
+TEST(SpecimenGeneration, PeriodicDiskPackingErrors) {
+  std::mt19937_64 rng(1);
+  // A side below twice the largest disk.
+  EXPECT_THROW(random_disk_packing_periodic({1.0, 0.5}, 1.99, 5.0, 0, rng), std::invalid_argument);
+  EXPECT_THROW(random_disk_packing_periodic({1.0, 0.5}, 5.0, 1.99, 0, rng), std::invalid_argument);
+  EXPECT_NO_THROW(random_disk_packing_periodic({1.0}, 2.0, 2.0, 0, rng));
+  // More disk area than the cell holds: area fraction 100 · π/4 / 25 = 3.1.
+  try {
+    random_disk_packing_periodic(std::vector<double>(100, 1.0), 5.0, 5.0, 0, rng, 500);
+    FAIL() << "no error";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("found no free place"), std::string::npos);
+  }
+  EXPECT_TRUE(random_disk_packing_periodic({}, 1.0, 1.0, 0, rng).empty());
 }
 
 TEST(SpecimenGeneration, BoxVoidRatioIsExactForCutSpheres) {
