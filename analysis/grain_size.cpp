@@ -5,20 +5,23 @@
 
 namespace gs::analysis {
 
-double diameter_percentile(std::vector<double> radii, double fraction) {
+double diameter_percentile(std::vector<double> radii, double fraction, int exponent) {
   if (radii.empty()) throw std::invalid_argument("diameter_percentile: no particles");
   if (!(fraction >= 0 && fraction <= 1))
     throw std::invalid_argument("diameter_percentile: fraction outside [0, 1]");
   std::sort(radii.begin(), radii.end());
   // Cumulative volume passing at each distinct diameter, counting half of that size class's
   // own volume (mid-point rule), so a monodisperse sample returns its diameter for every fraction.
+  if (exponent != 2 && exponent != 3)
+    throw std::invalid_argument("diameter_percentile: weight exponent must be 2 or 3");
+  const auto weight = [exponent](double r) { return exponent == 3 ? r * r * r : r * r; };
   double total = 0;
-  for (double r : radii) total += r * r * r;
+  for (double r : radii) total += weight(r);
   double below = 0, prev_d = 2 * radii.front(), prev_c = 0;
   for (std::size_t i = 0; i < radii.size();) {
     std::size_t j = i;
     double v = 0;
-    for (; j < radii.size() && radii[j] == radii[i]; ++j) v += radii[j] * radii[j] * radii[j];
+    for (; j < radii.size() && radii[j] == radii[i]; ++j) v += weight(radii[j]);
     const double c = (below + 0.5 * v) / total;
     const double d = 2 * radii[i];
     if (fraction <= c) {
@@ -37,7 +40,7 @@ double diameter_percentile(const Frame& frame, double fraction) {
   std::vector<double> r;
   r.reserve(frame.particles.size());
   for (const auto& p : frame.particles) r.push_back(p.radius);
-  return diameter_percentile(std::move(r), fraction);
+  return diameter_percentile(std::move(r), fraction, frame.two_d ? 2 : 3);
 }
 
 }  // namespace gs::analysis

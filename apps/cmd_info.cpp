@@ -36,7 +36,8 @@ void print_info(const std::string& file, const std::string& format, std::size_t 
   }
   if (last.two_d) std::printf("dimension:    2D (in the xy plane)\n");
   if (!last.particles.empty())
-    std::printf("d50:          %.6g m (by volume, last frame)\n", analysis::d50(last));
+    std::printf("d50:          %.6g m (by %s, last frame)\n", analysis::d50(last),
+                last.two_d ? "area: 2D" : "volume");
   std::printf("walls:        %zu\n", last.walls.size());
   if (!last.clumps.empty())
     std::printf("clumps:       %zu bodies (last frame)\n", last.clumps.size());

@@ -1003,6 +1003,28 @@ double Simulation::kinetic_energy() const {
   return e;
 }
 
+double Simulation::kinetic_energy_in_contact() const {
+  std::vector<std::uint8_t> touching(p_.size(), 0);
+  for (const auto& h : hist_) {
+    if (!h.real) continue;
+    touching[h.a] = 1;
+    if (h.b < kWallBase) touching[h.b] = 1;
+  }
+  double e = 0;
+  for (std::size_t i = 0; i < p_.size(); ++i) {
+    if (p_.clump[i] >= 0 || !touching[i]) continue;
+    const Eigen::Vector3d v = periodic_ ? Eigen::Vector3d(p_.vel[i] - cell_.vel_grad * p_.pos[i])
+                                        : p_.vel[i];
+    e += 0.5 * p_.mass[i] * v.squaredNorm() + 0.5 * p_.inertia[i] * p_.angvel[i].squaredNorm();
+  }
+  for (const auto& c : clumps_) {
+    bool t = false;
+    for (const std::uint32_t i : c.members) t = t || touching[i];
+    if (t) e += clump_kinetic_energy(c);
+  }
+  return e;
+}
+
 double Simulation::inertial_number() const {
   // Over the particles in the scene (not those removed or waiting to be inserted).
   std::size_t n = 0;

@@ -103,6 +103,10 @@ class Simulation {
   /// YADE's unbalancedForce: mean |resultant force| on free particles / mean |contact force|.
   double unbalanced_force() const;
   double kinetic_energy() const;
+  /// The kinetic energy of the bodies that touch something (a real contact): without the
+  /// rattlers, which in a periodic cell keep flying or spinning undamped (local damping acts on
+  /// forces) and would hold any kinetic-energy criterion of equilibrium off forever.
+  double kinetic_energy_in_contact() const;
   /// Global inertial number I = γ̇·d/sqrt(p/ρ): γ̇ = sqrt(2·D':D') from the least-squares
   /// affine fit of particle velocities to positions (D its symmetric part, ' deviatoric),
   /// d the mean diameter, p the mean stress of the contact (Love–Weber) stress over the bounding

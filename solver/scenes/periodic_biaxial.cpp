@@ -33,7 +33,7 @@ void PeriodicBiaxial::start(Simulation& sim) {
   // curve lags ε̇t by under 1.5 % of itself up to ε22 = 3 %; docs/scenes.md).
   sv.target = {-spec_.lateral_stress_Pa, -spec_.strain_rate_1_s, 0.0};
   sv.stiffness_fraction = spec_.servo_fraction;
-  sv.max_rate = spec_.max_rate_1_s;
+  sv.max_rate = spec_.max_rate_1_s > 0 ? spec_.max_rate_1_s : 10 * spec_.strain_rate_1_s;
   sim.set_cell_servo(sv);
 }
 

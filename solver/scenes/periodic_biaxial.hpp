@@ -18,7 +18,7 @@ struct PeriodicBiaxialSpec {
   double frame_every_strain = 0.005;  // trajectory frames every Δε22 …
   std::vector<double> frame_strains;  // … and when ε22 passes each of these (sorted)
   double servo_fraction = 0.2;        // CellServo::stiffness_fraction of the width servo
-  double max_rate_1_s = 1.0;          // |L11| limit of the width servo
+  double max_rate_1_s = 0;            // |L11| limit of the width servo (0: 10·ε̇)
   double inertial_warning = 1e-4;
   double d50_m = 0;  // for the inertial number (0: mean diameter)
 };

@@ -212,7 +212,8 @@ void read_lab_sections(const Reader& r, const toml::table& root, Scene& s) {
     x.servo_fraction = r.positive(t, sec, "servo_fraction", false, x.servo_fraction);
     if (x.servo_fraction > 1)
       r.fail("biaxial_periodic.servo_fraction", "must be at most 1", value_str(x.servo_fraction));
-    x.max_rate_1_s = r.positive(t, sec, "max_rate_1_s", false, x.max_rate_1_s);
+    if (t->contains("max_rate_1_s"))
+      x.max_rate_1_s = r.positive(t, sec, "max_rate_1_s", true, 0);
     x.inertial_warning = r.positive(t, sec, "inertial_warning", false, x.inertial_warning);
   } else if (s.test == "direct_shear") {
     const auto* t = r.table("direct_shear", true);

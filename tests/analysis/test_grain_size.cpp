@@ -24,3 +24,26 @@ TEST(GrainSize, RejectsEmptyAndBadFraction) {
   EXPECT_THROW(diameter_percentile(std::vector<double>{}, 0.5), std::invalid_argument);
   EXPECT_THROW(diameter_percentile(std::vector<double>{1.0}, 1.5), std::invalid_argument);
 }
+
+TEST(GrainSize, TwoSizesByAreaIn2D) {
+  // 2D (disks, weight ∝ r²): one disk of r = 2 (4 units) and four of r = 1 (4 units): the same
+  // half-way d50 = 3 by area, while by volume the small ones weigh 4 of 12 units (d50 = 10/3 by
+  // interpolation between the mid-points 2/12 and 8/12).
+  std::vector<double> r(4, 1.0);
+  r.push_back(2.0);
+  EXPECT_DOUBLE_EQ(diameter_percentile(r, 0.5, 2), 3.0);
+  EXPECT_DOUBLE_EQ(diameter_percentile(r, 0.5, 3), 2.0 + 2.0 * (0.5 - 2.0 / 12) / (0.5));
+  gs::Frame f;
+  for (std::size_t i = 0; i < r.size(); ++i) {
+    gs::Particle p;
+    p.id = static_cast<std::int64_t>(i);
+    p.radius = r[i];
+    p.position = Eigen::Vector3d(10.0 * static_cast<double>(i), 0, 0);
+    f.particles.push_back(p);
+  }
+  f.two_d = true;
+  EXPECT_DOUBLE_EQ(diameter_percentile(f, 0.5), 3.0);
+  f.two_d = false;
+  EXPECT_DOUBLE_EQ(diameter_percentile(f, 0.5), diameter_percentile(r, 0.5, 3));
+  EXPECT_THROW(diameter_percentile(r, 0.5, 4), std::invalid_argument);
+}

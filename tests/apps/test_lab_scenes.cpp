@@ -292,7 +292,7 @@ TEST(LabScenes, BadScenesExitTwoWithOneLine) {
        {"young_Pa = 3.0e8", "young_MPa = 300.0", "material.young_MPa: unknown key"}},
       {"bad distribution",
        {"dmax_m = 0.008", "dmax_m = 0.008\ndistribution = \"bimodal\"",
-        "specimen.distribution: expected \"uniform\" or \"linear\" (bimodal)"}},
+        "specimen.distribution: expected \"uniform\", \"linear\" or \"graded\" (bimodal)"}},
       {"walls in a test",
        {"[output]", "[[walls]]\nname = \"x\"\nshape = \"plane\"\n[output]",
         "[[walls]]: a laboratory test builds its own walls; remove [[walls]]"}},
@@ -311,7 +311,8 @@ TEST(LabScenes, BadScenesExitTwoWithOneLine) {
         "preparation.pressure_Pa: negative (-1)"}},
       {"unknown test",
        {"test = \"triaxial\"", "test = \"oedometer\"",
-        "scene.test: expected \"triaxial\", \"plane_strain\" or \"direct_shear\" (oedometer)"}},
+        "scene.test: expected \"triaxial\", \"plane_strain\", \"direct_shear\" or "
+        "\"biaxial_periodic\" (oedometer)"}},
   };
   for (const auto& [what, c] : cases) {
     std::string text = base;

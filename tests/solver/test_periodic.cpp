@@ -401,3 +401,31 @@ TEST(PeriodicCell, StiffnessScaledServoHoldsTheTargetAndResumesBitForBit) {
   servo.stiffness_fraction = 1.5;
   EXPECT_THROW(a->set_cell_servo(servo), std::invalid_argument);
 }
+
+// A rattler spinning alone keeps its energy (nothing damps a free body); the equilibrium checks
+// of a cell count only the bodies in contact: exactly the kinetic energy of the touching pair.
+TEST(PeriodicCell, KineticEnergyInContactLeavesTheRattlersOut) {
+  const double r = 0.001, t = 0.004;
+  auto a = sphere(0, {0.004, 0.005, 0.002}, r);
+  auto b = sphere(1, {0.005999, 0.005, 0.002}, r);
+  auto c = sphere(2, {0.009, 0.009, 0.002}, r);
+  a.velocity = {0.01, 0, 0};
+  c.angular_velocity = {0, 0, 30.0};
+  auto cfg = config(0.3);
+  cfg.dt = 1e-7;
+  Simulation sim(cfg, {a, b, c}, {});
+  Eigen::Matrix3d h = Eigen::Matrix3d::Zero();
+  h.diagonal() << 0.012, 0.012, t;
+  sim.set_periodic(h, true);
+  sim.set_disks(t);
+  for (int n = 0; n < 50; ++n) sim.step();
+  ASSERT_EQ(sim.contact_count(), 1u);
+  const auto& p = sim.particles();
+  double pair = 0;
+  for (int i = 0; i < 2; ++i)
+    pair += 0.5 * p.mass[i] * p.vel[i].squaredNorm() + 0.5 * p.inertia[i] * p.angvel[i].squaredNorm();
+  const double spin = 0.5 * p.inertia[2] * p.angvel[2].squaredNorm();
+  EXPECT_EQ(p.angvel[2].z(), 30.0);  // (undamped: no force, no damping)
+  EXPECT_NEAR(sim.kinetic_energy_in_contact(), pair, 1e-15 * pair);
+  EXPECT_NEAR(sim.kinetic_energy(), pair + spin, 1e-15 * (pair + spin));
+}
