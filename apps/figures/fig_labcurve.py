@@ -3,6 +3,7 @@ curve.csv (and preparation.csv) beside the trajectory; nothing when there is non
   triaxial / plane strain: mobilised friction angle and σ1/σ3 vs ε1, volumetric strain vs ε1
   (dilation positive, as seed 004 Figs 4.2-4.8 and seed 000 Fig 3);
   direct shear: τ/σn and volumetric strain vs horizontal displacement u (seed 004 Fig 4.12);
+  periodic biaxial (2D): σ22 − σ11 and σ22/σ11 vs ε22, area strain vs ε22 (seed 002 Fig 7b);
   preparation: void ratio and friction against steps."""
 import csv
 import os
@@ -56,6 +57,27 @@ def shear(c, title):
     return fig
 
 
+def biaxial(c, title):
+    fig, (a1, a2) = plt.subplots(2, 1, figsize=(6.5, 7), sharex=True)
+    e22 = 100 * c["eps22_shortening"]
+    dev = 1e-3 * (c["sigma22_Pa"] - c["sigma11_Pa"])
+    a1.plot(e22, dev, "k-")
+    a1.set_ylabel("Δσ22 = σ22 − σ11 (kPa)")
+    k = int(np.argmax(dev))
+    a1.plot(e22[k], dev[k], "ro")
+    a1.annotate(f"peak {dev[k]:.0f} kPa at ε22 = {e22[k]:.2f} %", (e22[k], dev[k]),
+                textcoords="offset points", xytext=(8, -14), fontsize=8)
+    r = a1.twinx()
+    r.plot(e22, c["sigma22_over_sigma11"], color="0.6", lw=0.8)
+    r.set_ylabel("σ22/σ11", color="0.5")
+    a2.plot(e22, 100 * c["eps_v_dilation"], "k-")
+    a2.axhline(0, color="0.7", lw=0.5)
+    a2.set_ylabel("area strain (%, dilation +)")
+    a2.set_xlabel("vertical strain ε22 (%, shortening +)")
+    a1.set_title(title)
+    return fig
+
+
 def preparation(c, title):
     fig, a1 = plt.subplots(figsize=(6.5, 4))
     a1.plot(c["step"], c["void_ratio"], "k-", label="whole box")
@@ -79,6 +101,8 @@ def make(path, out_dir, args):
         c = read(curve)
         if "u_m" in c:
             fig = shear(c, f"{stem}: direct shear")
+        elif "eps22_shortening" in c:
+            fig = biaxial(c, f"{stem}: periodic biaxial")
         elif "eps1_shortening" in c:
             fig = compression(c, f"{stem}: {'plane strain' if 'width_m' in c else 'triaxial'}")
         else:

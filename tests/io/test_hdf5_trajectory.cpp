@@ -439,7 +439,7 @@ TEST(Hdf5Trajectory, EveryDatasetIsChunkedShuffledDeflatedAndChecksummed) {
       ++checked;
     }
   }
-  EXPECT_EQ(checked, 48);
+  EXPECT_EQ(checked, 49);
   H5Fclose(f);
 }
 

@@ -43,6 +43,7 @@ inline Frame random_frame(std::size_t np, std::size_t nc, unsigned seed, double 
   f.domain.hi = f.domain.lo + Eigen::Vector3d(1.5, 2.5, 3.5);
   f.domain.periodic = seed % 3 == 0;
   f.domain.cell = Eigen::Matrix3d::Random();
+  if (f.domain.periodic) f.domain.velocity_gradient = Eigen::Matrix3d::Random();
   for (std::size_t i = 0; i < np; ++i) {
     Particle p;
     p.id = static_cast<std::int64_t>(i * 7 + seed);
@@ -134,6 +135,7 @@ inline void expect_same_frame(const Frame& a, const Frame& b, bool with_walls = 
   EXPECT_EQ(a.domain.hi, b.domain.hi);
   EXPECT_EQ(a.domain.periodic, b.domain.periodic);
   EXPECT_EQ(a.domain.cell, b.domain.cell);
+  EXPECT_EQ(a.domain.velocity_gradient, b.domain.velocity_gradient);
   for (std::size_t i = 0; i < a.particles.size(); ++i) {
     const auto &p = a.particles[i], &q = b.particles[i];
     EXPECT_EQ(p.id, q.id);
