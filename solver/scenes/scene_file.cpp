@@ -631,7 +631,7 @@ Scene load_scene(const std::filesystem::path& path) {
     if (periodic2d)
       r.only(specimen, "specimen",
              {"count", "two_d", "thickness_m", "dmin_m", "dmax_m", "distribution", "d50_m",
-              "uniformity", "void_ratio", "seed", "cloud_solid_fraction"});
+              "uniformity", "grading", "void_ratio", "seed", "cloud_solid_fraction"});
     else
       r.only(specimen, "specimen",
              {"size_m", "dmin_m", "dmax_m", "distribution", "d50_m", "uniformity", "void_ratio",
@@ -660,8 +660,33 @@ Scene load_scene(const std::filesystem::path& path) {
       sp.sizes.distribution = SizeDistribution::Linear;
     else if (dist == "graded")
       sp.sizes.distribution = SizeDistribution::Graded;
+    else if (dist == "piecewise")
+      sp.sizes.distribution = SizeDistribution::Piecewise;
     else
-      r.fail("specimen.distribution", "expected \"uniform\", \"linear\" or \"graded\"", dist);
+      r.fail("specimen.distribution",
+             "expected \"uniform\", \"linear\", \"graded\" or \"piecewise\"", dist);
+    if (dist == "piecewise") {
+      // grading = [[d_m, mass fraction finer], …] from [dmin_m, 0] to [dmax_m, 1]; d50_m (the
+      // weight-median, for the biaxial test's scales) is read off the curve.
+      const auto* a = specimen->contains("grading") ? (*specimen)["grading"].as_array() : nullptr;
+      if (!a) r.fail("specimen.grading", "missing: [[d_m, fraction finer], …]");
+      for (std::size_t i = 0; i < a->size(); ++i) {
+        const auto* row = (*a)[i].as_array();
+        const auto d = row && row->size() == 2 ? (*row)[0].value<double>() : std::nullopt;
+        const auto f = row && row->size() == 2 ? (*row)[1].value<double>() : std::nullopt;
+        if (!d || !f)
+          r.fail("specimen.grading", "expected [d_m, fraction] pairs", std::to_string(i));
+        sp.sizes.grading.emplace_back(*d, *f);
+      }
+      try {
+        check_piecewise(sp.sizes);
+      } catch (const std::invalid_argument& e) {
+        r.fail("specimen.grading", e.what());
+      }
+      sp.sizes.d50_m = mass_quantile(sp.sizes, 0.5);
+    } else if (specimen->contains("grading")) {
+      r.fail("specimen.grading", "only for distribution = \"piecewise\"");
+    }
     if (dist == "graded") {
       sp.sizes.d50_m = r.positive(specimen, "specimen", "d50_m", true, 0);
       sp.sizes.uniformity = r.positive(specimen, "specimen", "uniformity", true, 0);

@@ -251,6 +251,53 @@ void fit_graded(SizeSpec& s) {
   s.graded_table = tabulate(s);
 }
 
+void check_piecewise(const SizeSpec& s) {
+  const auto& g = s.grading;
+  if (g.size() < 2) throw std::invalid_argument("Piecewise grading needs at least 2 points");
+  if (g.front().first != s.dmin_m || g.front().second != 0 || g.back().first != s.dmax_m ||
+      g.back().second != 1)
+    throw std::invalid_argument("Piecewise grading must run from (dmin, 0) to (dmax, 1)");
+  for (std::size_t i = 1; i < g.size(); ++i)
+    if (!(g[i].first > g[i - 1].first) || !(g[i].second >= g[i - 1].second))
+      throw std::invalid_argument(
+          "Piecewise grading: diameters must increase and fractions not decrease (point " +
+          std::to_string(i) + ")");
+}
+
+namespace {
+/// ∫ x⁻ᵏ dx from a to d (the number of grains of a unit mass density, up to a constant).
+double inverse_power_integral(int k, double a, double d) {
+  if (k == 1) return std::log(d / a);
+  return (std::pow(a, 1.0 - k) - std::pow(d, 1.0 - k)) / (k - 1.0);
+}
+/// The d in [a, b] at which inverse_power_integral(k, a, d) = t·inverse_power_integral(k, a, b).
+double inverse_power_quantile(int k, double a, double b, double t) {
+  if (k == 1) return std::clamp(a * std::exp(t * std::log(b / a)), a, b);
+  const double e = 1.0 - k, pa = std::pow(a, e), pb = std::pow(b, e);
+  return std::clamp(std::pow(pa - t * (pa - pb), 1 / e), a, b);
+}
+double draw_piecewise(const SizeSpec& s, double u) {
+  check_piecewise(s);
+  const auto& g = s.grading;
+  std::vector<double> w(g.size() - 1);  // number share of each segment
+  double total = 0;
+  for (std::size_t i = 0; i + 1 < g.size(); ++i) {
+    const double a = g[i].first, b = g[i + 1].first, dm = g[i + 1].second - g[i].second;
+    w[i] = dm / (b - a) * inverse_power_integral(s.mass_exponent, a, b);
+    total += w[i];
+  }
+  double acc = 0;
+  for (std::size_t i = 0; i < w.size(); ++i) {
+    if (w[i] <= 0) continue;
+    if (u * total < acc + w[i] || i + 1 == w.size())
+      return inverse_power_quantile(s.mass_exponent, g[i].first, g[i + 1].first,
+                                    std::clamp((u * total - acc) / w[i], 0.0, 1.0));
+    acc += w[i];
+  }
+  return s.dmax_m;
+}
+}  // namespace
+
 double mass_fraction_finer(const SizeSpec& s, double d) {
   check_range(s);
   if (d <= s.dmin_m) return 0;
@@ -265,6 +312,15 @@ double mass_fraction_finer(const SizeSpec& s, double d) {
       return (d - s.dmin_m) / (s.dmax_m - s.dmin_m);
     case SizeDistribution::Graded:
       return graded_curve(s).finer(d);
+    case SizeDistribution::Piecewise: {
+      check_piecewise(s);
+      const auto& g = s.grading;
+      for (std::size_t i = 1; i < g.size(); ++i)
+        if (d <= g[i].first)
+          return g[i - 1].second + (g[i].second - g[i - 1].second) * (d - g[i - 1].first) /
+                                       (g[i].first - g[i - 1].first);
+      return 1;
+    }
   }
   throw std::invalid_argument("unknown size distribution");
 }
@@ -283,6 +339,15 @@ double mass_quantile(const SizeSpec& s, double p) {
     case SizeDistribution::Graded:
       if (s.dmax_m == s.dmin_m) return s.dmin_m;
       return graded_curve(s).quantile(p);
+    case SizeDistribution::Piecewise: {
+      check_piecewise(s);
+      const auto& g = s.grading;
+      for (std::size_t i = 1; i < g.size(); ++i)
+        if (p <= g[i].second && g[i].second > g[i - 1].second)
+          return g[i - 1].first + (g[i].first - g[i - 1].first) * (p - g[i - 1].second) /
+                                      (g[i].second - g[i - 1].second);
+      return s.dmax_m;
+    }
   }
   throw std::invalid_argument("unknown size distribution");
 }
@@ -299,6 +364,8 @@ double draw_diameter(const SizeSpec& s, std::mt19937_64& rng) {
       return s.dmin_m + u * (s.dmax_m - s.dmin_m);
     case SizeDistribution::Graded:
       return draw_graded(*s.graded_table, u);
+    case SizeDistribution::Piecewise:
+      return draw_piecewise(s, u);
     case SizeDistribution::Linear:
       break;
   }

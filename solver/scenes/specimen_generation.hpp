@@ -30,7 +30,11 @@ namespace gs::solver {
 ///    (seed 002 §4, Kuhn 1999: "1002 irregularly arranged circular disks ... largest and smallest
 ///    having diameters 1.4 and 0.45 times the weight-median diameter D50. The coefficient of
 ///    uniformity D60/D10 was 1.7"). By number the density is ∝ f_mass(d)/dᵏ.
-enum class SizeDistribution { Uniform, Linear, Graded };
+///  - Piecewise: the grading curve is the broken line through `grading` (d, mass fraction finer)
+///    points, from (dmin, 0) to (dmax, 1): any shape that honours given D10, D50, D60 (e.g.
+///    through (D10, 0.1), (D50, 0.5), (D60, 0.6)); on each segment the mass density is constant,
+///    so the number density is ∝ d⁻ᵏ there (drawn in closed form, segment by its number share).
+enum class SizeDistribution { Uniform, Linear, Graded, Piecewise };
 
 /// Number CDF of a fitted Graded distribution on nodes equally spaced in [lo_m, hi_m], built by
 /// fit_graded() for the parameters it records (a draw checks that they are still the spec's).
@@ -48,7 +52,13 @@ struct SizeSpec {
   double fit_mu_m = 0, fit_sigma_m = 0;  // Graded: filled by fit_graded()
   int mass_exponent = 3;                 // mass ∝ d^k: 3 spheres, 2 disks
   std::shared_ptr<const GradedTable> graded_table = nullptr;  // Graded: filled by fit_graded()
+  /// Piecewise: (d_m, mass fraction finer) points, d and fraction non-decreasing, first
+  /// (dmin, 0), last (dmax, 1) (check_piecewise() validates).
+  std::vector<std::pair<double, double>> grading = {};
 };
+
+/// Throws std::invalid_argument unless `grading` is a valid Piecewise curve for [dmin, dmax].
+void check_piecewise(const SizeSpec& size);
 
 /// Fits (fit_mu_m, fit_sigma_m) of a Graded spec to d50_m and `uniformity` (to 1e-12 relative)
 /// and tabulates its number CDF for draw_diameter(). Throws std::invalid_argument naming the

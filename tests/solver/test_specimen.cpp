@@ -177,6 +177,36 @@ TEST(SpecimenGeneration, GradedFitReachesKuhnsD50AndUniformity) {
   EXPECT_EQ(s2.fit_sigma_m, s3.fit_sigma_m);
 }
 
+TEST(SpecimenGeneration, PiecewiseGradingHonoursItsPointsByMassAndInTheDraw) {
+  // A gap-graded curve through Kuhn's D10, D50, D60 (seed 002 §4; D60/D10 = 1.003/0.59 = 1.7).
+  SizeSpec s{0.45e-3, 1.4e-3, SizeDistribution::Piecewise};
+  s.mass_exponent = 2;
+  s.grading = {{0.45e-3, 0},      {0.455e-3, 0.095},  {0.585e-3, 0.0995}, {0.59e-3, 0.1},
+               {0.595e-3, 0.495}, {0.995e-3, 0.4995}, {1.0e-3, 0.5},      {1.003e-3, 0.6},
+               {1.39e-3, 0.6005}, {1.4e-3, 1}};
+  EXPECT_NO_THROW(check_piecewise(s));
+  EXPECT_NEAR(mass_quantile(s, 0.1), 0.59e-3, 1e-15);
+  EXPECT_NEAR(mass_quantile(s, 0.5), 1.0e-3, 1e-15);
+  EXPECT_NEAR(mass_quantile(s, 0.6) / mass_quantile(s, 0.1), 1.7, 1e-12);
+  EXPECT_NEAR(mass_fraction_finer(s, 0.5925e-3), 0.2975, 1e-12);  // mid-segment: linear
+  EXPECT_EQ(mass_fraction_finer(s, s.dmin_m), 0.0);
+  EXPECT_EQ(mass_fraction_finer(s, s.dmax_m), 1.0);
+  std::mt19937_64 rng(7);
+  const std::vector<double> d = draw_diameter_count(s, 40000, rng);
+  for (const double x : d) ASSERT_TRUE(x >= s.dmin_m && x <= s.dmax_m) << x;
+  // (mid-way up the three steep segments, where sampling noise barely moves the quantile)
+  EXPECT_NEAR(empirical_mass_quantile(d, 2, 0.3) / 1e-3, 0.5925, 0.003);
+  EXPECT_NEAR(empirical_mass_quantile(d, 2, 0.55) / 1e-3, 1.0015, 0.003);
+  EXPECT_NEAR(empirical_mass_quantile(d, 2, 0.8) / 1e-3, 1.395, 0.003);
+  // Not from (dmin, 0) to (dmax, 1), or decreasing: an error.
+  SizeSpec bad = s;
+  bad.grading.back().second = 0.9;
+  EXPECT_THROW(check_piecewise(bad), std::invalid_argument);
+  bad = s;
+  std::swap(bad.grading[2], bad.grading[3]);
+  EXPECT_THROW(check_piecewise(bad), std::invalid_argument);
+}
+
 TEST(SpecimenGeneration, GradedFitOutsideTheReachableRangeIsAClearError) {
   auto message = [](SizeSpec s) {
     try {
