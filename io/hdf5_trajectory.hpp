@@ -1,8 +1,8 @@
 // HDF5 trajectory format (docs/format.md, schema_version 3; version 1 files, which have no
-// /clumps group, and version 2 files, which have no cell velocity gradient, are read too): plain chunked, compressed, checksummed arrays, one row block per
-// frame, appended frame by frame. The frame index /frames/end is appended last and flushed, so a
-// run killed mid-write leaves every completed frame readable (HDF5 single-writer/multiple-reader
-// mode keeps the file consistent).
+// /clumps group, and version 2 files, which have no cell velocity gradient, are read too): plain
+// chunked, compressed, checksummed arrays, one row block per frame, appended frame by frame. The
+// frame index /frames/end is appended last and flushed, so a run killed mid-write leaves every
+// completed frame readable (HDF5 single-writer/multiple-reader mode keeps the file consistent).
 #pragma once
 
 #include <cstddef>

@@ -937,10 +937,11 @@ void Simulation::step() {
     }
     for (int i = 0; i < 3; ++i) {
       const double error = sv.target[i] - sigma(i, i);
-      l(i, i) = !sv.stress[i] ? sv.target[i]
-                : std::isinf(gain[i])
-                    ? (error > 0 ? sv.max_rate : error < 0 ? -sv.max_rate : 0.0)
-                    : std::clamp(gain[i] * error, -sv.max_rate, sv.max_rate);
+      l(i, i) = !sv.stress[i]         ? sv.target[i]
+                : std::isinf(gain[i]) ? (error > 0   ? sv.max_rate
+                                         : error < 0 ? -sv.max_rate
+                                                     : 0.0)
+                                      : std::clamp(gain[i] * error, -sv.max_rate, sv.max_rate);
     }
     cell_.set_velocity_gradient(l);
   }
@@ -1013,8 +1014,8 @@ double Simulation::kinetic_energy_in_contact() const {
   double e = 0;
   for (std::size_t i = 0; i < p_.size(); ++i) {
     if (p_.clump[i] >= 0 || !touching[i]) continue;
-    const Eigen::Vector3d v = periodic_ ? Eigen::Vector3d(p_.vel[i] - cell_.vel_grad * p_.pos[i])
-                                        : p_.vel[i];
+    const Eigen::Vector3d v =
+        periodic_ ? Eigen::Vector3d(p_.vel[i] - cell_.vel_grad * p_.pos[i]) : p_.vel[i];
     e += 0.5 * p_.mass[i] * v.squaredNorm() + 0.5 * p_.inertia[i] * p_.angvel[i].squaredNorm();
   }
   for (const auto& c : clumps_) {
@@ -1153,7 +1154,11 @@ Frame Simulation::frame() const {
     q.id = p_.id[i];
     q.position = periodic_ ? cell_.wrap(p_.pos[i]) : p_.pos[i];
     q.radius = p_.radius[i];
-    q.velocity = p_.vel[i];
+    // In a cell the velocity carries the mean flow L·x at the unwrapped position; the image in
+    // the cell moves with v − L·(x − x_wrapped) (YADE's image shift velocity), so that the
+    // frame's velocities are a field over its wrapped positions.
+    q.velocity = periodic_ ? Eigen::Vector3d(p_.vel[i] - cell_.vel_grad * (p_.pos[i] - q.position))
+                           : p_.vel[i];
     q.angular_velocity = p_.angvel[i];
     q.orientation = p_.ori[i];
     q.rotation = p_.rot[i];

@@ -9,7 +9,8 @@ namespace gs::solver {
 
 PeriodicBiaxial::PeriodicBiaxial(PeriodicBiaxialSpec spec)
     : spec_(std::move(spec)), inertial_warning_{spec_.inertial_warning} {
-  if (!(spec_.lateral_stress_Pa > 0)) throw std::invalid_argument("lateral stress must be positive");
+  if (!(spec_.lateral_stress_Pa > 0))
+    throw std::invalid_argument("lateral stress must be positive");
   if (!(spec_.strain_rate_1_s > 0)) throw std::invalid_argument("strain rate must be positive");
   if (!(spec_.max_strain > 0 && spec_.max_strain < 1))
     throw std::invalid_argument("max strain must be in (0, 1)");
@@ -57,9 +58,9 @@ std::int64_t PeriodicBiaxial::frame_index(const Simulation& sim) const {
   const double e = axial_strain(sim);
   const auto listed = std::upper_bound(spec_.frame_strains.begin(), spec_.frame_strains.end(), e) -
                       spec_.frame_strains.begin();
-  const auto regular =
-      spec_.frame_every_strain > 0 ? static_cast<std::int64_t>(std::floor(e / spec_.frame_every_strain))
-                                   : 0;
+  const auto regular = spec_.frame_every_strain > 0
+                           ? static_cast<std::int64_t>(std::floor(e / spec_.frame_every_strain))
+                           : 0;
   return static_cast<std::int64_t>(listed) + std::max<std::int64_t>(regular, 0);
 }
 

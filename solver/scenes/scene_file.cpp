@@ -212,8 +212,7 @@ void read_lab_sections(const Reader& r, const toml::table& root, Scene& s) {
     x.servo_fraction = r.positive(t, sec, "servo_fraction", false, x.servo_fraction);
     if (x.servo_fraction > 1)
       r.fail("biaxial_periodic.servo_fraction", "must be at most 1", value_str(x.servo_fraction));
-    if (t->contains("max_rate_1_s"))
-      x.max_rate_1_s = r.positive(t, sec, "max_rate_1_s", true, 0);
+    if (t->contains("max_rate_1_s")) x.max_rate_1_s = r.positive(t, sec, "max_rate_1_s", true, 0);
     x.inertial_warning = r.positive(t, sec, "inertial_warning", false, x.inertial_warning);
   } else if (s.test == "direct_shear") {
     const auto* t = r.table("direct_shear", true);
@@ -277,7 +276,8 @@ void read_lab_sections(const Reader& r, const toml::table& root, Scene& s) {
         r.fail("preparation.servo_gain", "a cell's servo gain is a fraction in (0, 1]",
                value_str(p.servo_gain));
     } else if (prep && prep->contains("max_rate_1_s")) {
-      r.fail("preparation.max_rate_1_s", "is for a periodic cell (scene.test = \"biaxial_periodic\")");
+      r.fail("preparation.max_rate_1_s",
+             "is for a periodic cell (scene.test = \"biaxial_periodic\")");
     }
     if (p.pressure_Pa == 0 && !p.deposition)
       r.fail("preparation.pressure_Pa", "missing (or set deposition = true)");
@@ -556,10 +556,10 @@ Scene load_scene(const std::filesystem::path& path) {
   Scene s;
   s.file = path;
   for (const auto& [k, v] : root) {
-    static const char* sections[] = {"scene",          "material",     "solver",      "output",
-                                     "walls",          "specimen",     "preparation", "triaxial",
-                                     "plane_strain",   "direct_shear", "mesh",        "outlet",
-                                     "clump_template", "clumps",       "fill",        "cell",
+    static const char* sections[] = {"scene",           "material",     "solver",      "output",
+                                     "walls",           "specimen",     "preparation", "triaxial",
+                                     "plane_strain",    "direct_shear", "mesh",        "outlet",
+                                     "clump_template",  "clumps",       "fill",        "cell",
                                      "biaxial_periodic"};
     if (std::find(std::begin(sections), std::end(sections), k.str()) == std::end(sections))
       r.fail("[" + std::string(k.str()) + "]", "unknown section");
@@ -711,8 +711,7 @@ Scene load_scene(const std::filesystem::path& path) {
                  (periodic2d ? "0.6 in 2D)" : "0.45)"),
              value_str(sp.cloud_solid_fraction));
     if (periodic2d) {
-      sp.thickness_m =
-          r.positive(specimen, "specimen", "thickness_m", false, 2 * sp.sizes.dmax_m);
+      sp.thickness_m = r.positive(specimen, "specimen", "thickness_m", false, 2 * sp.sizes.dmax_m);
     }
   }
   double auto_dt_safety = 0;  // "auto": dt is set at the end, once clumps and fillings are in

@@ -353,12 +353,16 @@ double mass_quantile(const SizeSpec& s, double p) {
 }
 
 double draw_diameter(const SizeSpec& s, std::mt19937_64& rng) {
+  return diameter_at(s, uniform01(rng));
+}
+
+double diameter_at(const SizeSpec& s, double u) {
   check_range(s);
   if (s.distribution == SizeDistribution::Graded && !table_is_current(s))
     throw std::invalid_argument(
         "Graded size distribution: no number table for the spec's current parameters (call "
         "fit_graded() after setting them)");
-  const double u = uniform01(rng);
+  if (!(u >= 0 && u <= 1)) throw std::invalid_argument("diameter_at: u outside [0, 1]");
   switch (s.distribution) {
     case SizeDistribution::Uniform:
       return s.dmin_m + u * (s.dmax_m - s.dmin_m);
@@ -408,8 +412,12 @@ std::vector<double> draw_diameters(const SizeSpec& size, double solid_volume_m3,
 std::vector<double> draw_diameter_count(const SizeSpec& size, std::size_t n, std::mt19937_64& rng) {
   SizeSpec scratch;
   const SizeSpec& s = drawable(size, scratch);
+  // Stratified by number: the i-th diameter from the quantile (i + U_i)/n, so that the sample's
+  // grading follows the curve to within one particle per size class — a plain random sample of
+  // 1 002 disks misses a 10 % mass class by ±2 % and can move D50 or D60 across a gap.
   std::vector<double> d(n);
-  for (auto& x : d) x = draw_diameter(s, rng);
+  for (std::size_t i = 0; i < n; ++i)
+    d[i] = diameter_at(s, (static_cast<double>(i) + uniform01(rng)) / static_cast<double>(n));
   std::sort(d.begin(), d.end(), std::greater<>());
   return d;
 }

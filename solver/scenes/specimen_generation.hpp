@@ -84,8 +84,12 @@ double draw_diameter(const SizeSpec& size, std::mt19937_64& rng);
 /// (a Graded spec without a current table is fitted on a copy first).
 std::vector<double> draw_diameters(const SizeSpec& size, double solid_volume_m3,
                                    std::mt19937_64& rng);
-/// Exactly n diameters, sorted largest first (a Graded spec without a current table is fitted
-/// on a copy first).
+/// The diameter at number quantile u ∈ [0, 1] of the distribution (the inverse transform
+/// draw_diameter applies to one uniform variate).
+double diameter_at(const SizeSpec& size, double u);
+/// Exactly n diameters, sorted largest first, stratified by number: the i-th from the quantile
+/// (i + U_i)/n with U_i uniform, so the sample's grading curve follows the distribution's to
+/// within 1/n by number (a Graded spec without a current table is fitted on a copy first).
 std::vector<double> draw_diameter_count(const SizeSpec& size, std::size_t n, std::mt19937_64& rng);
 
 /// Places spheres of the given diameters without overlap inside the box [lo, hi] (each sphere

@@ -18,7 +18,8 @@ SpecimenPreparation::SpecimenPreparation(PreparationSpec spec, SpecimenGauge gau
   if (spec_.pressure_Pa == 0 && !spec_.deposition)
     throw std::invalid_argument("preparation needs a pressure or deposition");
   if (gauge_.cell_axes > 0 && (spec_.deposition || !(spec_.pressure_Pa > 0)))
-    throw std::invalid_argument("a periodic cell is prepared by compaction (a pressure, no deposition)");
+    throw std::invalid_argument(
+        "a periodic cell is prepared by compaction (a pressure, no deposition)");
   if (gauge_.cell_axes > 0 && spec_.servo_gain > 1)
     throw std::invalid_argument("servo_gain of a cell is a fraction in (0, 1]");
 }

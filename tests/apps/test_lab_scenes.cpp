@@ -292,7 +292,8 @@ TEST(LabScenes, BadScenesExitTwoWithOneLine) {
        {"young_Pa = 3.0e8", "young_MPa = 300.0", "material.young_MPa: unknown key"}},
       {"bad distribution",
        {"dmax_m = 0.008", "dmax_m = 0.008\ndistribution = \"bimodal\"",
-        "specimen.distribution: expected \"uniform\", \"linear\" or \"graded\" (bimodal)"}},
+        "specimen.distribution: expected \"uniform\", \"linear\", \"graded\" or \"piecewise\" "
+        "(bimodal)"}},
       {"walls in a test",
        {"[output]", "[[walls]]\nname = \"x\"\nshape = \"plane\"\n[output]",
         "[[walls]]: a laboratory test builds its own walls; remove [[walls]]"}},

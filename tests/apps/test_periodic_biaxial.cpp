@@ -66,8 +66,10 @@ std::string scene(const std::string& extra_specimen = "", const std::string& ext
 
 std::string replaced(std::string s, const std::string& from, const std::string& to) {
   const auto at = s.find(from);
-  if (at == std::string::npos) ADD_FAILURE() << "no " << from;
-  else s.replace(at, from.size(), to);
+  if (at == std::string::npos)
+    ADD_FAILURE() << "no " << from;
+  else
+    s.replace(at, from.size(), to);
   return s;
 }
 
@@ -76,9 +78,8 @@ std::string replaced(std::string s, const std::string& from, const std::string& 
 TEST(PeriodicBiaxial, SmallAssemblyEndToEnd) {
   gs::test::ScratchDir dir("periodic_biaxial");
   std::ofstream(dir / "kb.toml") << scene();
-  const auto r = run_cli("simulate " + (dir / "kb.toml").string() + " -q -o " +
-                             (dir / "out").string(),
-                         dir.path);
+  const auto r = run_cli(
+      "simulate " + (dir / "kb.toml").string() + " -q -o " + (dir / "out").string(), dir.path);
   ASSERT_EQ(r.rc, 0) << r.err;
   // Preparation: ends at the target void ratio or below, with σ11 = σ22 = 100 kPa within 1 %.
   const Table prep = read_table(dir / "out" / "preparation.csv");
@@ -122,8 +123,8 @@ TEST(PeriodicBiaxial, SmallAssemblyEndToEnd) {
     }
   }
   // Void cells of the 0.01 % frame, with the cell's gradient from the file: a torus (Euler 0).
-  const auto v = run_cli("analyze voidcells " + (dir / "out" / "kb.h5").string() +
-                             " --from 1 -o " + (dir / "cells.h5").string(),
+  const auto v = run_cli("analyze voidcells " + (dir / "out" / "kb.h5").string() + " --from 1 -o " +
+                             (dir / "cells.h5").string(),
                          dir.path);
   ASSERT_EQ(v.rc, 0) << v.err;
   const hid_t f = H5Fopen((dir / "cells.h5").c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);

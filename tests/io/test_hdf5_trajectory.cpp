@@ -387,8 +387,8 @@ const std::vector<std::pair<std::string, std::vector<std::string>>> kDocumentedD
       "principal_inertia"}},
     {"facet_loads", {"wall_id", "facet", "centroid", "force"}},
     {"frames",
-     {"time", "step", "dt", "two_d", "domain_lo", "domain_hi", "periodic", "cell", "cell_velocity_gradient", "clump_end",
-      "facet_end", "end"}},
+     {"time", "step", "dt", "two_d", "domain_lo", "domain_hi", "periodic", "cell",
+      "cell_velocity_gradient", "clump_end", "facet_end", "end"}},
 };
 
 }  // namespace

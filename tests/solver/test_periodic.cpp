@@ -397,7 +397,8 @@ TEST(PeriodicCell, StiffnessScaledServoHoldsTheTargetAndResumesBitForBit) {
   std::filesystem::remove(ckpt);
   EXPECT_EQ(a->cell().hsize, b->cell().hsize);
   EXPECT_EQ(a->cell().vel_grad, b->cell().vel_grad);
-  for (std::size_t i = 0; i < ps.size(); ++i) EXPECT_EQ(a->particles().pos[i], b->particles().pos[i]) << i;
+  for (std::size_t i = 0; i < ps.size(); ++i)
+    EXPECT_EQ(a->particles().pos[i], b->particles().pos[i]) << i;
   servo.stiffness_fraction = 1.5;
   EXPECT_THROW(a->set_cell_servo(servo), std::invalid_argument);
 }
@@ -423,9 +424,37 @@ TEST(PeriodicCell, KineticEnergyInContactLeavesTheRattlersOut) {
   const auto& p = sim.particles();
   double pair = 0;
   for (int i = 0; i < 2; ++i)
-    pair += 0.5 * p.mass[i] * p.vel[i].squaredNorm() + 0.5 * p.inertia[i] * p.angvel[i].squaredNorm();
+    pair +=
+        0.5 * p.mass[i] * p.vel[i].squaredNorm() + 0.5 * p.inertia[i] * p.angvel[i].squaredNorm();
   const double spin = 0.5 * p.inertia[2] * p.angvel[2].squaredNorm();
   EXPECT_EQ(p.angvel[2].z(), 30.0);  // (undamped: no force, no damping)
   EXPECT_NEAR(sim.kinetic_energy_in_contact(), pair, 1e-15 * pair);
   EXPECT_NEAR(sim.kinetic_energy(), pair + spin, 1e-15 * (pair + spin));
+}
+
+// A frame's velocities are a field over its wrapped positions: a free sphere moving through the
+// z face of a cell sheared along x by z (the flow differs by 20/s · 10 mm across it) has, in the
+// frame, the same fluctuation about the mean flow at its wrapped position as the engine's about the
+// flow at its unwrapped one.
+TEST(PeriodicCell, FrameVelocitiesFollowTheWrappedPositions) {
+  auto cfg = config(0.0);
+  cfg.dt = 1e-5;
+  auto s0 = sphere(0, {0.005, 0.005, 0.0095}, 0.0005);
+  s0.velocity = {0, 0, 0.5};  // up through the z face: its image is shifted by H·(0, 0, −1)
+  Simulation sim(cfg, {s0}, {});
+  sim.set_periodic(cube(0.01));
+  Eigen::Matrix3d l = Eigen::Matrix3d::Zero();
+  l(0, 2) = 20.0;  // v_x = 20/s · z
+  sim.set_velocity_gradient(l);
+  for (int n = 0; n < 1000; ++n) sim.step();  // 5 mm along z
+  const auto& p = sim.particles();
+  const Frame f = sim.frame();
+  const Eigen::Vector3d xw = f.particles[0].position;
+  const Eigen::Vector3d sw = f.domain.cell.inverse() * xw;
+  EXPECT_GT((p.pos[0] - xw).norm(), 0.005) << "the sphere has left the cell (unwrapped)";
+  EXPECT_TRUE((sw.array() >= 0).all() && (sw.array() < 1).all()) << sw.transpose();
+  const Eigen::Vector3d fluct = p.vel[0] - l * p.pos[0];
+  EXPECT_NEAR(fluct.z(), 0.5, 1e-9);
+  EXPECT_NEAR((f.particles[0].velocity - l * xw - fluct).norm(), 0.0, 1e-12);
+  EXPECT_EQ(f.domain.velocity_gradient, l);
 }
