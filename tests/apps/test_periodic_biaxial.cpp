@@ -2,11 +2,17 @@
 // graded disks compacted in the cell to the target void ratio, σ11 held by the width servo while
 // the height shortens at its rate, frames at the listed strains carrying the cell's velocity
 // gradient, `analyze voidcells` on them with no extra option; and the test's bad inputs.
+#include <fcntl.h>
 #include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
+#include <chrono>
 #include <cmath>
 #include <fstream>
 #include <sstream>
+#include <thread>
 
 #include <hdf5.h>
 #include "../io/test_util.hpp"
@@ -61,7 +67,9 @@ std::string scene(const std::string& extra_specimen = "", const std::string& ext
          "check_every = 100\nservo_gain = 0.3\nmax_rate_1_s = 20.0\n"
          "[biaxial_periodic]\nlateral_stress_Pa = 1e5\nstrain_rate_1_s = 0.5\n"
          "max_strain = 0.004\nframe_strains = [0.0001, 0.0016]\nframe_every_strain = 0.002\n" +
-         extra + "[output]\ntrajectory = \"kb.h5\"\ncurve_every = 50\nhistory_every = 500\n";
+         extra +
+         "[output]\ntrajectory = \"kb.h5\"\ncurve_every = 50\nhistory_every = 500\n"
+         "checkpoint_every = 5000\n";
 }
 
 std::string replaced(std::string s, const std::string& from, const std::string& to) {
@@ -165,5 +173,47 @@ TEST(PeriodicBiaxial, BadInputsFailWithOneLine) {
     EXPECT_EQ(r.rc, 2) << i;
     EXPECT_NE(r.err.find(cases[i].second), std::string::npos) << i << ": " << r.err;
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << i << ": " << r.err;
+  }
+}
+
+// Killed once in the preparation and once in the test, resumed: every output equals the
+// uninterrupted run's (the cell servo and its base gradient come from the checkpoint).
+TEST(PeriodicBiaxial, ResumeIsBitForBitInBothPhases) {
+  gs::test::ScratchDir dir("periodic_biaxial_resume");
+  std::ofstream(dir / "kb.toml") << scene();
+  const std::string sc = (dir / "kb.toml").string();
+  ASSERT_EQ(run_cli("simulate " + sc + " -q -o " + (dir / "straight").string(), dir.path).rc, 0);
+  for (const long kill_after : {15000L, 30000L}) {  // (the preparation ends near 24 600)
+    const auto killed = dir / ("killed" + std::to_string(kill_after));
+    const pid_t pid = fork();
+    ASSERT_GE(pid, 0);
+    if (pid == 0) {
+      const int devnull = ::open("/dev/null", O_WRONLY);
+      dup2(devnull, 1);
+      dup2(devnull, 2);
+      execl(gs::test::kGranoscope.c_str(), gs::test::kGranoscope.c_str(), "simulate", sc.c_str(),
+            "-q", "-o", killed.c_str(), nullptr);
+      _exit(127);
+    }
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+    while (std::chrono::steady_clock::now() < deadline) {
+      const std::string idx = slurp(killed / "checkpoint.txt");
+      const auto k = idx.find("\nstep ");
+      if (k != std::string::npos && std::stol(idx.substr(k + 6)) >= kill_after) break;
+      std::this_thread::sleep_for(std::chrono::microseconds(200));
+    }
+    kill(pid, SIGKILL);
+    int status = 0;
+    waitpid(pid, &status, 0);
+    ASSERT_TRUE(WIFSIGNALED(status)) << "the run finished before it could be killed";
+    const auto r = run_cli("simulate " + sc + " -q --resume -o " + killed.string(), dir.path);
+    ASSERT_EQ(r.rc, 0) << r.err;
+    for (const char* f : {"history.csv", "curve.csv", "preparation.csv"})
+      EXPECT_EQ(slurp(dir / "straight" / f), slurp(killed / f)) << f << " after " << kill_after;
+    const auto a = gs::read_hdf5_trajectory(dir / "straight" / "kb.h5");
+    const auto b = gs::read_hdf5_trajectory(killed / "kb.h5");
+    ASSERT_EQ(a.frames.size(), b.frames.size());
+    for (std::size_t i = 0; i < a.frames.size(); ++i)
+      gs::test::expect_same_frame(a.frames[i], b.frames[i]);
   }
 }
