@@ -1,15 +1,22 @@
 // Helpers for end-to-end tests of the `granoscope` executable.
 #pragma once
 
+#include <fcntl.h>
 #include <gtest/gtest.h>
+#include <signal.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <chrono>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <thread>
+#include <vector>
 
 namespace gs::test {
 
@@ -48,6 +55,60 @@ inline void expect_rejected(const CliResult& r, const std::string& file) {
   EXPECT_EQ(r.rc, 2) << r.err;
   EXPECT_EQ(r.err.rfind("error: " + file + ": ", 0), 0u) << r.err;
   EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+}
+
+/// Starts `granoscope simulate SCENE -q -o OUT` and kills it (SIGKILL) once a checkpoint past
+/// `step` is on disk; false if the run ended first.
+inline bool run_and_kill(const std::string& scene, const std::filesystem::path& out, long step) {
+  const pid_t pid = fork();
+  if (pid < 0) return false;
+  if (pid == 0) {
+    const int devnull = ::open("/dev/null", O_WRONLY);
+    dup2(devnull, 1);
+    dup2(devnull, 2);
+    execl(kGranoscope.c_str(), kGranoscope.c_str(), "simulate", scene.c_str(), "-q", "-o",
+          out.c_str(), nullptr);
+    _exit(127);
+  }
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (std::chrono::steady_clock::now() < deadline) {
+    const std::string idx = slurp(out / "checkpoint.txt");
+    const auto k = idx.find("\nstep ");
+    if (k != std::string::npos && std::stol(idx.substr(k + 6)) >= step) break;
+    std::this_thread::sleep_for(std::chrono::microseconds(200));
+  }
+  kill(pid, SIGKILL);
+  int status = 0;
+  waitpid(pid, &status, 0);
+  return WIFSIGNALED(status);
+}
+
+/// A CSV file of numbers as its header and rows.
+struct CsvTable {
+  std::vector<std::string> header;
+  std::vector<std::vector<double>> rows;
+  double num(std::size_t r, const std::string& name) const {
+    for (std::size_t i = 0; i < header.size(); ++i)
+      if (header[i] == name) return rows.at(r).at(i);
+    ADD_FAILURE() << "no column " << name;
+    return std::nan("");
+  }
+};
+
+inline CsvTable read_csv_table(const std::filesystem::path& p) {
+  std::istringstream in(slurp(p));
+  CsvTable t;
+  std::string line, cell;
+  std::getline(in, line);
+  std::istringstream h(line);
+  while (std::getline(h, cell, ',')) t.header.push_back(cell);
+  while (std::getline(in, line)) {
+    if (line.empty()) continue;
+    std::istringstream v(line);
+    auto& row = t.rows.emplace_back();
+    while (std::getline(v, cell, ',')) row.push_back(std::strtod(cell.c_str(), nullptr));
+  }
+  return t;
 }
 
 }  // namespace gs::test

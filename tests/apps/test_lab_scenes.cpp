@@ -221,28 +221,8 @@ void expect_resume_identical(const std::string& name, std::int64_t kill_after,
   ASSERT_EQ(
       run_cli("simulate " + scene(name) + " -q -o " + (dir / "straight").string(), dir.path).rc, 0);
   const fs::path killed = dir / "killed";
-  const pid_t pid = fork();
-  ASSERT_GE(pid, 0);
-  if (pid == 0) {
-    const int devnull = ::open("/dev/null", O_WRONLY);
-    dup2(devnull, 1);
-    dup2(devnull, 2);
-    const std::string s = scene(name);
-    execl(gs::test::kGranoscope.c_str(), gs::test::kGranoscope.c_str(), "simulate", s.c_str(), "-q",
-          "-o", killed.c_str(), nullptr);
-    _exit(127);
-  }
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
-  while (std::chrono::steady_clock::now() < deadline) {
-    const std::string idx = slurp(killed / "checkpoint.txt");
-    const auto k = idx.find("\nstep ");
-    if (k != std::string::npos && std::stol(idx.substr(k + 6)) >= kill_after) break;
-    std::this_thread::sleep_for(std::chrono::microseconds(200));
-  }
-  kill(pid, SIGKILL);
-  int status = 0;
-  waitpid(pid, &status, 0);
-  ASSERT_TRUE(WIFSIGNALED(status)) << "the run finished before it could be killed";
+  ASSERT_TRUE(gs::test::run_and_kill(scene(name), killed, kill_after))
+      << "the run finished before it could be killed";
   const auto r =
       run_cli("simulate " + scene(name) + " -q --resume -o " + killed.string(), dir.path);
   ASSERT_EQ(r.rc, 0) << r.err;

@@ -2,17 +2,11 @@
 // graded disks compacted in the cell to the target void ratio, σ11 held by the width servo while
 // the height shortens at its rate, frames at the listed strains carrying the cell's velocity
 // gradient, `analyze voidcells` on them with no extra option; and the test's bad inputs.
-#include <fcntl.h>
 #include <gtest/gtest.h>
-#include <signal.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
-#include <chrono>
 #include <cmath>
 #include <fstream>
 #include <sstream>
-#include <thread>
 
 #include <hdf5.h>
 #include "../io/test_util.hpp"
@@ -25,32 +19,8 @@ namespace {
 using gs::test::run_cli;
 using gs::test::slurp;
 
-struct Table {
-  std::vector<std::string> header;
-  std::vector<std::vector<double>> rows;
-  double num(std::size_t r, const std::string& name) const {
-    for (std::size_t i = 0; i < header.size(); ++i)
-      if (header[i] == name) return rows.at(r).at(i);
-    ADD_FAILURE() << "no column " << name;
-    return std::nan("");
-  }
-};
-
-Table read_table(const std::filesystem::path& p) {
-  std::istringstream in(slurp(p));
-  Table t;
-  std::string line, cell;
-  std::getline(in, line);
-  std::istringstream h(line);
-  while (std::getline(h, cell, ',')) t.header.push_back(cell);
-  while (std::getline(in, line)) {
-    if (line.empty()) continue;
-    std::istringstream v(line);
-    auto& row = t.rows.emplace_back();
-    while (std::getline(v, cell, ',')) row.push_back(std::strtod(cell.c_str(), nullptr));
-  }
-  return t;
-}
+using Table = gs::test::CsvTable;
+using gs::test::read_csv_table;
 
 // 150 of Kuhn's graded disks; softer (Ec = 1e8) and a faster compaction than the shipped scene,
 // so that the whole test takes seconds.
@@ -90,7 +60,7 @@ TEST(PeriodicBiaxial, SmallAssemblyEndToEnd) {
       "simulate " + (dir / "kb.toml").string() + " -q -o " + (dir / "out").string(), dir.path);
   ASSERT_EQ(r.rc, 0) << r.err;
   // Preparation: ends at the target void ratio or below, with σ11 = σ22 = 100 kPa within 1 %.
-  const Table prep = read_table(dir / "out" / "preparation.csv");
+  const Table prep = read_csv_table(dir / "out" / "preparation.csv");
   ASSERT_FALSE(prep.rows.empty());
   const std::size_t lp = prep.rows.size() - 1;
   EXPECT_LE(prep.num(lp, "void_ratio"), 0.21);
@@ -98,7 +68,7 @@ TEST(PeriodicBiaxial, SmallAssemblyEndToEnd) {
     EXPECT_NEAR(prep.num(lp, c), 1e5, 1e3) << c;
   // The test: ε22 reaches 0.4 %, σ11 held within 2 % once loading has settled in, the area
   // strain and the void ratio consistent (e = A/A_s − 1 with A_s fixed).
-  const Table curve = read_table(dir / "out" / "curve.csv");
+  const Table curve = read_csv_table(dir / "out" / "curve.csv");
   ASSERT_GT(curve.rows.size(), 5u);
   const std::size_t last = curve.rows.size() - 1;
   EXPECT_GE(curve.num(last, "eps22_shortening"), 0.004);
@@ -185,27 +155,8 @@ TEST(PeriodicBiaxial, ResumeIsBitForBitInBothPhases) {
   ASSERT_EQ(run_cli("simulate " + sc + " -q -o " + (dir / "straight").string(), dir.path).rc, 0);
   for (const long kill_after : {15000L, 30000L}) {  // (the preparation ends near 24 600)
     const auto killed = dir / ("killed" + std::to_string(kill_after));
-    const pid_t pid = fork();
-    ASSERT_GE(pid, 0);
-    if (pid == 0) {
-      const int devnull = ::open("/dev/null", O_WRONLY);
-      dup2(devnull, 1);
-      dup2(devnull, 2);
-      execl(gs::test::kGranoscope.c_str(), gs::test::kGranoscope.c_str(), "simulate", sc.c_str(),
-            "-q", "-o", killed.c_str(), nullptr);
-      _exit(127);
-    }
-    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
-    while (std::chrono::steady_clock::now() < deadline) {
-      const std::string idx = slurp(killed / "checkpoint.txt");
-      const auto k = idx.find("\nstep ");
-      if (k != std::string::npos && std::stol(idx.substr(k + 6)) >= kill_after) break;
-      std::this_thread::sleep_for(std::chrono::microseconds(200));
-    }
-    kill(pid, SIGKILL);
-    int status = 0;
-    waitpid(pid, &status, 0);
-    ASSERT_TRUE(WIFSIGNALED(status)) << "the run finished before it could be killed";
+    ASSERT_TRUE(gs::test::run_and_kill(sc, killed, kill_after))
+        << "the run finished before it could be killed";
     const auto r = run_cli("simulate " + sc + " -q --resume -o " + killed.string(), dir.path);
     ASSERT_EQ(r.rc, 0) << r.err;
     for (const char* f : {"history.csv", "curve.csv", "preparation.csv"})

@@ -774,34 +774,7 @@ TEST(Surface, SawToothWallAsStlForAScene) {
   EXPECT_FALSE(std::filesystem::exists(dir / "bad.stl"));
 }
 
-namespace {
-
-// Starts `simulate SCENE -q -o OUT` and kills it (SIGKILL) once a checkpoint past `step` is on
-// disk; returns false if the run ended first.
-bool run_and_kill(const std::string& scene, const std::filesystem::path& out, long step) {
-  const pid_t pid = fork();
-  if (pid < 0) return false;
-  if (pid == 0) {
-    const int devnull = ::open("/dev/null", O_WRONLY);
-    dup2(devnull, 1);
-    dup2(devnull, 2);
-    execl(kExe.c_str(), kExe.c_str(), "simulate", scene.c_str(), "-q", "-o", out.c_str(), nullptr);
-    _exit(127);
-  }
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
-  while (std::chrono::steady_clock::now() < deadline) {
-    const std::string idx = slurp(out / "checkpoint.txt");
-    const auto k = idx.find("\nstep ");
-    if (k != std::string::npos && std::stol(idx.substr(k + 6)) >= step) break;
-    std::this_thread::sleep_for(std::chrono::microseconds(200));
-  }
-  kill(pid, SIGKILL);
-  int status = 0;
-  waitpid(pid, &status, 0);
-  return WIFSIGNALED(status);
-}
-
-}  // namespace
+using gs::test::run_and_kill;
 
 // Issue 15, resume edge cases: killed between the final renames (history already final, the
 // trajectory still .partial) and with a checkpoint's temporary left behind, --resume finishes

@@ -40,33 +40,8 @@ std::filesystem::path reference_dir() {
   return std::filesystem::path(GS_TEST_DATA_DIR) / "yade_periodic2d";
 }
 
-/// A CSV file as a header and rows of numbers.
-struct Table {
-  std::vector<std::string> header;
-  std::vector<std::vector<double>> rows;
-  double num(std::size_t r, const std::string& name) const {
-    for (std::size_t i = 0; i < header.size(); ++i)
-      if (header[i] == name) return rows.at(r).at(i);
-    ADD_FAILURE() << "no column " << name;
-    return std::nan("");
-  }
-};
-
-Table read_table(const std::filesystem::path& p) {
-  std::istringstream in(slurp(p));
-  Table t;
-  std::string line, cell;
-  std::getline(in, line);
-  std::istringstream h(line);
-  while (std::getline(h, cell, ',')) t.header.push_back(cell);
-  while (std::getline(in, line)) {
-    if (line.empty()) continue;
-    std::istringstream v(line);
-    auto& row = t.rows.emplace_back();
-    while (std::getline(v, cell, ',')) row.push_back(std::strtod(cell.c_str(), nullptr));
-  }
-  return t;
-}
+using Table = gs::test::CsvTable;
+const auto read_table = gs::test::read_csv_table;
 
 std::string scene_text(const std::string& cell) {
   const auto packing = reference_dir() / "packing.csv";
