@@ -64,6 +64,14 @@ std::vector<std::unique_ptr<LoadingProgramme>> scene_programmes(Scene& s) {
   if (s.test == "biaxial_periodic") {
     // Seed 002 §4: disks in a square doubly periodic cell, of the thickness asked for.
     const SpecimenSpec& sp = *s.specimen;
+    // The cell's z is not searched periodically: it must be thicker than 2 r_max + skin (the
+    // skin's default is half the smallest radius).
+    const double skin = s.config.skin > 0 ? s.config.skin : 0.25 * sp.sizes.dmin_m;
+    if (!(sp.thickness_m > sp.sizes.dmax_m + skin))
+      throw InputError(s.file.string(),
+                       "specimen.thickness_m: not thicker than dmax + skin (" +
+                           value_str(sp.sizes.dmax_m + skin) + " m)",
+                       value_str(sp.thickness_m));
     std::mt19937_64 rng(sp.seed);
     try {
       const auto d = draw_diameter_count(sp.sizes, static_cast<std::size_t>(sp.count), rng);

@@ -135,6 +135,7 @@ TEST(PeriodicBiaxial, BadInputsFailWithOneLine) {
        "biaxial_periodic.frame_strains"},
       {scene("", "servo_fraction = 1.5\n"), "biaxial_periodic.servo_fraction: must be at most 1"},
       {scene("size_m = [0.01, 0.01, 0.01]\n"), "specimen.size_m: unknown key"},
+      {scene("thickness_m = 0.001\n"), "specimen.thickness_m: not thicker than dmax + skin"},
   };
   for (std::size_t i = 0; i < cases.size(); ++i) {
     const auto p = dir / ("bad" + std::to_string(i) + ".toml");
