@@ -24,24 +24,34 @@ def read(path):
     return {h: data[:, i] for i, h in enumerate(head)}
 
 
-def compression(c, title):
+def strength_and_dilatancy(x, x_label, y, y_label, peak, ratio, ratio_label, ev, ev_label,
+                           title):
+    """Two panels over the loading strain x (%): a strength measure y with its peak marked and a
+    stress ratio on the right axis, and the volumetric (or area) strain below."""
     fig, (a1, a2) = plt.subplots(2, 1, figsize=(6.5, 7), sharex=True)
-    e1 = 100 * c["eps1_shortening"]
-    a1.plot(e1, c["phi_deg"], "k-")
-    a1.set_ylabel("mobilised friction angle φ (°)")
-    k = int(np.argmax(c["phi_deg"]))
-    a1.plot(e1[k], c["phi_deg"][k], "ro")
-    a1.annotate(f"peak {c['phi_deg'][k]:.1f}° at ε1 = {e1[k]:.1f} %", (e1[k], c["phi_deg"][k]),
-                textcoords="offset points", xytext=(8, -14), fontsize=8)
+    a1.plot(x, y, "k-")
+    a1.set_ylabel(y_label)
+    k = int(np.argmax(y))
+    a1.plot(x[k], y[k], "ro")
+    a1.annotate(peak(y[k], x[k]), (x[k], y[k]), textcoords="offset points", xytext=(8, -14),
+                fontsize=8)
     r = a1.twinx()
-    r.plot(e1, c["sigma1_Pa"] / c["sigma3_Pa"], color="0.6", lw=0.8)
-    r.set_ylabel("σ1/σ3", color="0.5")
-    a2.plot(e1, 100 * c["eps_v_dilation"], "k-")
+    r.plot(x, ratio, color="0.6", lw=0.8)
+    r.set_ylabel(ratio_label, color="0.5")
+    a2.plot(x, ev, "k-")
     a2.axhline(0, color="0.7", lw=0.5)
-    a2.set_ylabel("volumetric strain εv (%, dilation +)")
-    a2.set_xlabel("axial strain ε1 (%)")
+    a2.set_ylabel(ev_label)
+    a2.set_xlabel(x_label)
     a1.set_title(title)
     return fig
+
+
+def compression(c, title):
+    return strength_and_dilatancy(
+        100 * c["eps1_shortening"], "axial strain ε1 (%)", c["phi_deg"],
+        "mobilised friction angle φ (°)", lambda y, x: f"peak {y:.1f}° at ε1 = {x:.1f} %",
+        c["sigma1_Pa"] / c["sigma3_Pa"], "σ1/σ3", 100 * c["eps_v_dilation"],
+        "volumetric strain εv (%, dilation +)", title)
 
 
 def shear(c, title):
@@ -58,24 +68,11 @@ def shear(c, title):
 
 
 def biaxial(c, title):
-    fig, (a1, a2) = plt.subplots(2, 1, figsize=(6.5, 7), sharex=True)
-    e22 = 100 * c["eps22_shortening"]
-    dev = 1e-3 * (c["sigma22_Pa"] - c["sigma11_Pa"])
-    a1.plot(e22, dev, "k-")
-    a1.set_ylabel("Δσ22 = σ22 − σ11 (kPa)")
-    k = int(np.argmax(dev))
-    a1.plot(e22[k], dev[k], "ro")
-    a1.annotate(f"peak {dev[k]:.0f} kPa at ε22 = {e22[k]:.2f} %", (e22[k], dev[k]),
-                textcoords="offset points", xytext=(8, -14), fontsize=8)
-    r = a1.twinx()
-    r.plot(e22, c["sigma22_over_sigma11"], color="0.6", lw=0.8)
-    r.set_ylabel("σ22/σ11", color="0.5")
-    a2.plot(e22, 100 * c["eps_v_dilation"], "k-")
-    a2.axhline(0, color="0.7", lw=0.5)
-    a2.set_ylabel("area strain (%, dilation +)")
-    a2.set_xlabel("vertical strain ε22 (%, shortening +)")
-    a1.set_title(title)
-    return fig
+    return strength_and_dilatancy(
+        100 * c["eps22_shortening"], "vertical strain ε22 (%, shortening +)",
+        1e-3 * (c["sigma22_Pa"] - c["sigma11_Pa"]), "Δσ22 = σ22 − σ11 (kPa)",
+        lambda y, x: f"peak {y:.0f} kPa at ε22 = {x:.2f} %", c["sigma22_over_sigma11"],
+        "σ22/σ11", 100 * c["eps_v_dilation"], "area strain (%, dilation +)", title)
 
 
 def preparation(c, title):

@@ -282,31 +282,38 @@ void Simulation::set_velocity_gradient(const Eigen::Matrix3d& l) {
   cell_.set_velocity_gradient(l);
 }
 
-Eigen::Matrix3d Simulation::cell_stress() const {
-  Eigen::Matrix3d sigma = Eigen::Matrix3d::Zero();
+void Simulation::cell_sums(Eigen::Matrix3d& stress, Eigen::Vector3d* stiffness) const {
+  stress.setZero();
+  if (stiffness) stiffness->setZero();
   for (std::size_t k = 0; k < hist_.size(); ++k) {
     const auto& h = hist_[k];
     if (!h.real || h.b >= kWallBase) continue;
     Eigen::Vector3d branch = p_.pos[h.a] - p_.pos[h.b];
     if (periodic_) branch -= cell_.hsize * nl_.cell_dist[k].cast<double>();
-    sigma += (h.fn * h.normal + h.shear_force) * branch.transpose();
+    stress += (h.fn * h.normal + h.shear_force) * branch.transpose();
+    if (stiffness) {
+      const Eigen::Array3d n2 = h.normal.array().square();
+      stiffness->array() +=
+          branch.array().square() * (params_[k].kn * n2 + params_[k].ks * (1 - n2));
+    }
   }
   const double volume = periodic_ ? cell_.volume() : 0.0;
-  return volume > 0 ? Eigen::Matrix3d(sigma / volume) : sigma;
+  if (!(volume > 0)) return;
+  stress /= volume;
+  if (stiffness) *stiffness /= volume;
+}
+
+Eigen::Matrix3d Simulation::cell_stress() const {
+  Eigen::Matrix3d sigma;
+  cell_sums(sigma, nullptr);
+  return sigma;
 }
 
 Eigen::Vector3d Simulation::cell_stiffness() const {
-  Eigen::Vector3d k = Eigen::Vector3d::Zero();
-  for (std::size_t c = 0; c < hist_.size(); ++c) {
-    const auto& h = hist_[c];
-    if (!h.real || h.b >= kWallBase) continue;
-    Eigen::Vector3d branch = p_.pos[h.a] - p_.pos[h.b];
-    if (periodic_) branch -= cell_.hsize * nl_.cell_dist[c].cast<double>();
-    const Eigen::Array3d n2 = h.normal.array().square();
-    k.array() += branch.array().square() * (params_[c].kn * n2 + params_[c].ks * (1 - n2));
-  }
-  const double volume = periodic_ ? cell_.volume() : 0.0;
-  return volume > 0 ? Eigen::Vector3d(k / volume) : k;
+  Eigen::Matrix3d sigma;
+  Eigen::Vector3d k;
+  cell_sums(sigma, &k);
+  return k;
 }
 
 void Simulation::rebuild_neighbors() {
@@ -925,12 +932,13 @@ void Simulation::step() {
   if (cell_servo_) {
     // The next step's diagonal from this step's stress (forces of this step, positions and
     // cell after it, as YADE's getStress() there).
-    const Eigen::Matrix3d sigma = cell_stress();
-    Eigen::Matrix3d l = servo_base_gradient_;
     const CellServo& sv = *cell_servo_;
+    Eigen::Matrix3d sigma;
+    Eigen::Vector3d k;  // (one pass over the contacts for the stress and the stiffness)
+    cell_sums(sigma, sv.stiffness_fraction > 0 ? &k : nullptr);
+    Eigen::Matrix3d l = servo_base_gradient_;
     Eigen::Vector3d gain = Eigen::Vector3d::Constant(sv.gain);
     if (sv.stiffness_fraction > 0) {
-      const Eigen::Vector3d k = cell_stiffness();
       for (int i = 0; i < 3; ++i)
         gain[i] = k[i] > 0 ? sv.stiffness_fraction / (k[i] * dt)
                            : std::numeric_limits<double>::infinity();
@@ -988,20 +996,25 @@ std::size_t Simulation::sphere_contact_count() const {
   return c;
 }
 
-double Simulation::kinetic_energy() const {
+double Simulation::kinetic_energy_of(const std::vector<std::uint8_t>* touching) const {
   double e = 0;
   for (std::size_t i = 0; i < p_.size(); ++i) {
-    if (p_.clump[i] >= 0) continue;
-    if (periodic_) {  // fluctuations about the mean field (YADE's utils.kineticEnergy)
-      const Eigen::Vector3d v = p_.vel[i] - cell_.vel_grad * p_.pos[i];
-      e += 0.5 * p_.mass[i] * v.squaredNorm() + 0.5 * p_.inertia[i] * p_.angvel[i].squaredNorm();
-      continue;
-    }
-    e += 0.5 * p_.mass[i] * p_.vel[i].squaredNorm() +
-         0.5 * p_.inertia[i] * p_.angvel[i].squaredNorm();
+    if (p_.clump[i] >= 0 || (touching && !(*touching)[i])) continue;
+    // In a cell: the fluctuations about the mean field (YADE's utils.kineticEnergy).
+    const Eigen::Vector3d v =
+        periodic_ ? Eigen::Vector3d(p_.vel[i] - cell_.vel_grad * p_.pos[i]) : p_.vel[i];
+    e += 0.5 * p_.mass[i] * v.squaredNorm() + 0.5 * p_.inertia[i] * p_.angvel[i].squaredNorm();
   }
-  for (const auto& c : clumps_) e += clump_kinetic_energy(c);  // (members skipped, as YADE)
+  for (const auto& c : clumps_) {  // (members skipped, as YADE)
+    bool t = !touching;
+    for (std::size_t m = 0; !t && m < c.members.size(); ++m) t = (*touching)[c.members[m]] != 0;
+    if (t) e += clump_kinetic_energy(c);
+  }
   return e;
+}
+
+double Simulation::kinetic_energy() const {
+  return kinetic_energy_of(nullptr);
 }
 
 double Simulation::kinetic_energy_in_contact() const {
@@ -1011,19 +1024,7 @@ double Simulation::kinetic_energy_in_contact() const {
     touching[h.a] = 1;
     if (h.b < kWallBase) touching[h.b] = 1;
   }
-  double e = 0;
-  for (std::size_t i = 0; i < p_.size(); ++i) {
-    if (p_.clump[i] >= 0 || !touching[i]) continue;
-    const Eigen::Vector3d v =
-        periodic_ ? Eigen::Vector3d(p_.vel[i] - cell_.vel_grad * p_.pos[i]) : p_.vel[i];
-    e += 0.5 * p_.mass[i] * v.squaredNorm() + 0.5 * p_.inertia[i] * p_.angvel[i].squaredNorm();
-  }
-  for (const auto& c : clumps_) {
-    bool t = false;
-    for (const std::uint32_t i : c.members) t = t || touching[i];
-    if (t) e += clump_kinetic_energy(c);
-  }
-  return e;
+  return kinetic_energy_of(&touching);
 }
 
 double Simulation::inertial_number() const {

@@ -183,8 +183,6 @@ class Simulation {
   Eigen::Vector3d cell_stiffness() const;
   /// The cell servo in force, if any.
   const std::optional<CellServo>& cell_servo() const { return cell_servo_; }
-  /// Stops the cell servo; the velocity gradient stays the last one set.
-  void clear_cell_servo() { cell_servo_.reset(); }
   /// Controls the cell's diagonal from now on; the off-diagonal gradient is the last one set
   /// (set_velocity_gradient). Throws without a cell, or on a bad gain, rate limit or target.
   void set_cell_servo(const CellServo& servo);
@@ -243,6 +241,10 @@ class Simulation {
   PeriodicCell cell_;
   HomogeneousField field_;  // this step's homogeneous terms of the integration
   std::optional<CellServo> cell_servo_;
+  /// The cell's Love–Weber stress and, if asked for, its affine stiffness, in one pass.
+  void cell_sums(Eigen::Matrix3d& stress, Eigen::Vector3d* stiffness) const;
+  /// Kinetic energy of all bodies, or of those marked in `touching`.
+  double kinetic_energy_of(const std::vector<std::uint8_t>* touching) const;
   Eigen::Matrix3d servo_base_gradient_ = Eigen::Matrix3d::Zero();  // its off-diagonal part
   bool outlet_ = false;
   Eigen::Vector3d keep_lo_ = Eigen::Vector3d::Zero(), keep_hi_ = Eigen::Vector3d::Zero();

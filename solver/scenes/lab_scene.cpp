@@ -86,24 +86,19 @@ std::vector<std::unique_ptr<LoadingProgramme>> scene_programmes(Scene& s) {
     } catch (const std::invalid_argument& e) {
       throw InputError(s.file.string(), std::string("[specimen]: ") + e.what());
     }
-    if (s.preparation) {
-      try {
-        out.push_back(std::make_unique<SpecimenPreparation>(
-            *s.preparation, cell_gauge(2, s.preparation->max_cell_rate_1_s), test_friction));
-      } catch (const std::invalid_argument& e) {
-        throw InputError(s.file.string(), std::string("[preparation]: ") + e.what());
-      }
+    try {
+      gauge = cell_gauge(2, s.preparation ? s.preparation->max_cell_rate_1_s : 1.0);
+    } catch (const std::invalid_argument& e) {
+      throw InputError(s.file.string(), std::string("[preparation]: ") + e.what());
     }
     if (s.biaxial_periodic.d50_m <= 0 && sp.sizes.d50_m > 0)
       s.biaxial_periodic.d50_m = sp.sizes.d50_m;
     try {
-      out.push_back(std::make_unique<PeriodicBiaxial>(s.biaxial_periodic));
+      test = std::make_unique<PeriodicBiaxial>(s.biaxial_periodic);
     } catch (const std::invalid_argument& e) {
       throw InputError(s.file.string(), std::string("[biaxial_periodic]: ") + e.what());
     }
-    return out;
-  }
-  if (s.test == "triaxial" || s.test == "plane_strain") {
+  } else if (s.test == "triaxial" || s.test == "plane_strain") {
     Eigen::Vector3d lo, hi;
     if (s.specimen) {
       const double phi = 1 / (1 + s.specimen->void_ratio);

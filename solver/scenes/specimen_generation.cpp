@@ -373,22 +373,14 @@ double diameter_at(const SizeSpec& s, double u) {
     case SizeDistribution::Linear:
       break;
   }
-  // Straight grading curve by mass with mass ∝ dᵏ: number density ∝ d⁻ᵏ on [dmin, dmax].
+  // Straight grading curve by mass with mass ∝ dᵏ: number density ∝ d⁻ᵏ on [dmin, dmax], one
+  // segment of a broken line.
   if (s.mass_exponent == 3) {
-    // F(d) = (dmin⁻² − d⁻²)/(dmin⁻² − dmax⁻²).
+    // F(d) = (dmin⁻² − d⁻²)/(dmin⁻² − dmax⁻²) (this form since before k: the same draws).
     const double a = 1 / (s.dmin_m * s.dmin_m), b = 1 / (s.dmax_m * s.dmax_m);
     return 1 / std::sqrt(a - u * (a - b));
   }
-  if (s.mass_exponent == 2) {
-    // F(d) = (dmin⁻¹ − d⁻¹)/(dmin⁻¹ − dmax⁻¹), so 1/d = dmin⁻¹ − u·(dmin⁻¹ − dmax⁻¹).
-    const double a = 1 / s.dmin_m, b = 1 / s.dmax_m;
-    return std::clamp(1 / (a - u * (a - b)), s.dmin_m, s.dmax_m);
-  }
-  if (s.mass_exponent == 1)  // F(d) = ln(d/dmin)/ln(dmax/dmin)
-    return std::clamp(s.dmin_m * std::exp(u * std::log(s.dmax_m / s.dmin_m)), s.dmin_m, s.dmax_m);
-  // F(d) = (dmin^(1−k) − d^(1−k))/(dmin^(1−k) − dmax^(1−k)).
-  const double e = 1 - s.mass_exponent, a = std::pow(s.dmin_m, e), b = std::pow(s.dmax_m, e);
-  return std::clamp(std::pow(a - u * (a - b), 1 / e), s.dmin_m, s.dmax_m);
+  return inverse_power_quantile(s.mass_exponent, s.dmin_m, s.dmax_m, u);
 }
 
 std::vector<double> draw_diameters(const SizeSpec& size, double solid_volume_m3,
