@@ -9,7 +9,8 @@
 namespace gs::solver {
 
 bool NeighborList::stale(const ParticleState& p, const std::vector<WallState>& walls,
-                         const PeriodicCell* cell) const {
+                         const PeriodicCell* cell,
+                         const std::vector<std::uint32_t>* walls_to_check) const {
   if (ref_pos.size() != p.size() || wall_ref.size() != walls.size()) return true;
   if (cell) {
     // Branch vectors change by the particles' non-affine displacements and by M·(branch at the
@@ -32,10 +33,12 @@ bool NeighborList::stale(const ParticleState& p, const std::vector<WallState>& w
   for (std::size_t i = 0; i < p.size(); ++i)
     dmax2 = std::max(dmax2, (p.pos[i] - ref_pos[i]).squaredNorm());
   const double dmax = std::sqrt(dmax2);
-  moved = HUGE_VAL;  // (until known: a rebuild follows every early return)
+  moved = walls_moved = HUGE_VAL;  // (until known: a rebuild follows every early return)
   if (2 * dmax > skin) return true;
   double wmax = 0;
-  for (std::size_t w = 0; w < walls.size(); ++w) {
+  const std::size_t nw = walls_to_check ? walls_to_check->size() : walls.size();
+  for (std::size_t i = 0; i < nw; ++i) {
+    const std::size_t w = walls_to_check ? (*walls_to_check)[i] : i;
     const WallState& wall = walls[w];
     double move = wall.pos == wall_ref[w] ? 0.0 : (wall.pos - wall_ref[w]).norm();
     if (wall.spec.shape == WallShape::Facets) {
@@ -50,6 +53,7 @@ bool NeighborList::stale(const ParticleState& p, const std::vector<WallState>& w
     wmax = std::max(wmax, move);
   }
   moved = dmax + wmax;
+  walls_moved = wmax;
   return dmax + wmax > skin;
 }
 
@@ -124,6 +128,7 @@ void NeighborList::build(const ParticleState& p, const std::vector<WallState>& w
   cell_dist.clear();
   ref_pos = p.pos;
   moved = 0;
+  walls_moved = 0;
   wall_ref.resize(walls.size());
   wall_normal_ref.resize(walls.size());
   wall_ori_ref.resize(walls.size());

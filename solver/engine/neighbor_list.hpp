@@ -38,13 +38,17 @@ struct NeighborList {
   /// Set by stale(): a bound on how far any particle and any wall point have moved since the
   /// last build (m), i.e. on how much any pair's gap can have closed.
   mutable double moved = 0;
+  mutable double walls_moved = 0;  // the same for the walls alone (m)
 
   /// True when some pair may have come within contact since the last build.
   /// With a cell, the gap of a pair also closes by the cell's deformation since the build:
   /// with M = (H − H_ref)·H_ref⁻¹, by at most |M|·(2 r_max + skin) beyond twice the largest
   /// non-affine displacement x − x_ref − M·x_ref.
+  /// `walls_to_check`: only these walls can have moved or turned since the build (the others
+  /// are where they were then; Simulation keeps the list), so only they are looked at.
   bool stale(const ParticleState& p, const std::vector<WallState>& walls,
-             const PeriodicCell* cell = nullptr) const;
+             const PeriodicCell* cell = nullptr,
+             const std::vector<std::uint32_t>* walls_to_check = nullptr) const;
   /// With a cell: pairs between images across its faces too (each periodic direction must be
   /// at least 3 search cells of 2 r_max + skin wide; PeriodicTooSmall otherwise). `planar_z`:
   /// all centres lie in one plane z = const and the cell is thicker in z than 2 r_max + skin, so

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <iterator>
 #include <limits>
 
 #include <Eigen/QR>
@@ -322,6 +323,59 @@ void Simulation::rebuild_neighbors() {
   old_params_.swap(params_);
   nl_.build(p_, walls_, cell_ptr(), planar_);
   attach_histories(old_hist_, &old_params_);
+  classify_walls();
+}
+
+void Simulation::classify_walls() {
+  walls_dirty_ = false;
+  zero_all_walls_ = true;
+  moving_walls_.clear();
+  servo_walls_.clear();
+  servo_body_of_.clear();
+  servo_bodies_.clear();
+  timed_walls_.clear();
+  const bool built = nl_.wall_ref.size() == walls_.size() &&
+                     nl_.wall_normal_ref.size() == walls_.size() &&
+                     nl_.wall_ori_ref.size() == walls_.size();
+  const Eigen::Vector3d zero = Eigen::Vector3d::Zero();
+  std::vector<int> body_slot;
+  for (std::size_t w = 0; w < walls_.size(); ++w) {
+    WallState& ws = walls_[w];
+    const auto i = static_cast<std::uint32_t>(w);
+    const bool servo = ws.spec.servo_area_m2 > 0;
+    const bool moves = servo || ws.vel != zero || ws.spec.angular_velocity != zero;
+    const bool displaced = !built || ws.pos != nl_.wall_ref[w] ||
+                           ws.normal != nl_.wall_normal_ref[w] ||
+                           ws.ori.coeffs() != nl_.wall_ori_ref[w].coeffs();
+    if (moves || displaced) moving_walls_.push_back(i);
+    // A still wall's step adds its (signed) zero velocity to its position once here rather than
+    // every step: the same bits from then on.
+    if (!moves) ws.pos += ws.vel * 0.0;
+    if (ws.active && ws.spec.off_at_s < HUGE_VAL) timed_walls_.push_back(i);
+    if (!servo) continue;
+    servo_walls_.push_back(i);
+    const int b = ws.spec.body;
+    if (b < 0) {
+      servo_body_of_.push_back(-1);
+      continue;
+    }
+    if (body_slot.size() <= static_cast<std::size_t>(b)) body_slot.resize(b + 1, -1);
+    if (body_slot[b] < 0) {
+      body_slot[b] = static_cast<int>(servo_bodies_.size());
+      servo_bodies_.emplace_back();
+      for (std::size_t v = 0; v < walls_.size(); ++v)
+        if (walls_[v].spec.body == b) servo_bodies_.back().push_back(static_cast<std::uint32_t>(v));
+    }
+    servo_body_of_.push_back(body_slot[b]);
+  }
+}
+
+void Simulation::set_wall_velocity(std::size_t w, const Eigen::Vector3d& velocity) {
+  walls_.at(w).vel = velocity;
+  if (walls_dirty_) return;
+  const auto i = static_cast<std::uint32_t>(w);
+  const auto at = std::lower_bound(moving_walls_.begin(), moving_walls_.end(), i);
+  if (at == moving_walls_.end() || *at != i) moving_walls_.insert(at, i);
 }
 
 void Simulation::attach_histories(const std::vector<ContactHistory>& old,
@@ -412,15 +466,32 @@ void Simulation::attach_histories(const std::vector<ContactHistory>& old,
   }
   // Pairs that start deferred: a positive gap (the pass would find them apart at once, since the
   // bound on the displacements is 0 right after a build).
+  // They are kept per particle (the pairs are sorted by particle), each particle's sorted by
+  // gap: a pair's gap closes by at most its particle's displacement plus the walls' (a sphere
+  // resting on a finely toothed wall keeps its far teeth out of the pass however much the rest
+  // of the assembly moves).
   deferred_.clear();
-  deferred_next_ = 0;
+  deferred_groups_.clear();
+  admitted_.clear();
+  admitted_prev_.clear();
+  visit_valid_ = false;
   pass_pairs_.clear();
   for (const std::uint32_t k : wall_pairs_)
     if (facet_gap_[k] > 0) deferred_.push_back(k);
   if (!deferred_.empty()) {
-    std::sort(deferred_.begin(), deferred_.end(), [&](std::uint32_t x, std::uint32_t y) {
+    const auto by_gap = [&](std::uint32_t x, std::uint32_t y) {
       return facet_gap_[x] != facet_gap_[y] ? facet_gap_[x] < facet_gap_[y] : x < y;
-    });
+    };
+    for (std::size_t g = 0; g < deferred_.size();) {
+      std::size_t e = g + 1;
+      while (e < deferred_.size() && nl_.pairs[deferred_[e]].first == nl_.pairs[deferred_[g]].first)
+        ++e;
+      std::sort(deferred_.begin() + static_cast<std::ptrdiff_t>(g),
+                deferred_.begin() + static_cast<std::ptrdiff_t>(e), by_gap);
+      deferred_groups_.push_back({nl_.pairs[deferred_[g]].first, static_cast<std::uint32_t>(g),
+                                  static_cast<std::uint32_t>(e)});
+      g = e;
+    }
     for (const std::uint32_t k : deferred_) hist_[k].real = false;
     pass_pairs_.reserve(np);
     is_deferred_.assign(np, 0);
@@ -467,6 +538,7 @@ void Simulation::set_wall_active(std::size_t w, bool active) {
   walls_[w].active = active;
   walls_[w].force.setZero();
   walls_[w].torque.setZero();
+  walls_dirty_ = true;
   invalidate_neighbors();
 }
 
@@ -481,6 +553,7 @@ void Simulation::set_facet_forces(bool on) {
   facet_forces_ = on;
   if (!on)
     for (auto& w : walls_) w.facet_force.clear();
+  walls_dirty_ = true;
   invalidate_neighbors();
 }
 
@@ -528,24 +601,17 @@ void Simulation::set_facet_forces(bool on) {
 }
 
 void Simulation::update_servos() {
-  // The force on each rigid mesh (body): the sum over its walls, in wall order.
-  std::vector<Eigen::Vector3d> body_force;
-  for (const auto& w : walls_)
-    if (w.spec.body >= 0 && w.spec.servo_area_m2 > 0) {
-      const auto b = static_cast<std::size_t>(w.spec.body);
-      if (body_force.size() <= b) body_force.resize(b + 1, Eigen::Vector3d::Zero());
-    }
-  if (!body_force.empty())
-    for (const auto& w : walls_)
-      if (w.spec.body >= 0 && static_cast<std::size_t>(w.spec.body) < body_force.size())
-        body_force[static_cast<std::size_t>(w.spec.body)] += w.force;
-  for (auto& w : walls_) {
+  // The force on each servo'd rigid mesh (body): the sum over its walls, in wall order.
+  std::vector<Eigen::Vector3d> body_force(servo_bodies_.size(), Eigen::Vector3d::Zero());
+  for (std::size_t b = 0; b < servo_bodies_.size(); ++b)
+    for (const std::uint32_t w : servo_bodies_[b]) body_force[b] += walls_[w].force;
+  for (std::size_t i = 0; i < servo_walls_.size(); ++i) {
+    WallState& w = walls_[servo_walls_[i]];
     const auto& s = w.spec;
-    if (!(s.servo_area_m2 > 0)) continue;
     // Compressive stress on the wall: the particles push it along −normal (its inward normal).
     const Eigen::Vector3d axis = s.shape == WallShape::Plane ? w.normal : s.normal.normalized();
-    const Eigen::Vector3d& force =
-        s.body >= 0 ? body_force[static_cast<std::size_t>(s.body)] : w.force;
+    const int b = servo_body_of_[i];
+    const Eigen::Vector3d& force = b >= 0 ? body_force[static_cast<std::size_t>(b)] : w.force;
     const double stress = -force.dot(axis) / s.servo_area_m2;
     const double v = std::clamp(s.servo_gain * (s.servo_stress_Pa - stress), -s.servo_max_velocity,
                                 s.servo_max_velocity);
@@ -554,19 +620,27 @@ void Simulation::update_servos() {
 }
 
 void Simulation::accumulate_walls() {
-  for (auto& w : walls_) {
+  // Only the walls loaded in the last step have loads to clear (all of them after a change).
+  auto clear = [&](WallState& w) {
     w.force.setZero();
     w.torque.setZero();
     w.contact_stiffness = 0;
     w.contacts = 0;
+    if (facet_forces_) w.facet_force.assign(w.facets.size(), Eigen::Vector3d::Zero());
+  };
+  if (zero_all_walls_) {
+    for (auto& w : walls_) clear(w);
+    zero_all_walls_ = false;
+  } else {
+    for (const std::uint32_t w : loaded_walls_) clear(walls_[w]);
   }
-  if (facet_forces_)
-    for (auto& w : walls_) w.facet_force.assign(w.facets.size(), Eigen::Vector3d::Zero());
+  loaded_walls_.clear();
   // (the deferred pairs are not active: only the visited ones are looked at)
-  for (const std::uint32_t k : deferred_.empty() ? wall_pairs_ : pass_wall_pairs_) {
+  for (const std::uint32_t k : deferred_.empty() ? wall_pairs_ : visit_wall_) {
     if (!active_[k]) continue;
     const ContactLoads& L = loads_[k];
     WallState& w = walls_[nl_.pairs[k].second - kWallBase];
+    if (w.contacts == 0) loaded_walls_.push_back(nl_.pairs[k].second - kWallBase);
     add_to(w.force, L.force1);
     if (facet_forces_ && !w.facet_force.empty()) add_to(w.facet_force[pair_facet_[k]], L.force1);
     w.contact_stiffness += params_[k].kn;
@@ -664,21 +738,39 @@ namespace {
 }  // namespace
 
 void Simulation::admit_deferred() {
-  if (deferred_next_ == deferred_.size()) return;
+  if (deferred_.empty()) return;
+  // A deferred pair's gap has closed by at most its particle's displacement since the build plus
+  // the largest wall displacement (NeighborList::stale's bound, per particle): the pairs of each
+  // particle whose gap is within that bound this step are visited, the others provably do not
+  // touch. The bound holds step by step, so a pair may join the pass and leave it again.
+  admitted_prev_.swap(admitted_);
   admitted_.clear();
-  while (deferred_next_ < deferred_.size() && !(facet_gap_[deferred_[deferred_next_]] > nl_.moved))
-    admitted_.push_back(deferred_[deferred_next_++]);
-  if (admitted_.empty()) return;
-  std::sort(admitted_.begin(), admitted_.end());
-  const std::size_t old = pass_pairs_.size();
-  pass_pairs_.insert(pass_pairs_.end(), admitted_.begin(), admitted_.end());
-  std::inplace_merge(pass_pairs_.begin(), pass_pairs_.begin() + static_cast<std::ptrdiff_t>(old),
-                     pass_pairs_.end());
-  const std::size_t old_w = pass_wall_pairs_.size();
-  pass_wall_pairs_.insert(pass_wall_pairs_.end(), admitted_.begin(), admitted_.end());
-  std::inplace_merge(pass_wall_pairs_.begin(),
-                     pass_wall_pairs_.begin() + static_cast<std::ptrdiff_t>(old_w),
-                     pass_wall_pairs_.end());
+  const double walls_moved = nl_.walls_moved;
+  for (const DeferredGroup& g : deferred_groups_) {
+    const double bound =
+        std::sqrt((p_.pos[g.particle] - nl_.ref_pos[g.particle]).squaredNorm()) + walls_moved;
+    std::uint32_t e = g.begin;
+    while (e < g.end && !(facet_gap_[deferred_[e]] > bound)) ++e;
+    if (e == g.begin) continue;
+    const std::size_t at = admitted_.size();
+    admitted_.insert(admitted_.end(), deferred_.begin() + g.begin, deferred_.begin() + e);
+    // (in pair order: the groups follow the particles, and so the pairs)
+    std::sort(admitted_.begin() + static_cast<std::ptrdiff_t>(at), admitted_.end());
+  }
+  // Pairs visited in the last step and not in this one: apart, as the pass would have found.
+  for (std::size_t i = 0, j = 0; i < admitted_prev_.size(); ++i) {
+    while (j < admitted_.size() && admitted_[j] < admitted_prev_[i]) ++j;
+    if (j == admitted_.size() || admitted_[j] != admitted_prev_[i])
+      hist_[admitted_prev_[i]].real = false;
+  }
+  if (visit_valid_ && admitted_ == admitted_prev_) return;
+  visit_.clear();
+  std::merge(pass_pairs_.begin(), pass_pairs_.end(), admitted_.begin(), admitted_.end(),
+             std::back_inserter(visit_));
+  visit_wall_.clear();
+  std::merge(pass_wall_pairs_.begin(), pass_wall_pairs_.end(), admitted_.begin(), admitted_.end(),
+             std::back_inserter(visit_wall_));
+  visit_valid_ = true;
 }
 
 template <bool kIndexed>
@@ -693,7 +785,7 @@ int Simulation::fill_batch(std::size_t& i, std::size_t end, ContactBatch& batch,
   std::uint32_t near[ContactBatch::kLanes];
   int m = 0;
   for (; i < end && m < ContactBatch::kLanes; ++i) {
-    const std::size_t k = kIndexed ? pass_pairs_[i] : i;
+    const std::size_t k = kIndexed ? visit_[i] : i;
     const auto [a, b] = nl_.pairs[k];
     bool in_reach;
     if (b < kWallBase) {
@@ -742,13 +834,14 @@ int Simulation::fill_batch(std::size_t& i, std::size_t end, ContactBatch& batch,
 
 void Simulation::step() {
   if (periodic_) cell_.integrate(cfg_.dt);  // (YADE: Scene::moveToNextTimeStep, before engines)
-  if (nl_.stale(p_, walls_, cell_ptr())) rebuild_neighbors();
+  if (walls_dirty_) classify_walls();
+  if (nl_.stale(p_, walls_, cell_ptr(), &moving_walls_)) rebuild_neighbors();
   admit_deferred();
   const double dt = cfg_.dt;
   const std::size_t np = nl_.pairs.size();
-  // The pairs the contact pass visits: all, or pass_pairs_ while some facet pairs are deferred.
+  // The pairs the contact pass visits: all, or visit_ while some facet pairs are deferred.
   const bool indexed = !deferred_.empty();
-  const std::size_t nv = indexed ? pass_pairs_.size() : np;
+  const std::size_t nv = indexed ? visit_.size() : np;
   loads_.resize(np);
   active_.assign(np, 0);
   dissipation_.resize(2 * np);
@@ -894,7 +987,9 @@ void Simulation::step() {
         const Eigen::Matrix3d r = 0.5 * (field_.d_vel_grad - field_.d_vel_grad.transpose());
         field_.d_spin = Eigen::Vector3d(-r(1, 2), r(0, 2), -r(0, 1));
       }
-      for (const auto& w : walls_) ledger_.wall_work += -w.force.dot(w.vel) * dt;
+      // (a wall not in moving_walls_ has a zero velocity: its term is ±0)
+      for (const std::uint32_t w : moving_walls_)
+        ledger_.wall_work += -walls_[w].force.dot(walls_[w].vel) * dt;
     }  // (implicit barrier: servo velocities and the work terms use this step's loads)
 
     // Integration, with the work of gravity and of applied loads over this step (velocities of
@@ -959,7 +1054,8 @@ void Simulation::step() {
                  std::to_string(cfg_.max_overlap_ratio) +
                  " (time step too large or walls too fast?)");
   if (!finite) throw BlowUp("step " + std::to_string(step_) + ": non-finite particle state");
-  for (auto& w : walls_) {
+  for (const std::uint32_t wi : moving_walls_) {
+    WallState& w = walls_[wi];
     w.pos += w.vel * dt;
     const double om = w.spec.angular_velocity.norm();
     if (!(om > 0)) continue;
@@ -975,7 +1071,7 @@ void Simulation::step() {
   }
   time_ += dt;
   ++step_;
-  for (std::size_t w = 0; w < walls_.size(); ++w)
+  for (const std::uint32_t w : timed_walls_)
     if (walls_[w].active && time_ >= walls_[w].spec.off_at_s) set_wall_active(w, false);
   if (outlet_) remove_outflow();
 }
@@ -1115,7 +1211,8 @@ const EnergyLedger& Simulation::energy() {
     if (step_ == 0) {
       // Overlaps present in the initial packing become contacts in the first step: their
       // normal elastic energy ½·Kn·u² belongs to the initial state.
-      if (nl_.stale(p_, walls_, cell_ptr())) rebuild_neighbors();
+      if (nl_.stale(p_, walls_, cell_ptr(), walls_dirty_ ? nullptr : &moving_walls_))
+        rebuild_neighbors();
       for (std::size_t k = 0; k < nl_.pairs.size(); ++k) {
         ContactGeometry g;
         BodyMotion m1, m2;
@@ -1485,6 +1582,7 @@ std::string Simulation::load_checkpoint(const std::filesystem::path& path) {
   // Rebuild the neighbour list from the restored state and put the histories back.
   nl_.build(p_, walls_, cell_ptr(), planar_);
   attach_histories(real);
+  walls_dirty_ = true;
   return extra;
 }
 

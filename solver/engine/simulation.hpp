@@ -93,7 +93,16 @@ class Simulation {
   const ParticleState& particles() const { return p_; }
   ParticleState& particles() { return p_; }
   const std::vector<WallState>& walls() const { return walls_; }
-  std::vector<WallState>& walls() { return walls_; }
+  /// The walls to change (velocity, position, …). Changes made before the next step() take
+  /// effect in it; a reference kept across a step is not to be written through (fetch the walls
+  /// again): the engine then sorts the walls anew into those it must look at every step and
+  /// those that stand still, so that a mesh of many still walls costs nothing per step.
+  std::vector<WallState>& mutable_walls() {
+    walls_dirty_ = true;
+    return walls_;
+  }
+  /// Sets wall w's velocity (m/s) for the next steps, without sorting all the walls anew.
+  void set_wall_velocity(std::size_t w, const Eigen::Vector3d& velocity);
 
   /// Snapshot of the current state: particles, real contacts, walls with their loads.
   Frame frame() const;
@@ -229,6 +238,20 @@ class Simulation {
   void gather_clump_loads();
   /// Wall loads, dissipation and work terms of this step, summed in pair / particle order.
   void accumulate_walls();
+  /// Sorts the walls into the lists below (after a build, and after mutable_walls()).
+  void classify_walls();
+  /// Walls the per-step bookkeeping must look at, ascending: `moving_walls_` those with a
+  /// velocity, an angular velocity or a servo, or that have moved since the last build (the
+  /// others are exactly where the build saw them and their velocity is zero, so they add nothing
+  /// to the work terms and need no new position); `servo_walls_` and `servo_bodies_` (the walls
+  /// of each servo'd mesh body), `timed_walls_` (active, with a switch-off time), and
+  /// `loaded_walls_` those accumulate_walls gave loads in the last step (the others' are zero).
+  std::vector<std::uint32_t> moving_walls_, servo_walls_, timed_walls_, loaded_walls_;
+  std::vector<std::vector<std::uint32_t>> servo_bodies_;
+  std::vector<std::int32_t> servo_body_of_;  // per servo wall (parallel to servo_walls_): -1 or
+                                             // an index into servo_bodies_
+  bool walls_dirty_ = true;                  // classify_walls() due
+  bool zero_all_walls_ = true;  // accumulate_walls() zeroes every wall (after a load, a change)
 
   SimulationConfig cfg_;
   ParticleState p_;
@@ -256,12 +279,20 @@ class Simulation {
   std::vector<ContactHistory> hist_;  // parallel to nl_.pairs
   std::vector<double> facet_gap_;     // facet-wall pairs: the gap at the last build (m)
   // The contact pass visits pass_pairs_ (ascending) when some facet pairs are deferred: those
-  // whose gap at the build exceeds the displacement bound since (nl_.moved), sorted by gap;
-  // deferred_next_ is the first not yet admitted. A deferred pair provably does not touch, so
+  // whose gap at the build exceeds the bound on how far it has closed since (the displacement
+  // of its particle plus nl_.walls_moved), per particle sorted by gap (deferred_groups_); each
+  // step visits those within the bound (admit_deferred). A skipped pair provably does not touch, so
   // skipping it changes no result (its history is marked not real at the build, as the pass
   // would have marked it).
-  std::vector<std::uint32_t> pass_pairs_, pass_wall_pairs_, deferred_, admitted_;
-  std::size_t deferred_next_ = 0;
+  // pass_pairs_ / pass_wall_pairs_: the pairs never deferred; admitted_ (admitted_prev_): the
+  // deferred ones visited in this (the last) step; visit_ / visit_wall_: the two merged.
+  std::vector<std::uint32_t> pass_pairs_, pass_wall_pairs_, deferred_, admitted_, admitted_prev_;
+  std::vector<std::uint32_t> visit_, visit_wall_;
+  bool visit_valid_ = false;  // visit_ merged from this build's lists and admitted_prev_
+  struct DeferredGroup {
+    std::uint32_t particle, begin, end;  // its deferred pairs: deferred_[begin, end), by gap
+  };
+  std::vector<DeferredGroup> deferred_groups_;
   std::vector<std::uint8_t> is_deferred_;  // (scratch of attach_histories)
   bool facet_forces_ = false;
   std::vector<std::uint32_t> pair_facet_;  // closest facet of each wall pair (facet forces on)

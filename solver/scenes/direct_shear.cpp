@@ -84,7 +84,8 @@ double DirectShear::specimen_height(const Simulation& sim) const {
 void DirectShear::start(Simulation& sim) {
   reset_rotations(sim);
   for (const auto c : w_.closer) sim.set_wall_active(c, false);
-  for (auto& w : sim.walls()) w.vel.setZero();
+  for (std::size_t w = 0; w < sim.walls().size(); ++w)
+    sim.set_wall_velocity(w, Eigen::Vector3d::Zero());
   x0_ = sim.walls()[w_.upper[0]].pos.x();
   h0_ = specimen_height(sim);
 }
@@ -95,11 +96,11 @@ double DirectShear::normal_stress(const Simulation& sim) const {
 
 void DirectShear::control(Simulation& sim) {
   const Eigen::Vector3d v(spec_.shear_velocity_m_s, 0, 0);
-  for (const auto k : w_.upper) sim.walls()[k].vel = v;
+  for (const auto k : w_.upper) sim.set_wall_velocity(k, v);
   const double area = g_.length_m * g_.width_m;
   const double vz = servo_speed(sim, w_.platen, normal_stress(sim), spec_.normal_stress_Pa, area,
                                 spec_.servo_gain, spec_.max_platen_speed_m_s);
-  sim.walls()[w_.platen].vel = v + Eigen::Vector3d(0, 0, -vz);
+  sim.set_wall_velocity(w_.platen, v + Eigen::Vector3d(0, 0, -vz));
 }
 
 double DirectShear::displacement(const Simulation& sim) const {

@@ -59,7 +59,7 @@ void PlaneStrainCompression::refresh(Simulation& sim) {
 void PlaneStrainCompression::start(Simulation& sim) {
   reset_rotations(sim);
   d50_ = spec_.d50_m > 0 ? spec_.d50_m : mean_diameter(sim.particles());
-  for (std::size_t f = 0; f < 6; ++f) sim.walls()[f].vel.setZero();
+  for (std::size_t f = 0; f < 6; ++f) sim.set_wall_velocity(f, Eigen::Vector3d::Zero());
   // Clamps where the x walls meet the caps; then the x walls give way to the membranes.
   const Eigen::Vector3d lo = cuboid_lo(sim), hi = cuboid_hi(sim);
   clamp_ = spec_.clamp_height_m > 0 ? spec_.clamp_height_m : d50_;
@@ -67,7 +67,7 @@ void PlaneStrainCompression::start(Simulation& sim) {
   const double t = d50_;  // clamp thickness (outside the specimen)
   const Eigen::Vector3d half(0.5 * t, 0.5 * (hi.y() - lo.y()) + t, 0.5 * clamp_);
   for (int k = 0; k < 4; ++k) {
-    WallState& w = sim.walls().at(kClamp + static_cast<std::size_t>(k));
+    WallState& w = sim.mutable_walls().at(kClamp + static_cast<std::size_t>(k));
     const double x = (k % 2 == 0) ? lo.x() - 0.5 * t : hi.x() + 0.5 * t;
     const double z = (k < 2) ? lo.z() + 0.5 * clamp_ : hi.z() - 0.5 * clamp_;
     w.spec.half_extents = half;
@@ -94,8 +94,8 @@ double PlaneStrainCompression::top_shift(const Simulation& sim) const {
 void PlaneStrainCompression::control(Simulation& sim) {
   const double axial_speed = spec_.strain_rate_1_s * h0_;
   const Eigen::Vector3d v = axial_speed * cuboid_inward(kZmax);
-  sim.walls()[kZmax].vel = v;  // frictionless: its own lateral motion would change nothing
-  Eigen::Vector3d vc = v;      // the top clamps move with the top cap, and on the sledge
+  sim.set_wall_velocity(kZmax, v);  // frictionless: its own lateral motion changes nothing
+  Eigen::Vector3d vc = v;           // the top clamps move with the top cap, and on the sledge
   if (spec_.top_sledge) {
     // Lateral force of the grains on the sledge (cap frictionless: the clamps take it all).
     double fx = 0, k = 0;
@@ -106,8 +106,8 @@ void PlaneStrainCompression::control(Simulation& sim) {
     if (k > 0)
       vc.x() = std::clamp(spec_.sledge_gain * fx / k / sim.config().dt, -axial_speed, axial_speed);
   }
-  sim.walls()[kClamp + 2].vel = vc;
-  sim.walls()[kClamp + 3].vel = vc;
+  sim.set_wall_velocity(kClamp + 2, vc);
+  sim.set_wall_velocity(kClamp + 3, vc);
   if ((sim.step_count() - start_step_) % spec_.refresh_steps == 0) refresh(sim);
 }
 

@@ -150,16 +150,15 @@ void SpecimenPreparation::control(Simulation& sim) {
   if (stage_ == kDone) return;
   const bool servo = stage_ != kDeposition && spec_.pressure_Pa > 0;
   for (const auto w : gauge_.servo_walls) {
-    auto& wall = sim.walls()[w];
     const Eigen::Vector3d in = gauge_.inward(sim, w);
     if (!servo) {
-      wall.vel.setZero();
+      sim.set_wall_velocity(w, Eigen::Vector3d::Zero());
       continue;
     }
     const double a = gauge_.area_m2(sim, w);
     const double v = servo_speed(sim, w, wall_stress(sim, w, in, a), spec_.pressure_Pa, a,
                                  spec_.servo_gain, spec_.max_wall_speed_m_s);
-    wall.vel = v * in;
+    sim.set_wall_velocity(w, v * in);
   }
   const std::int64_t s = sim.step_count();
   if (spec_.max_steps > 0 && s - first_step_ >= spec_.max_steps) {

@@ -32,19 +32,19 @@ void TriaxialCompression::start(Simulation& sim) {
   h0_ = size0_.z();
   v0_ = size0_.prod();
   d50_ = spec_.d50_m > 0 ? spec_.d50_m : mean_diameter(sim.particles());
-  for (std::size_t f = 0; f < 6; ++f) sim.walls()[f].vel.setZero();
+  for (std::size_t f = 0; f < 6; ++f) sim.set_wall_velocity(f, Eigen::Vector3d::Zero());
 }
 
 void TriaxialCompression::control(Simulation& sim) {
   const double v = 0.5 * spec_.strain_rate_1_s * h0_;
-  sim.walls()[kZmin].vel = v * cuboid_inward(kZmin);
-  sim.walls()[kZmax].vel = v * cuboid_inward(kZmax);
+  sim.set_wall_velocity(kZmin, v * cuboid_inward(kZmin));
+  sim.set_wall_velocity(kZmax, v * cuboid_inward(kZmax));
   for (const std::size_t f : {kXmin, kXmax, kYmin, kYmax}) {
     const Eigen::Vector3d in = cuboid_inward(f);
     const double a = cuboid_face_area(sim, f);
     const double speed = servo_speed(sim, f, wall_stress(sim, f, in, a), spec_.confining_Pa, a,
                                      spec_.servo_gain, spec_.max_wall_speed_m_s);
-    sim.walls()[f].vel = speed * in;
+    sim.set_wall_velocity(f, speed * in);
   }
 }
 

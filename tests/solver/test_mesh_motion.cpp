@@ -264,3 +264,54 @@ TEST(MeshMotion, RotatingMeshCheckpointResumesBitForBit) {
   EXPECT_EQ(a.walls()[0].pos, r.walls()[0].pos);
   EXPECT_EQ(a.walls()[0].facets[1].vertex[2].eigen(), r.walls()[0].facets[1].vertex[2].eigen());
 }
+
+// The engine looks only at the walls that move (or have moved since the last neighbour-list
+// build), that carry a servo or a switch-off time, or that were loaded in the last step; the
+// others stand still and carry no load. Against a twin that rebuilds its list every step (every
+// wall looked at every step): the same bits, while a mesh floor of many walls is lifted by
+// set_wall_velocity, stops, a side wall is moved through mutable_walls(), and a switch-off time
+// passes.
+TEST(MeshMotion, StillWallsLeftOutOfTheStepChangeNoResult) {
+  auto c = config();
+  c.gravity = Eigen::Vector3d(0, 0, -9.81);
+  c.damping = 0.1;
+  auto floor = solver::mesh_walls(square(0.05), MeshContact::YadeParity);  // two walls, one body
+  ASSERT_EQ(floor.size(), 2u);
+  solver::WallSpec side;
+  side.shape = solver::WallShape::Plane;
+  side.center = Eigen::Vector3d(-3.4e-3, 0, 0);
+  side.normal = Eigen::Vector3d::UnitX();
+  solver::WallSpec gone = side;  // a far wall that switches off half-way
+  gone.center = Eigen::Vector3d(0, 3.4e-3, 0);
+  gone.normal = -Eigen::Vector3d::UnitY();
+  gone.off_at_s = 2500 * c.dt;
+  std::vector<solver::WallSpec> walls = floor;
+  walls.push_back(side);
+  walls.push_back(gone);
+  solver::Simulation sim(c, pile(), walls), twin(c, pile(), walls);
+  const Eigen::Vector3d up(0, 0, 0.02);
+  bool side_touched = false;
+  for (int s = 0; s < 5000; ++s) {
+    for (auto* x : {&sim, &twin}) {
+      if (s == 1000)
+        for (std::size_t w = 0; w < 2; ++w) x->set_wall_velocity(w, up);
+      if (s == 2000)
+        for (std::size_t w = 0; w < 2; ++w) x->set_wall_velocity(w, Eigen::Vector3d::Zero());
+      if (s == 3000) x->mutable_walls()[2].pos.x() += 2.5e-4;  // 50 µm into the pile
+      if (x == &twin) x->invalidate_neighbors();
+      x->step();
+    }
+    for (std::size_t i = 0; i < sim.particles().size(); ++i)
+      ASSERT_EQ(sim.particles().pos[i], twin.particles().pos[i]) << "step " << s;
+    for (std::size_t w = 0; w < walls.size(); ++w) {
+      ASSERT_EQ(sim.walls()[w].pos, twin.walls()[w].pos) << "step " << s;
+      ASSERT_EQ(sim.walls()[w].force, twin.walls()[w].force) << "step " << s;
+    }
+    side_touched = side_touched || sim.walls()[2].force != Eigen::Vector3d::Zero();
+  }
+  EXPECT_NEAR(sim.walls()[0].pos.z(), 0.02 * 1000 * c.dt, 1e-15);  // lifted 40 µm, then still
+  EXPECT_FALSE(sim.walls()[3].active);
+  EXPECT_TRUE(side_touched);  // the moved side wall pushed the pile
+  EXPECT_EQ(sim.energy().wall_work, twin.energy().wall_work);
+  EXPECT_GT(std::abs(sim.energy().wall_work), 0);
+}
