@@ -58,6 +58,27 @@ std::vector<std::unique_ptr<LoadingProgramme>> scene_programmes(Scene& s) {
     out.push_back(std::make_unique<FixedSteps>(s.steps, s.output.every, s.fill.has_value()));
     return out;
   }
+  if (s.test == "silo") {
+    // Seed 004 §5.2: the silo's walls, the filling in layers, then the flow.
+    const FillSpec& f = *s.fill;
+    const double d50 = s.silo.d50_m > 0 ? s.silo.d50_m : mass_quantile(f.sizes, 0.5);
+    SiloWalls idx;
+    try {
+      s.walls = silo_walls(s.silo, d50, f.sizes.dmax_m, idx);
+      if (s.silo.mode == "gravitational") {
+        // What falls through the outlet is removed two grains below the bottom.
+        const double big = 10 * (s.silo.width_m + s.silo.height_m + s.silo.depth_m);
+        s.outlet = std::make_pair(Eigen::Vector3d(-big, -big, -2 * f.sizes.dmax_m),
+                                  Eigen::Vector3d(big, big, big));
+      }
+      out.push_back(
+          std::make_unique<LayeredFilling>(f, s.fill_first, s.fill_layers, s.output.every));
+      out.push_back(std::make_unique<SiloFlow>(s.silo, idx));
+    } catch (const std::invalid_argument& e) {
+      throw InputError(s.file.string(), e.what());
+    }
+    return out;
+  }
   const double test_friction = s.config.material.friction_deg;
   std::optional<SpecimenGauge> gauge;
   std::unique_ptr<LoadingProgramme> test;

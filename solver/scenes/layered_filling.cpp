@@ -180,6 +180,7 @@ void LayeredFilling::insert_layer(Simulation& sim) {
   for (std::size_t k = 0; k < layer.size(); ++k) sim.insert_particle(first_ + layer[k], x[k]);
   ++inserted_;
   last_insert_step_ = sim.step_count();
+  moved_ = false;
 }
 
 void LayeredFilling::start(Simulation& sim) {
@@ -189,6 +190,8 @@ void LayeredFilling::start(Simulation& sim) {
   sim.set_pending(all);
   inserted_ = 0;
   done_ = false;
+  material_friction_deg_ = sim.config().material.friction_deg;
+  if (spec_.friction_deg >= 0) sim.set_friction_deg(spec_.friction_deg);
   insert_layer(sim);
 }
 
@@ -197,7 +200,15 @@ void LayeredFilling::control(Simulation& sim) {
   const std::int64_t since = sim.step_count() - last_insert_step_;
   if (since < spec_.min_steps) return;
   const double ek = settling_energy(sim);
-  if (ek >= threshold(sim)) {
+  // A layer placed at rest has next to no kinetic energy while it starts to fall: it has
+  // settled only once it has moved (its energy went above the threshold) or has had the time
+  // to fall through the region's height.
+  const Eigen::Vector3d g = sim.config().gravity;
+  const double fall_height = std::abs((spec_.region_hi_m - spec_.region_lo_m).dot(g.normalized()));
+  const bool fallen = moved_ || static_cast<double>(since) * sim.config().dt >=
+                                    std::sqrt(2 * fall_height / g.norm());
+  if (ek >= threshold(sim)) moved_ = true;
+  if (ek >= threshold(sim) || !fallen) {
     if (since >= spec_.max_steps)
       throw FillError("fill: layer " + std::to_string(inserted_) + " did not settle within " +
                       std::to_string(spec_.max_steps) + " steps (translational kinetic energy " +
@@ -210,6 +221,7 @@ void LayeredFilling::control(Simulation& sim) {
     return;
   }
   for (const std::size_t w : open_walls_) sim.set_wall_active(w, false);
+  if (spec_.friction_deg >= 0) sim.set_friction_deg(material_friction_deg_);
   done_ = true;
 }
 
@@ -234,6 +246,8 @@ std::string LayeredFilling::save_state() const {
   st.set("inserted", static_cast<std::int64_t>(inserted_));
   st.set("last_insert_step", last_insert_step_);
   st.set("done", static_cast<std::int64_t>(done_));
+  st.set("material_friction_deg", material_friction_deg_);
+  st.set("moved", static_cast<std::int64_t>(moved_));
   return st.text();
 }
 
@@ -242,6 +256,9 @@ void LayeredFilling::load_state(const std::string& state) {
   inserted_ = static_cast<int>(st.integer("inserted"));
   last_insert_step_ = st.integer("last_insert_step");
   done_ = st.integer("done") != 0;
+  material_friction_deg_ = st.has("material_friction_deg") ? st.number("material_friction_deg")
+                                                           : -1.0;  // (older checkpoints)
+  moved_ = st.has("moved") ? st.integer("moved") != 0 : true;
 }
 
 }  // namespace gs::solver

@@ -33,6 +33,10 @@ struct FillSpec {
   std::int64_t min_steps = 100;       // steps a layer falls at least before the next
   std::int64_t max_steps = 10000000;  // a layer that has not settled by then is an error
   int max_attempts = 20000;           // random draws per particle before the region is full
+  // The inter-particle friction angle while filling (negative: the material's): a lower one
+  // packs denser (the seeds reach their initial void ratios so, seed 004 §4.2.2); the
+  // material's comes back when the filling ends.
+  double friction_deg = -1;
 };
 
 /// The particles of the layers (ids from `first_id`, radii drawn largest first within each
@@ -95,6 +99,8 @@ class LayeredFilling final : public LoadingProgramme {
   std::int64_t last_insert_step_ = 0;
   bool done_ = false;
   std::int64_t frame_every_ = 0;
+  double material_friction_deg_ = 0;  // restored when the filling ends (fill.friction_deg)
+  bool moved_ = false;  // the last layer's kinetic energy has been above the threshold
 };
 
 }  // namespace gs::solver

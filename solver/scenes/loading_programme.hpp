@@ -48,6 +48,7 @@ class ProgrammeState {
   void set(const std::string& key, std::int64_t v);
   double number(const std::string& key) const;
   std::int64_t integer(const std::string& key) const;
+  bool has(const std::string& key) const { return values_.count(key) != 0; }
   std::string text() const;
 
  private:

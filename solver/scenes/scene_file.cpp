@@ -135,7 +135,8 @@ struct Reader {
 };
 
 void read_lab_sections(const Reader& r, const toml::table& root, Scene& s) {
-  for (const char* name : {"triaxial", "plane_strain", "direct_shear", "biaxial_periodic"}) {
+  for (const char* name :
+       {"triaxial", "plane_strain", "direct_shear", "biaxial_periodic", "silo"}) {
     if (root.contains(name) && s.test != name)
       r.fail(std::string("[") + name + "]", "does not match scene.test", s.test);
   }
@@ -232,8 +233,72 @@ void read_lab_sections(const Reader& r, const toml::table& root, Scene& s) {
     g.gap_m = r.number(t, "direct_shear", "gap_m", false, -1);
     g.side_friction_deg = r.number(t, "direct_shear", "side_friction_deg", false, 0);
     g.platen_friction_deg = r.number(t, "direct_shear", "platen_friction_deg", false, -1);
+  } else if (s.test == "silo") {
+    // Seed 004 §5.2 (silo_flow.hpp, docs/silo.md).
+    const auto* t = r.table("silo", true);
+    const std::string sec = "silo";
+    r.only(t, sec,
+           {"width_m",
+            "height_m",
+            "depth_m",
+            "roughness",
+            "d50_m",
+            "tooth_slope_deg",
+            "tooth_spacing_ratio",
+            "wall_friction_deg",
+            "front_back_friction_deg",
+            "bottom_friction_deg",
+            "mode",
+            "flow_damping",
+            "bottom_velocity_m_s",
+            "bottom_travel_m",
+            "frame_every_m",
+            "settle_s",
+            "outlet",
+            "outlet_width_m",
+            "max_discharge_s",
+            "end_fraction",
+            "frame_every_s"});
+    auto& x = s.silo;
+    x.width_m = r.positive(t, sec, "width_m", true, 0);
+    x.height_m = r.positive(t, sec, "height_m", true, 0);
+    x.depth_m = r.positive(t, sec, "depth_m", true, 0);
+    x.roughness = r.number(t, sec, "roughness", true, 0);
+    x.d50_m = r.number(t, sec, "d50_m", false, 0);
+    x.tooth_slope_deg = r.number(t, sec, "tooth_slope_deg", false, x.tooth_slope_deg);
+    x.tooth_spacing_ratio = r.positive(t, sec, "tooth_spacing_ratio", false, x.tooth_spacing_ratio);
+    x.wall_friction_deg = r.number(t, sec, "wall_friction_deg", false, x.wall_friction_deg);
+    x.front_back_friction_deg =
+        r.number(t, sec, "front_back_friction_deg", false, x.front_back_friction_deg);
+    x.bottom_friction_deg = r.number(t, sec, "bottom_friction_deg", false, -1);
+    for (const char* k : {"wall_friction_deg", "front_back_friction_deg"}) {
+      const double v = r.number(t, sec, k, false, 0);
+      if (!(v >= 0 && v < 90)) r.fail(sec + "." + k, "outside [0, 90)", value_str(v));
+    }
+    x.mode = r.string(t, sec, "mode", false, x.mode);
+    if (x.mode != "quasi_static" && x.mode != "gravitational")
+      r.fail("silo.mode", "expected \"quasi_static\" or \"gravitational\"", x.mode);
+    const bool quasi = x.mode == "quasi_static";
+    for (const char* k : {"bottom_velocity_m_s", "bottom_travel_m", "frame_every_m"})
+      if (!quasi && t->contains(k)) r.fail(sec + "." + k, "is for mode = \"quasi_static\"");
+    for (const char* k : {"settle_s", "outlet", "outlet_width_m", "max_discharge_s", "end_fraction",
+                          "frame_every_s"})
+      if (quasi && t->contains(k)) r.fail(sec + "." + k, "is for mode = \"gravitational\"");
+    x.flow_damping = r.number(t, sec, "flow_damping", false, x.flow_damping);
+    x.bottom_velocity_m_s = r.positive(t, sec, "bottom_velocity_m_s", false, x.bottom_velocity_m_s);
+    x.bottom_travel_m = r.positive(t, sec, "bottom_travel_m", false, x.bottom_travel_m);
+    x.frame_every_m = r.number(t, sec, "frame_every_m", false, x.frame_every_m);
+    x.settle_s = r.number(t, sec, "settle_s", false, x.settle_s);
+    x.outlet = r.string(t, sec, "outlet", false, x.outlet);
+    x.outlet_width_m = r.number(t, sec, "outlet_width_m", false, x.outlet_width_m);
+    x.max_discharge_s = r.positive(t, sec, "max_discharge_s", false, x.max_discharge_s);
+    x.end_fraction = r.number(t, sec, "end_fraction", false, x.end_fraction);
+    x.frame_every_s = r.number(t, sec, "frame_every_s", false, x.frame_every_s);
+    if (!root.contains("fill")) r.fail("[fill]", "missing (the silo is filled in layers)");
   }
   const auto* prep = r.table("preparation", false);
+  if (s.test == "silo" && (prep || s.specimen))
+    r.fail(prep ? "[preparation]" : "[specimen]", "the silo is filled by its [fill]; remove it");
   if (!s.test.empty() && (prep || s.specimen)) {
     auto& p = s.preparation.emplace();
     r.only(prep, "preparation",
@@ -434,10 +499,11 @@ void read_clumps(const Reader& r, const toml::table& root, const std::filesystem
 void read_fill(const Reader& r, Scene& s) {
   const auto* t = r.table("fill", false);
   if (!t) return;
-  if (!s.test.empty()) r.fail("[fill]", "a laboratory test makes its own specimen; remove [fill]");
+  if (!s.test.empty() && s.test != "silo")
+    r.fail("[fill]", "a laboratory test makes its own specimen; remove [fill]");
   r.only(t, "fill",
          {"region_lo_m", "region_hi_m", "layers", "count", "dmin_m", "dmax_m", "distribution",
-          "seed", "kinetic_ratio", "min_steps", "max_steps", "max_attempts"});
+          "seed", "kinetic_ratio", "min_steps", "max_steps", "max_attempts", "friction_deg"});
   FillSpec f;
   f.region_lo_m = r.vec3(t, "fill", "region_lo_m", true, {});
   f.region_hi_m = r.vec3(t, "fill", "region_hi_m", true, {});
@@ -460,6 +526,9 @@ void read_fill(const Reader& r, Scene& s) {
   f.min_steps = r.integer(t, "fill", "min_steps", false, f.min_steps, 1);
   f.max_steps = r.integer(t, "fill", "max_steps", false, f.max_steps, f.min_steps);
   f.max_attempts = static_cast<int>(r.integer(t, "fill", "max_attempts", false, 20000, 1));
+  f.friction_deg = r.number(t, "fill", "friction_deg", false, -1);
+  if (!(f.friction_deg < 90))
+    r.fail("fill.friction_deg", "must be below 90", value_str(f.friction_deg));
   if (!(s.config.gravity.norm() > 0)) r.fail("solver.gravity_m_s2", "[fill] needs gravity");
   std::int64_t next_id = 0;
   for (const auto& p : s.particles) next_id = std::max(next_id, p.id + 1);
@@ -556,11 +625,24 @@ Scene load_scene(const std::filesystem::path& path) {
   Scene s;
   s.file = path;
   for (const auto& [k, v] : root) {
-    static const char* sections[] = {"scene",           "material",     "solver",      "output",
-                                     "walls",           "specimen",     "preparation", "triaxial",
-                                     "plane_strain",    "direct_shear", "mesh",        "outlet",
-                                     "clump_template",  "clumps",       "fill",        "cell",
-                                     "biaxial_periodic"};
+    static const char* sections[] = {"scene",
+                                     "material",
+                                     "solver",
+                                     "output",
+                                     "walls",
+                                     "specimen",
+                                     "preparation",
+                                     "triaxial",
+                                     "plane_strain",
+                                     "direct_shear",
+                                     "mesh",
+                                     "outlet",
+                                     "clump_template",
+                                     "clumps",
+                                     "fill",
+                                     "cell",
+                                     "biaxial_periodic",
+                                     "silo"};
     if (std::find(std::begin(sections), std::end(sections), k.str()) == std::end(sections))
       r.fail("[" + std::string(k.str()) + "]", "unknown section");
   }
@@ -569,9 +651,10 @@ Scene load_scene(const std::filesystem::path& path) {
   s.name = r.string(scene, "scene", "name", true, "");
   s.test = r.string(scene, "scene", "test", false, "");
   if (!s.test.empty() && s.test != "triaxial" && s.test != "plane_strain" &&
-      s.test != "direct_shear" && s.test != "biaxial_periodic")
+      s.test != "direct_shear" && s.test != "biaxial_periodic" && s.test != "silo")
     r.fail("scene.test",
-           "expected \"triaxial\", \"plane_strain\", \"direct_shear\" or \"biaxial_periodic\"",
+           "expected \"triaxial\", \"plane_strain\", \"direct_shear\", \"biaxial_periodic\" "
+           "or \"silo\"",
            s.test);
   const auto* specimen = r.table("specimen", false);
   const bool has_packing = scene->contains("packing");
@@ -761,6 +844,8 @@ Scene load_scene(const std::filesystem::path& path) {
   }
   read_lab_sections(r, root, s);
 
+  if (s.test == "silo" && root.contains("outlet"))
+    r.fail("[outlet]", "the silo removes what leaves through its outlet; remove [outlet]");
   if (!s.test.empty() && root.contains("walls"))
     r.fail("[[walls]]", "a laboratory test builds its own walls; remove [[walls]]");
   if (const auto* walls = root["walls"].as_array()) {

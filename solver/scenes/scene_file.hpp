@@ -15,6 +15,7 @@
 #include "loading_programme.hpp"
 #include "periodic_biaxial.hpp"
 #include "plane_strain_compression.hpp"
+#include "silo_flow.hpp"
 #include "simulation.hpp"
 #include "snapshot.hpp"
 #include "specimen_generation.hpp"
@@ -87,7 +88,7 @@ struct Scene {
   double dt_pwave = 0;  // YADE's PWaveTimeStep of the packing (s)
 
   // Laboratory tests (docs/scenes.md): empty `test` is a plain run of `steps` steps.
-  std::string test;  // "", "triaxial", "plane_strain", "direct_shear", "biaxial_periodic"
+  std::string test;  // "", "triaxial", "plane_strain", "direct_shear", "biaxial_periodic", "silo"
   std::optional<SpecimenSpec> specimen;
   std::optional<PreparationSpec> preparation;
   double wall_friction_deg = 0;  // smooth walls by default (seed 004 §4.1.2, seed 000 §3)
@@ -96,6 +97,7 @@ struct Scene {
   DirectShearSpec direct_shear;
   ShearBoxGeometry shear_box;
   PeriodicBiaxialSpec biaxial_periodic;
+  SiloSpec silo;
 };
 
 /// Generates the specimen when the scene asks for one, builds the walls of its test and returns

@@ -121,6 +121,36 @@ TEST(LayeredFilling, EachLayerFollowsOnceTheKineticEnergyIsNegligible) {
   for (std::size_t i = 0; i < 240; ++i) EXPECT_LT(s.sim.particles().pos[i].z(), 0.02);
 }
 
+// With a small time step a layer placed at rest gains next to no kinetic energy in its first
+// steps (here 1e-3 of the threshold after the 100 steps it must fall at least): the next layer
+// still waits until this one has fallen out of the region and come to rest on the floor.
+TEST(LayeredFilling, ALayerAtRestInTheRegionHasNotSettled) {
+  FillSpec f = spec();
+  f.layers = 2;
+  f.count = 80;
+  const auto fp = solver::fill_particles(f, 0);
+  auto c = config();
+  c.dt = 1e-6;
+  solver::Simulation sim(c, fp.particles, box());
+  solver::LayeredFilling fill(f, 0, fp.layers, 1000);
+  fill.start(sim);
+  std::int64_t second = -1;
+  while (!fill.finished(sim)) {
+    fill.control(sim);
+    if (second < 0 && fill.layers_inserted() == 2) {
+      second = sim.step_count();
+      for (const auto k : fp.layers[0]) EXPECT_LT(sim.particles().pos[k].z(), f.region_lo_m.z());
+    }
+    if (fill.finished(sim)) break;
+    sim.step();
+    ASSERT_LT(sim.step_count(), 2000000);
+  }
+  // At least the time to fall through the region's 8 mm: sqrt(2·0.008/g) = 40 ms.
+  EXPECT_GE(second, 40000);
+  std::printf("second layer at step %lld (%.1f ms)\n", static_cast<long long>(second),
+              1e3 * second * c.dt);
+}
+
 TEST(LayeredFilling, ResumesFromACheckpointBitForBit) {
   Filled a, b;
   a.fill.start(a.sim);

@@ -1,0 +1,177 @@
+// `simulate` of the model silo (seed 004 §5.2) on a small silo, end to end: the filling in
+// layers, then the bottom moving down (quasi-static mode) or an outlet opening (gravitational
+// mode), with the curve of the wall forces of §5.3.1 normalised by the weight; and the silo's
+// bad inputs.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+
+#include "../io/test_util.hpp"
+#include "cli_util.hpp"
+
+#include "hdf5_trajectory.hpp"
+
+namespace {
+
+using gs::test::read_csv_table;
+using gs::test::run_cli;
+
+// 120 grains of 1.5–2.5 mm in a 20 × 30 × 7.5 mm silo with R_n = 1 teeth (1.9 mm: d50 by mass
+// of the straight grading), two layers; the seed's material (Table 5.1).
+std::string scene(const std::string& silo, const std::string& extra = "") {
+  return "[scene]\nname = \"silo\"\ntest = \"silo\"\n"
+         "[material]\nyoung_Pa = 1.0e7\nstiffness_ratio = 0.3\nfriction_deg = 25.0\n"
+         "density_kg_m3 = 2600.0\nrolling_stiffness = 0.2\nrolling_limit = 0.4\n"
+         "[solver]\ndt_s = \"auto\"\ndt_safety = 0.5\ndamping = 0.3\n"
+         "gravity_m_s2 = [0.0, 0.0, -9.81]\n"
+         "[output]\nevery = 5000\nhistory_every = 1000\ncurve_every = 200\n"
+         "checkpoint_every = 20000\n"
+         "[fill]\nregion_lo_m = [0.0021, 0.0, 0.012]\nregion_hi_m = [0.0179, 0.0075, 0.03]\n"
+         "layers = 2\ncount = 120\ndmin_m = 0.0015\ndmax_m = 0.0025\ndistribution = \"linear\"\n"
+         "seed = 1\n" +
+         extra + "[silo]\nwidth_m = 0.02\nheight_m = 0.03\ndepth_m = 0.0075\nroughness = 1.0\n" +
+         silo;
+}
+
+const std::string kQuasi =
+    "mode = \"quasi_static\"\nbottom_velocity_m_s = 0.005\nbottom_travel_m = 0.001\n"
+    "frame_every_m = 0.00025\n";
+const std::string kGravity =
+    "mode = \"gravitational\"\noutlet = \"centre\"\noutlet_width_m = 0.008\nsettle_s = 0.02\n"
+    "max_discharge_s = 1.0\nend_fraction = 0.9\nframe_every_s = 0.05\n";
+
+std::string replaced(std::string s, const std::string& from, const std::string& to) {
+  const auto at = s.find(from);
+  if (at == std::string::npos)
+    ADD_FAILURE() << "no " << from;
+  else
+    s.replace(at, from.size(), to);
+  return s;
+}
+
+}  // namespace
+
+TEST(Silo, QuasiStaticBottomMovesAndTheForcesBalanceTheWeight) {
+  gs::test::ScratchDir dir("silo_quasi");
+  std::ofstream(dir / "silo.toml") << scene(kQuasi);
+  const auto r = run_cli(
+      "simulate " + (dir / "silo.toml").string() + " -q -o " + (dir / "out").string(), dir.path);
+  ASSERT_EQ(r.rc, 0) << r.err;
+  const auto c = read_csv_table(dir / "out" / "curve.csv");
+  ASSERT_GE(c.rows.size(), 3u);
+  // G is the weight of all 120 grains (all in the silo), exactly.
+  const auto t = gs::read_hdf5_trajectory(dir / "out" / "trajectory.h5");
+  const auto& last = t.frames.back();
+  ASSERT_EQ(last.particles.size(), 120u);
+  double weight = 0;
+  for (const auto& p : last.particles) weight += p.mass * 9.81;
+  EXPECT_NEAR(c.num(0, "G_N"), weight, 1e-12 * weight);
+  // At the end of the filling the grains are at rest: the bottom and the two walls carry the
+  // weight, G = P + T_left + T_right (seed 004 §5.3.1: G = 2T + P).
+  EXPECT_EQ(c.num(0, "u_m"), 0.0);
+  EXPECT_NEAR(c.num(0, "balance_G"), 1.0, 0.03);
+  EXPECT_NEAR(c.num(0, "balance_G"), c.num(0, "P_G") + c.num(0, "T_left_G") + c.num(0, "T_right_G"),
+              1e-5);
+  // The bottom moves down at its speed until it has travelled u = 1 mm.
+  double u = 0;
+  for (std::size_t i = 1; i < c.rows.size(); ++i) {
+    EXPECT_GE(c.num(i, "u_m"), u);
+    u = c.num(i, "u_m");
+    EXPECT_NEAR(c.num(i, "u_m"), 0.005 * c.num(i, "flow_time_s"), 1e-12);
+  }
+  EXPECT_GE(u, 0.001);
+  EXPECT_LT(u, 0.001 + 0.005 * 1e-5);
+  // Frames at u = 0.25, 0.5, 0.75 and 1 mm after the one that ends the filling.
+  int after = 0;
+  for (const auto& f : t.frames) after += f.time > c.num(0, "time_s") + 1e-12;
+  EXPECT_EQ(after, 4);
+  // The wall forces are in the history too, per side wall (the meshes' groups).
+  const auto h = read_csv_table(dir / "out" / "history.csv");
+  for (const char* col : {"left_fz_N", "right_fx_N", "bottom_fz_N"}) (void)h.num(0, col);
+}
+
+TEST(Silo, GravitationalOutletDischargesAndWeighsWhatLeaves) {
+  gs::test::ScratchDir dir("silo_gravity");
+  std::ofstream(dir / "silo.toml") << scene(kGravity);
+  const auto r = run_cli(
+      "simulate " + (dir / "silo.toml").string() + " -q -o " + (dir / "out").string(), dir.path);
+  ASSERT_EQ(r.rc, 0) << r.err;
+  const auto c = read_csv_table(dir / "out" / "curve.csv");
+  ASSERT_GE(c.rows.size(), 3u);
+  EXPECT_NEAR(c.num(0, "balance_G"), 1.0, 0.03);
+  double out = 0;
+  for (std::size_t i = 0; i < c.rows.size(); ++i) {
+    if (c.num(i, "flow_time_s") < 0.02) {
+      EXPECT_EQ(c.num(i, "discharged_kg"), 0.0) << i;
+    }
+    EXPECT_GE(c.num(i, "discharged_kg"), out);
+    out = c.num(i, "discharged_kg");
+  }
+  // The last row: at least 90 % of the mass has left (or the time ran out), and what left is
+  // what the outlet removed (the history's count of the engine's removals).
+  const std::size_t n = c.rows.size() - 1;
+  EXPECT_TRUE(c.num(n, "discharged_fraction") >= 0.9 || c.num(n, "flow_time_s") >= 1.02);
+  const auto h = read_csv_table(dir / "out" / "history.csv");
+  EXPECT_NEAR(h.num(h.rows.size() - 1, "removed_mass_kg"), out, 1e-9 * out);
+  EXPECT_NE(r.out.find("discharged"), std::string::npos) << r.out;
+}
+
+TEST(Silo, BadInputsFailWithOneLine) {
+  gs::test::ScratchDir dir("silo_bad");
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {replaced(scene(kGravity), "outlet_width_m = 0.008", "outlet_width_m = 0.05"),
+       "silo.outlet_width_m: outside the bottom (0.05)"},
+      {replaced(scene(kQuasi), "roughness = 1.0", "roughness = 0.0001"),
+       "silo.roughness: gives teeth below 1e-3·d50 (0.0001)"},
+      {replaced(scene(kQuasi), "mode = \"quasi_static\"", "mode = \"fast\""),
+       "silo.mode: expected \"quasi_static\" or \"gravitational\" (fast)"},
+      {scene(kGravity + "bottom_travel_m = 0.01\n"),
+       "silo.bottom_travel_m: is for mode = \"quasi_static\""},
+      {scene(kQuasi, "[outlet]\nkeep_lo_m = [-1.0, -1.0, -1.0]\nkeep_hi_m = [1.0, 1.0, 1.0]\n"),
+       "[outlet]: the silo removes what leaves through its outlet; remove [outlet]"},
+      {replaced(scene(kQuasi), "[fill]", "[nofill]"), "[nofill]: unknown section"},
+      {replaced(replaced(scene(kQuasi), "[fill]", "[unused]"), "[unused]", "[walls_x]"),
+       "[walls_x]: unknown section"},
+      {replaced(scene(kGravity), "outlet = \"centre\"", "outlet = \"middle\""),
+       "silo.outlet: expected \"centre\" or \"right\" (middle)"},
+      {scene(kQuasi,
+             "[[walls]]\nshape = \"plane\"\npoint_m = [0.0, 0.0, 0.0]\n"
+             "normal = [0.0, 0.0, 1.0]\n"),
+       "[[walls]]: a laboratory test builds its own walls"},
+  };
+  for (std::size_t i = 0; i < cases.size(); ++i) {
+    const auto p = dir / ("bad" + std::to_string(i) + ".toml");
+    std::ofstream(p) << cases[i].first;
+    const auto r = run_cli("simulate " + p.string() + " -q -o " + (dir / "out").string(), dir.path);
+    EXPECT_EQ(r.rc, 2) << i;
+    EXPECT_NE(r.err.find(cases[i].second), std::string::npos) << i << ": " << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << i << ": " << r.err;
+  }
+}
+
+// Killed once while filling and once while the outlet discharges, resumed: every output equals
+// the uninterrupted run's (the programmes' states, the removals and the insertions come from
+// the checkpoint).
+TEST(Silo, ResumeIsBitForBitWhileFillingAndDischarging) {
+  gs::test::ScratchDir dir("silo_resume");
+  std::ofstream(dir / "silo.toml") << scene(kGravity);
+  const std::string sc = (dir / "silo.toml").string();
+  ASSERT_EQ(run_cli("simulate " + sc + " -q -o " + (dir / "straight").string(), dir.path).rc, 0);
+  const auto straight = read_csv_table(dir / "straight" / "curve.csv");
+  for (const long kill_after : {45000L, 100000L}) {  // (the filling ends near 71 000)
+    const auto killed = dir / ("killed" + std::to_string(kill_after));
+    ASSERT_TRUE(gs::test::run_and_kill(sc, killed, kill_after))
+        << "the run finished before it could be killed";
+    const auto r = run_cli("simulate " + sc + " -q --resume -o " + killed.string(), dir.path);
+    ASSERT_EQ(r.rc, 0) << r.err;
+    for (const char* f : {"history.csv", "curve.csv"})
+      EXPECT_EQ(gs::test::slurp(dir / "straight" / f), gs::test::slurp(killed / f))
+          << f << " after " << kill_after;
+    const auto a = gs::read_hdf5_trajectory(dir / "straight" / "trajectory.h5");
+    const auto b = gs::read_hdf5_trajectory(killed / "trajectory.h5");
+    ASSERT_EQ(a.frames.size(), b.frames.size());
+    for (std::size_t i = 0; i < a.frames.size(); ++i)
+      gs::test::expect_same_frame(a.frames[i], b.frames[i]);
+  }
+}
