@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "mesh_walls.hpp"
+#include "sphere_box_volume.hpp"
 #include "surface_generators.hpp"
 
 namespace gs::solver {
@@ -76,6 +77,7 @@ std::vector<WallSpec> silo_walls(const SiloSpec& s, double d50_m, double dmax_m,
   // under them while the bottom moves down.
   index.floor_z_m = quasi ? -(s.bottom_travel_m + 2 * dmax_m) : 0.0;
   index.tooth_height_m = hg;
+  index.dmax_m = dmax_m;
   index.tooth_spacing_m = sg;
   std::vector<WallSpec> w;
   const double W = s.width_m, D = s.depth_m, z0 = index.floor_z_m, L = s.height_m - z0;
@@ -211,6 +213,30 @@ void SiloFlow::start(Simulation& sim) {
   mass0_ = silo_forces(sim, w_).weight / sim.config().gravity.norm();
   removed0_ = sim.removed_mass();
   opened_ = false;
+  // The gauge box for the void ratio: below the fill's surface, clear of walls and bottom.
+  const auto& p = sim.particles();
+  std::vector<double> tops;
+  for (std::size_t i = 0; i < p.size(); ++i)
+    if (p.removed[i] == 0) tops.push_back(p.pos[i].z() + p.radius[i]);
+  std::sort(tops.begin(), tops.end());
+  const std::size_t n_top = std::min(tops.size(), std::max<std::size_t>(1, tops.size() / 20));
+  double surface = 0;
+  for (std::size_t k = tops.size() - n_top; k < tops.size(); ++k)
+    surface += tops[k] / static_cast<double>(n_top);
+  const double c = w_.tooth_height_m + w_.dmax_m;
+  gauge_lo_ = Eigen::Vector3d(c, 0, z0_ + b.spec.half_extents.z() + w_.dmax_m);
+  gauge_hi_ = Eigen::Vector3d(spec_.width_m - c, spec_.depth_m, surface - w_.dmax_m);
+  e0_ = void_ratio(sim);
+}
+
+double SiloFlow::void_ratio(const Simulation& sim) const {
+  if (!(gauge_hi_.array() > gauge_lo_.array()).all()) return NAN;
+  const auto& p = sim.particles();
+  double solid = 0;
+  for (std::size_t i = 0; i < p.size(); ++i)
+    if (p.removed[i] == 0) solid += sphere_box_volume(p.pos[i], p.radius[i], gauge_lo_, gauge_hi_);
+  const double v = (gauge_hi_ - gauge_lo_).prod();
+  return solid > 0 ? v / solid - 1 : NAN;
 }
 
 double SiloFlow::travel(const Simulation& sim) const {
@@ -246,7 +272,7 @@ double SiloFlow::progress(const Simulation& sim) const {
 std::string SiloFlow::curve_header() const {
   return "time_s,flow_time_s,u_m,G_N,P_N,T_left_N,T_right_N,N_left_N,N_right_N,P_G,T_left_G,"
          "T_right_G,N_left_G,N_right_G,balance_G,phi_w_left_deg,phi_w_right_deg,"
-         "discharged_kg,discharged_fraction,inertial_number";
+         "discharged_kg,discharged_fraction,inertial_number,void_ratio";
 }
 
 std::string SiloFlow::curve_row(const Simulation& sim) const {
@@ -259,12 +285,12 @@ std::string SiloFlow::curve_row(const Simulation& sim) const {
   char b[768];
   std::snprintf(b, sizeof b,
                 "%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.9g,%.9g,%.9g,%.9g,%.9g,"
-                "%.9g,%.6g,%.6g,%.17g,%.9g,%.6g",
+                "%.9g,%.6g,%.6g,%.17g,%.9g,%.6g,%.6g",
                 sim.time(), sim.time() - t0_, u, G, f.bottom, f.t_left, f.t_right, f.n_left,
                 f.n_right, by_g(f.bottom), by_g(f.t_left), by_g(f.t_right), by_g(f.n_left),
                 by_g(f.n_right), by_g(f.bottom + f.t_left + f.t_right),
                 std::atan2(f.t_left, f.n_left) * deg, std::atan2(f.t_right, f.n_right) * deg, out,
-                mass0_ > 0 ? out / mass0_ : 0.0, sim.inertial_number());
+                mass0_ > 0 ? out / mass0_ : 0.0, sim.inertial_number(), void_ratio(sim));
   return b;
 }
 
@@ -280,21 +306,21 @@ std::int64_t SiloFlow::frame_index(const Simulation& sim) const {
 
 std::string SiloFlow::summary(const Simulation& sim) const {
   const SiloForces f = silo_forces(sim, w_);
-  char b[512];
+  char b[640];
   if (quasi_static()) {
-    std::snprintf(b, sizeof b,
-                  "silo (quasi-static): u = %.4g m; G = %.4g N, P/G = %.3f, T/G = %.3f / %.3f, "
-                  "N/G = %.3f / %.3f (left / right), (P + 2T)/G = %.3f",
-                  travel(sim), f.weight, f.bottom / f.weight, f.t_left / f.weight,
-                  f.t_right / f.weight, f.n_left / f.weight, f.n_right / f.weight,
-                  (f.bottom + f.t_left + f.t_right) / f.weight);
+    std::snprintf(
+        b, sizeof b,
+        "silo (quasi-static): e0 = %.3f; u = %.4g m; G = %.4g N, P/G = %.3f, T/G = %.3f / %.3f, "
+        "N/G = %.3f / %.3f (left / right), (P + 2T)/G = %.3f",
+        e0_, travel(sim), f.weight, f.bottom / f.weight, f.t_left / f.weight, f.t_right / f.weight,
+        f.n_left / f.weight, f.n_right / f.weight, (f.bottom + f.t_left + f.t_right) / f.weight);
   } else {
-    std::snprintf(b, sizeof b,
-                  "silo (gravitational, outlet %s, b = %.4g m): %.4g kg of %.4g kg discharged "
-                  "(%.1f %%) in %.4g s after the opening",
-                  spec_.outlet.c_str(), spec_.outlet_width_m, discharged_mass(sim), mass0_,
-                  mass0_ > 0 ? 100 * discharged_mass(sim) / mass0_ : 0.0,
-                  sim.time() - t0_ - spec_.settle_s);
+    std::snprintf(
+        b, sizeof b,
+        "silo (gravitational, outlet %s, b = %.4g m): e0 = %.3f; %.4g kg of %.4g kg discharged "
+        "(%.1f %%) in %.4g s after the opening",
+        spec_.outlet.c_str(), spec_.outlet_width_m, e0_, discharged_mass(sim), mass0_,
+        mass0_ > 0 ? 100 * discharged_mass(sim) / mass0_ : 0.0, sim.time() - t0_ - spec_.settle_s);
   }
   return b;
 }
@@ -306,6 +332,11 @@ std::string SiloFlow::save_state() const {
   st.set("mass0", mass0_);
   st.set("removed0", removed0_);
   st.set("opened", static_cast<std::int64_t>(opened_));
+  st.set("e0", e0_);
+  for (int k = 0; k < 3; ++k) {
+    st.set("gauge_lo" + std::to_string(k), gauge_lo_[k]);
+    st.set("gauge_hi" + std::to_string(k), gauge_hi_[k]);
+  }
   return st.text();
 }
 
@@ -316,6 +347,11 @@ void SiloFlow::load_state(const std::string& state) {
   mass0_ = st.number("mass0");
   removed0_ = st.number("removed0");
   opened_ = st.integer("opened") != 0;
+  e0_ = st.number("e0");
+  for (int k = 0; k < 3; ++k) {
+    gauge_lo_[k] = st.number("gauge_lo" + std::to_string(k));
+    gauge_hi_[k] = st.number("gauge_hi" + std::to_string(k));
+  }
 }
 
 }  // namespace gs::solver

@@ -63,6 +63,7 @@ struct SiloWalls {
   std::size_t front = 0, back = 0;
   double tooth_height_m = 0, tooth_spacing_m = 0;
   double floor_z_m = 0;  // the side walls' lower end (below 0 in the quasi-static mode)
+  double dmax_m = 0;     // the largest grain
 };
 
 /// The silo's walls (side walls as merged meshes of groups "left" and "right", the bottom as
@@ -102,12 +103,18 @@ class SiloFlow final : public LoadingProgramme {
   double travel(const Simulation& sim) const;
   /// Mass that has left the silo since the start, and its fraction of the mass at the start.
   double discharged_mass(const Simulation& sim) const { return sim.removed_mass() - removed0_; }
+  /// Void ratio in the gauge box fixed when the flow starts: the silo's interior one largest
+  /// grain clear of the teeth's tips, the bottom and the fill's surface (the mean top of its
+  /// highest 5 % of grains), over the whole depth; spheres cut by the box count with the part
+  /// inside it.
+  double void_ratio(const Simulation& sim) const;
 
  private:
   bool quasi_static() const { return spec_.mode == "quasi_static"; }
   SiloSpec spec_;
   SiloWalls w_;
-  double t0_ = 0, z0_ = 0, mass0_ = 0, removed0_ = 0;
+  double t0_ = 0, z0_ = 0, mass0_ = 0, removed0_ = 0, e0_ = 0;
+  Eigen::Vector3d gauge_lo_ = Eigen::Vector3d::Zero(), gauge_hi_ = Eigen::Vector3d::Zero();
   bool opened_ = false;
 };
 

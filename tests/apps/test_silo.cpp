@@ -4,6 +4,7 @@
 // bad inputs.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 
@@ -11,6 +12,7 @@
 #include "cli_util.hpp"
 
 #include "hdf5_trajectory.hpp"
+#include "sphere_box_volume.hpp"
 
 namespace {
 
@@ -73,6 +75,26 @@ TEST(Silo, QuasiStaticBottomMovesAndTheForcesBalanceTheWeight) {
   EXPECT_NEAR(c.num(0, "balance_G"), 1.0, 0.03);
   EXPECT_NEAR(c.num(0, "balance_G"), c.num(0, "P_G") + c.num(0, "T_left_G") + c.num(0, "T_right_G"),
               1e-5);
+  // The void ratio in the gauge box, recomputed from the frame that ends the filling: the box
+  // one largest grain (2.5 mm) clear of the teeth's tips (h_g = R_n·d50, d50 = 2 mm by mass for
+  // the straight grading 1.5–2.5 mm), of the bottom (z = 0) and of the surface (the mean top of
+  // the highest 5 % of grains), over the whole depth.
+  const gs::Frame* filled = nullptr;
+  for (const auto& f : t.frames)
+    if (std::abs(f.time - c.num(0, "time_s")) < 1e-12) filled = &f;
+  ASSERT_NE(filled, nullptr);
+  std::vector<double> tops;
+  for (const auto& p : filled->particles) tops.push_back(p.position.z() + p.radius);
+  std::sort(tops.begin(), tops.end());
+  const std::size_t n_top = tops.size() / 20;
+  double surface = 0;
+  for (std::size_t k = tops.size() - n_top; k < tops.size(); ++k) surface += tops[k] / n_top;
+  const Eigen::Vector3d lo(0.002 + 0.0025, 0, 0.0025), hi(0.02 - 0.0045, 0.0075, surface - 0.0025);
+  double solid = 0;
+  for (const auto& p : filled->particles)
+    solid += gs::sphere_box_volume(p.position, p.radius, lo, hi);
+  EXPECT_NEAR(c.num(0, "void_ratio"), (hi - lo).prod() / solid - 1, 1e-5);
+  EXPECT_NE(r.out.find("e0 = "), std::string::npos) << r.out;
   // The bottom moves down at its speed until it has travelled u = 1 mm.
   double u = 0;
   for (std::size_t i = 1; i < c.rows.size(); ++i) {
