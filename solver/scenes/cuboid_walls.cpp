@@ -4,20 +4,37 @@
 
 namespace gs::solver {
 
+WallSpec box_wall(const std::string& name, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi,
+                  double friction_deg) {
+  WallSpec w;
+  w.name = name;
+  w.shape = WallShape::Box;
+  w.center = 0.5 * (lo + hi);
+  w.half_extents = 0.5 * (hi - lo);
+  w.friction_deg = friction_deg;
+  return w;
+}
+
+WallSpec plane_wall(const std::string& name, const Eigen::Vector3d& point,
+                    const Eigen::Vector3d& normal, double friction_deg) {
+  WallSpec w;
+  w.name = name;
+  w.shape = WallShape::Plane;
+  w.center = point;
+  w.normal = normal;
+  w.friction_deg = friction_deg;
+  return w;
+}
+
 std::vector<WallSpec> cuboid_planes(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi,
                                     double friction_deg) {
   static const char* names[6] = {"x-", "x+", "y-", "y+", "z-", "z+"};
   std::vector<WallSpec> walls;
   for (std::size_t f = 0; f < 6; ++f) {
-    WallSpec w;
-    w.name = names[f];
-    w.shape = WallShape::Plane;
     const int axis = static_cast<int>(f / 2);
-    w.center = 0.5 * (lo + hi);
-    w.center[axis] = (f % 2 == 0) ? lo[axis] : hi[axis];
-    w.normal = cuboid_inward(f);
-    w.friction_deg = friction_deg;
-    walls.push_back(w);
+    Eigen::Vector3d point = 0.5 * (lo + hi);
+    point[axis] = (f % 2 == 0) ? lo[axis] : hi[axis];
+    walls.push_back(plane_wall(names[f], point, cuboid_inward(f), friction_deg));
   }
   return walls;
 }

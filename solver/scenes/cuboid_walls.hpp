@@ -4,6 +4,7 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <string>
 #include <vector>
 
 #include "specimen_preparation.hpp"
@@ -12,6 +13,13 @@ namespace gs::solver {
 
 /// Order of the six planes in the wall list.
 enum CuboidFace : std::size_t { kXmin = 0, kXmax, kYmin, kYmax, kZmin, kZmax };
+
+/// An axis-aligned box wall [lo, hi] and a plane wall through `point` with unit normal `normal`
+/// (into the domain), with a friction angle (deg; negative: the material's).
+WallSpec box_wall(const std::string& name, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi,
+                  double friction_deg);
+WallSpec plane_wall(const std::string& name, const Eigen::Vector3d& point,
+                    const Eigen::Vector3d& normal, double friction_deg);
 
 /// Planes through the faces of [lo, hi], normals pointing inwards, named x-, x+, y-, y+, z-, z+,
 /// with the given wall friction (deg; negative: the material's).

@@ -4,22 +4,9 @@
 #include <cstdio>
 #include <stdexcept>
 
+#include "cuboid_walls.hpp"
+
 namespace gs::solver {
-
-namespace {
-
-WallSpec box(const std::string& name, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi,
-             double friction_deg) {
-  WallSpec w;
-  w.name = name;
-  w.shape = WallShape::Box;
-  w.center = 0.5 * (lo + hi);
-  w.half_extents = 0.5 * (hi - lo);
-  w.friction_deg = friction_deg;
-  return w;
-}
-
-}  // namespace
 
 std::vector<WallSpec> shear_box_walls(const ShearBoxGeometry& g, ShearBoxWalls& index) {
   const double L = g.length_m, W = g.width_m, t = g.wall_thickness_m;
@@ -31,19 +18,20 @@ std::vector<WallSpec> shear_box_walls(const ShearBoxGeometry& g, ShearBoxWalls& 
   // Four sides of a frame between heights a and b; the x sides cover the y sides' ends.
   auto sides = [&](const std::string& prefix, double a, double b, double friction, auto& out) {
     const std::size_t first = w.size();
-    w.push_back(box(prefix + "x-", {-t, -t, a}, {0, W + t, b}, friction));
-    w.push_back(box(prefix + "x+", {L, -t, a}, {L + t, W + t, b}, friction));
-    w.push_back(box(prefix + "y-", {0, -t, a}, {L, 0, b}, friction));
-    w.push_back(box(prefix + "y+", {0, W, a}, {L, W + t, b}, friction));
+    w.push_back(box_wall(prefix + "x-", {-t, -t, a}, {0, W + t, b}, friction));
+    w.push_back(box_wall(prefix + "x+", {L, -t, a}, {L + t, W + t, b}, friction));
+    w.push_back(box_wall(prefix + "y-", {0, -t, a}, {L, 0, b}, friction));
+    w.push_back(box_wall(prefix + "y+", {0, W, a}, {L, W + t, b}, friction));
     for (std::size_t k = 0; k < 4; ++k) out[k + (out.size() - 4)] = first + k;
   };
   index.lower[0] = w.size();
-  w.push_back(box("lower bottom", {-t, -t, -t}, {L + t, W + t, 0}, g.platen_friction_deg));
+  w.push_back(box_wall("lower bottom", {-t, -t, -t}, {L + t, W + t, 0}, g.platen_friction_deg));
   sides("lower ", -t, zl, g.side_friction_deg, index.lower);
   sides("upper ", zu, g.frame_top_m, g.side_friction_deg, index.upper);
   sides("closer ", zl - 0.5 * t, zu + 0.5 * t, g.side_friction_deg, index.closer);
   index.platen = w.size();
-  w.push_back(box("platen", {0, 0, g.platen_z_m}, {L, W, g.platen_z_m + t}, g.platen_friction_deg));
+  w.push_back(
+      box_wall("platen", {0, 0, g.platen_z_m}, {L, W, g.platen_z_m + t}, g.platen_friction_deg));
   return w;
 }
 

@@ -5,6 +5,8 @@
 #include <cstdio>
 #include <stdexcept>
 
+#include "cuboid_walls.hpp"
+#include "errors.hpp"
 #include "mesh_walls.hpp"
 #include "sphere_box_volume.hpp"
 #include "surface_generators.hpp"
@@ -13,36 +15,8 @@ namespace gs::solver {
 
 namespace {
 
-std::string num(double v) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%g", v);
-  return b;
-}
-
 void require(bool ok, const std::string& key, double v, const std::string& what) {
-  if (!ok) throw std::invalid_argument(key + ": " + what + " (" + num(v) + ")");
-}
-
-WallSpec box(const std::string& name, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi,
-             double friction_deg) {
-  WallSpec w;
-  w.name = name;
-  w.shape = WallShape::Box;
-  w.center = 0.5 * (lo + hi);
-  w.half_extents = 0.5 * (hi - lo);
-  w.friction_deg = friction_deg;
-  return w;
-}
-
-WallSpec plane(const std::string& name, const Eigen::Vector3d& point, const Eigen::Vector3d& n,
-               double friction_deg) {
-  WallSpec w;
-  w.name = name;
-  w.shape = WallShape::Plane;
-  w.center = point;
-  w.normal = n;
-  w.friction_deg = friction_deg;
-  return w;
+  if (!ok) throw std::invalid_argument(key + ": " + what + " (" + value_str(v) + ")");
 }
 
 double rad(double deg) {
@@ -86,7 +60,7 @@ std::vector<WallSpec> silo_walls(const SiloSpec& s, double d50_m, double dmax_m,
     const std::size_t first = w.size();
     if (hg == 0) {
       w.push_back(
-          plane(name, {left ? 0.0 : W, 0, 0}, {left ? 1.0 : -1.0, 0, 0}, s.wall_friction_deg));
+          plane_wall(name, {left ? 0.0 : W, 0, 0}, {left ? 1.0 : -1.0, 0, 0}, s.wall_friction_deg));
       w.back().group = name;
     } else {
       SawToothSpec st;
@@ -129,7 +103,7 @@ std::vector<WallSpec> silo_walls(const SiloSpec& s, double d50_m, double dmax_m,
             "must be positive");
     require(s.bottom_travel_m > 0, "silo.bottom_travel_m", s.bottom_travel_m, "must be positive");
     index.bottom.push_back(w.size());
-    w.push_back(box("bottom", lo, hi, bf));
+    w.push_back(box_wall("bottom", lo, hi, bf));
   } else {
     const double b = s.outlet_width_m;
     double x1 = 0, x2 = 0;  // the opening
@@ -148,20 +122,20 @@ std::vector<WallSpec> silo_walls(const SiloSpec& s, double d50_m, double dmax_m,
     require(s.settle_s >= 0, "silo.settle_s", s.settle_s, "must not be negative");
     if (x1 > 0) {
       index.bottom.push_back(w.size());
-      w.push_back(box("bottom_left", lo, {x1, hi.y(), 0}, bf));
+      w.push_back(box_wall("bottom_left", lo, {x1, hi.y(), 0}, bf));
     }
     if (x2 < W) {
       index.bottom.push_back(w.size());
-      w.push_back(box("bottom_right", {x2, lo.y(), lo.z()}, hi, bf));
+      w.push_back(box_wall("bottom_right", {x2, lo.y(), lo.z()}, hi, bf));
     }
     index.outlet = w.size();
-    w.push_back(box("outlet", {x1 > 0 ? x1 : lo.x(), lo.y(), lo.z()},
-                    {x2 < W ? x2 : hi.x(), hi.y(), 0}, bf));
+    w.push_back(box_wall("outlet", {x1 > 0 ? x1 : lo.x(), lo.y(), lo.z()},
+                         {x2 < W ? x2 : hi.x(), hi.y(), 0}, bf));
   }
   index.front = w.size();
-  w.push_back(plane("front", {0, 0, 0}, Eigen::Vector3d::UnitY(), s.front_back_friction_deg));
+  w.push_back(plane_wall("front", {0, 0, 0}, Eigen::Vector3d::UnitY(), s.front_back_friction_deg));
   index.back = w.size();
-  w.push_back(plane("back", {0, D, 0}, -Eigen::Vector3d::UnitY(), s.front_back_friction_deg));
+  w.push_back(plane_wall("back", {0, D, 0}, -Eigen::Vector3d::UnitY(), s.front_back_friction_deg));
   return w;
 }
 

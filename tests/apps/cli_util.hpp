@@ -111,4 +111,28 @@ inline CsvTable read_csv_table(const std::filesystem::path& p) {
   return t;
 }
 
+/// `s` with the first `from` replaced by `to` (a test failure when there is none).
+inline std::string replaced(std::string s, const std::string& from, const std::string& to) {
+  const auto at = s.find(from);
+  if (at == std::string::npos)
+    ADD_FAILURE() << "no " << from;
+  else
+    s.replace(at, from.size(), to);
+  return s;
+}
+
+/// Each scene text of `cases` run by `simulate` in `dir` fails with exit code 2 and one line on
+/// stderr containing the case's message.
+inline void expect_bad_scenes(const std::filesystem::path& dir,
+                              const std::vector<std::pair<std::string, std::string>>& cases) {
+  for (std::size_t i = 0; i < cases.size(); ++i) {
+    const auto p = dir / ("bad" + std::to_string(i) + ".toml");
+    std::ofstream(p) << cases[i].first;
+    const auto r = run_cli("simulate " + p.string() + " -q -o " + (dir / "out").string(), dir);
+    EXPECT_EQ(r.rc, 2) << i;
+    EXPECT_NE(r.err.find(cases[i].second), std::string::npos) << i << ": " << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << i << ": " << r.err;
+  }
+}
+
 }  // namespace gs::test

@@ -16,6 +16,7 @@
 
 namespace {
 
+using gs::test::replaced;
 using gs::test::run_cli;
 using gs::test::slurp;
 
@@ -40,15 +41,6 @@ std::string scene(const std::string& extra_specimen = "", const std::string& ext
          extra +
          "[output]\ntrajectory = \"kb.h5\"\ncurve_every = 50\nhistory_every = 500\n"
          "checkpoint_every = 5000\n";
-}
-
-std::string replaced(std::string s, const std::string& from, const std::string& to) {
-  const auto at = s.find(from);
-  if (at == std::string::npos)
-    ADD_FAILURE() << "no " << from;
-  else
-    s.replace(at, from.size(), to);
-  return s;
 }
 
 }  // namespace
@@ -137,14 +129,7 @@ TEST(PeriodicBiaxial, BadInputsFailWithOneLine) {
       {scene("size_m = [0.01, 0.01, 0.01]\n"), "specimen.size_m: unknown key"},
       {scene("thickness_m = 0.001\n"), "specimen.thickness_m: not thicker than dmax + skin"},
   };
-  for (std::size_t i = 0; i < cases.size(); ++i) {
-    const auto p = dir / ("bad" + std::to_string(i) + ".toml");
-    std::ofstream(p) << cases[i].first;
-    const auto r = run_cli("simulate " + p.string() + " -q -o " + (dir / "out").string(), dir.path);
-    EXPECT_EQ(r.rc, 2) << i;
-    EXPECT_NE(r.err.find(cases[i].second), std::string::npos) << i << ": " << r.err;
-    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << i << ": " << r.err;
-  }
+  gs::test::expect_bad_scenes(dir.path, cases);
 }
 
 // Killed once in the preparation and once in the test, resumed: every output equals the

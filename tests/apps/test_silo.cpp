@@ -17,6 +17,7 @@
 namespace {
 
 using gs::test::read_csv_table;
+using gs::test::replaced;
 using gs::test::run_cli;
 
 // 120 grains of 1.5–2.5 mm in a 20 × 30 × 7.5 mm silo with R_n = 1 teeth (1.9 mm: d50 by mass
@@ -42,15 +43,6 @@ const std::string kQuasi =
 const std::string kGravity =
     "mode = \"gravitational\"\noutlet = \"centre\"\noutlet_width_m = 0.008\nsettle_s = 0.02\n"
     "max_discharge_s = 1.0\nend_fraction = 0.9\nframe_every_s = 0.05\n";
-
-std::string replaced(std::string s, const std::string& from, const std::string& to) {
-  const auto at = s.find(from);
-  if (at == std::string::npos)
-    ADD_FAILURE() << "no " << from;
-  else
-    s.replace(at, from.size(), to);
-  return s;
-}
 
 }  // namespace
 
@@ -143,9 +135,9 @@ TEST(Silo, BadInputsFailWithOneLine) {
   gs::test::ScratchDir dir("silo_bad");
   const std::vector<std::pair<std::string, std::string>> cases = {
       {replaced(scene(kGravity), "outlet_width_m = 0.008", "outlet_width_m = 0.05"),
-       "silo.outlet_width_m: outside the bottom (0.05)"},
+       "silo.outlet_width_m: outside the bottom (0.05"},
       {replaced(scene(kQuasi), "roughness = 1.0", "roughness = 0.0001"),
-       "silo.roughness: gives teeth below 1e-3·d50 (0.0001)"},
+       "silo.roughness: gives teeth below 1e-3·d50 (0.0001"},
       {replaced(scene(kQuasi), "mode = \"quasi_static\"", "mode = \"fast\""),
        "silo.mode: expected \"quasi_static\" or \"gravitational\" (fast)"},
       {scene(kGravity + "bottom_travel_m = 0.01\n"),
@@ -162,14 +154,7 @@ TEST(Silo, BadInputsFailWithOneLine) {
              "normal = [0.0, 0.0, 1.0]\n"),
        "[[walls]]: a laboratory test builds its own walls"},
   };
-  for (std::size_t i = 0; i < cases.size(); ++i) {
-    const auto p = dir / ("bad" + std::to_string(i) + ".toml");
-    std::ofstream(p) << cases[i].first;
-    const auto r = run_cli("simulate " + p.string() + " -q -o " + (dir / "out").string(), dir.path);
-    EXPECT_EQ(r.rc, 2) << i;
-    EXPECT_NE(r.err.find(cases[i].second), std::string::npos) << i << ": " << r.err;
-    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << i << ": " << r.err;
-  }
+  gs::test::expect_bad_scenes(dir.path, cases);
 }
 
 // Killed once while filling and once while the outlet discharges, resumed: every output equals
