@@ -165,7 +165,6 @@ TEST(Silo, ResumeIsBitForBitWhileFillingAndDischarging) {
   std::ofstream(dir / "silo.toml") << scene(kGravity);
   const std::string sc = (dir / "silo.toml").string();
   ASSERT_EQ(run_cli("simulate " + sc + " -q -o " + (dir / "straight").string(), dir.path).rc, 0);
-  const auto straight = read_csv_table(dir / "straight" / "curve.csv");
   for (const long kill_after : {45000L, 100000L}) {  // (the filling ends near 71 000)
     const auto killed = dir / ("killed" + std::to_string(kill_after));
     ASSERT_TRUE(gs::test::run_and_kill(sc, killed, kill_after))
