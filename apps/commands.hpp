@@ -30,6 +30,9 @@ void register_analyze_rev(CLI::App& app);
 /// `granoscope analyze fabric | rose | chains | walls` (apps/cmd_contacts.cpp).
 void register_analyze_contacts(CLI::App& app);
 
+/// `granoscope analyze silo` (apps/cmd_silo.cpp).
+void register_analyze_silo(CLI::App& app);
+
 /// `granoscope analyze hhd` and `granoscope analyze vortices` (apps/cmd_hhd.cpp).
 void register_analyze_hhd(CLI::App& app);
 

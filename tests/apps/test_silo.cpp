@@ -100,6 +100,25 @@ TEST(Silo, QuasiStaticBottomMovesAndTheForcesBalanceTheWeight) {
   int after = 0;
   for (const auto& f : t.frames) after += f.time > c.num(0, "time_s") + 1e-12;
   EXPECT_EQ(after, 4);
+  // `analyze silo` on the frames gives the curve's forces again (the last frame and the last
+  // row are the final step), and refuses a frame index it does not have.
+  const auto rep =
+      run_cli("analyze silo " + (dir / "out" / "trajectory.h5").string() + " -o " +
+                  (dir / "silo_report.h5").string() + " --csv " + (dir / "series.csv").string(),
+              dir.path);
+  ASSERT_EQ(rep.rc, 0) << rep.err;
+  const auto s = read_csv_table(dir / "series.csv");
+  const std::size_t m = s.rows.size() - 1, e = c.rows.size() - 1;
+  // (the report's CSV has 12 significant digits)
+  EXPECT_NEAR(s.num(m, "time_s"), c.num(e, "time_s"), 1e-11);
+  for (const char* col : {"G_N", "P_N", "T_left_N", "T_right_N", "N_left_N", "N_right_N"})
+    EXPECT_NEAR(s.num(m, col), c.num(e, col), 1e-10 * c.num(e, "G_N")) << col;
+  EXPECT_NE(rep.out.find("residual"), std::string::npos);
+  const auto bad = run_cli("analyze silo " + (dir / "out" / "trajectory.h5").string() + " -o " +
+                               (dir / "x.h5").string() + " --from 999",
+                           dir.path);
+  EXPECT_EQ(bad.rc, 2);
+  EXPECT_NE(bad.err.find("--from: no such frame"), std::string::npos) << bad.err;
   // The wall forces are in the history too, per side wall (the meshes' groups).
   const auto h = read_csv_table(dir / "out" / "history.csv");
   for (const char* col : {"left_fz_N", "right_fx_N", "bottom_fz_N"}) (void)h.num(0, col);

@@ -1,0 +1,56 @@
+// The silo report of seed 004 §5.3 from a snapshot of a silo (granoscope's `scene.test = "silo"`
+// or any run with two side walls across a horizontal axis and a bottom): the resultant wall
+// forces of §5.3.1 and the wall stress profiles σ11 (horizontal normal) and σ21 (vertical shear)
+// against the height (Figs 5.8–5.11, 5.55–5.61).
+//  * Walls are told apart by their orientation, so that saw-tooth walls (one wall per tooth face
+//    in the snapshot) count: a side wall is a plane or facet wall whose normal b (into the
+//    material) has |b·up| < 0.99 and |b·across| ≥ 0.1 — the left wall when b·across > 0, the
+//    right one otherwise (the front and back planes, normal ⟂ across, are neither); the bottom is
+//    every box wall and every plane or facet wall with b·up ≥ 0.99.
+//  * P = −Σ F·up over the bottom (F the force of the material on a wall, normal and tangential
+//    parts), T = −Σ F·up over a side wall (positive: the material drags it down), N = −Σ F·b̂
+//    with b̂ = ±across the side's inward horizontal (positive: pushed outwards), φ_w = atan(T/N),
+//    G the weight of the particles whose centre is above the bottom's top (boxes: the highest top
+//    face; planes: their point), and the balance (P + T_left + T_right)/G (= 1 at rest).
+//  * Profiles: the particle–wall contacts of each side, binned by the height of their contact
+//    point (bins of `bin` m from the bottom's top up), σ11 = Σ(−F·b̂)/(bin·depth),
+//    σ21 = Σ(−F·up)/(bin·depth), depth the extent of the particles along up × across (their
+//    centres ± radii) unless given.
+#pragma once
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "snapshot.hpp"
+
+namespace gs::analysis {
+
+struct SiloReportOptions {
+  Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
+  Eigen::Vector3d across = Eigen::Vector3d::UnitX();  // from the left wall to the right one
+  double bin = 0;                                     // m, > 0
+  double depth = 0;                                   // m; 0: the particles' extent
+  double gravity = 9.81;
+};
+
+struct SiloProfile {
+  std::vector<double> height;  // bin centres above the bottom, m
+  std::vector<double> sigma11_left, sigma21_left, sigma11_right, sigma21_right;  // Pa
+  std::vector<double> contacts_left, contacts_right;
+};
+
+struct SiloFrameReport {
+  double time = 0;
+  double G = 0, P = 0, T_left = 0, T_right = 0, N_left = 0, N_right = 0;  // N
+  double phi_left_deg = 0, phi_right_deg = 0, balance = 0;
+  std::size_t side_walls_left = 0, side_walls_right = 0, bottom_walls = 0;
+  double bottom_level = 0;  // m along up
+  SiloProfile profile;
+};
+
+/// Throws std::invalid_argument when the frame has no left or right side wall or no bottom,
+/// for a bad bin, depth or direction (up and across not orthogonal unit-able vectors), or when
+/// its walls carry forces but the frame holds no particle–wall contact for the profiles.
+SiloFrameReport silo_report(const Frame& frame, const SiloReportOptions& options);
+
+}  // namespace gs::analysis

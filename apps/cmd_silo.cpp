@@ -1,0 +1,184 @@
+// `granoscope analyze silo RUN.h5`: the silo report of seed 004 §5.3 over the frames of a run
+// (analysis/silo_report.hpp): P/G, T/G, N/G per side wall, the balance (P + 2T)/G and φ_w per
+// frame, and the wall stress profiles σ11, σ21 against the height at the initial, maximum
+// (largest N) and residual (last) states.
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <iostream>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "analyze_common.hpp"
+#include "commands.hpp"
+#include "errors.hpp"
+#include "field_output.hpp"
+#include "grain_size.hpp"
+#include "silo_report.hpp"
+#include "trajectory_io.hpp"
+
+namespace gs::cli {
+namespace {
+
+namespace ga = gs::analysis;
+
+struct SiloArgs {
+  std::string input, output, csv, profiles_csv;
+  std::vector<double> up{0.0, 0.0, 1.0}, across{1.0, 0.0, 0.0};
+  std::optional<double> bin, bin_d50, depth, d50;
+  long from = 0;
+  double gravity = 9.81;
+};
+
+Eigen::Vector3d vec(const std::vector<double>& v) {
+  return {v[0], v[1], v[2]};
+}
+
+void run_silo(const SiloArgs& a) {
+  const Trajectory t = read_snapshots(a.input);
+  if (t.frames.empty()) throw InputError(a.input, "no frames");
+  const long n = static_cast<long>(t.frames.size());
+  if (a.from < 0 || a.from >= n)
+    throw InputError(a.input, "--from: no such frame (" + std::to_string(n) + " frames)",
+                     std::to_string(a.from));
+  const Frame& last = t.frames.back();
+  if (last.particles.empty()) throw InputError(a.input, "the last frame has no particles");
+  const double d50 = a.d50 ? *a.d50 : ga::d50(last);
+  if (a.d50) require_positive(a.input, "--d50", *a.d50);
+  ga::SiloReportOptions o;
+  o.up = vec(a.up);
+  o.across = vec(a.across);
+  o.bin = length_option(a.input, "--bin", a.bin, a.bin_d50, 5.0, d50);
+  if (a.depth) require_positive(a.input, "--depth", *a.depth);
+  o.depth = a.depth.value_or(0.0);
+  require_positive(a.input, "--gravity", a.gravity);
+  o.gravity = a.gravity;
+  std::vector<ga::SiloFrameReport> reports;
+  for (long i = a.from; i < n; ++i) {
+    try {
+      reports.push_back(ga::silo_report(t.frames[static_cast<std::size_t>(i)], o));
+    } catch (const std::invalid_argument& e) {
+      throw InputError(a.input, "frame " + std::to_string(i) + ": " + e.what());
+    }
+  }
+  // The states of seed 004 §5.3.1: initial (the first frame reported), maximum (the largest
+  // N_left + N_right), residual (the last).
+  std::size_t k_max = 0;
+  for (std::size_t k = 0; k < reports.size(); ++k)
+    if (reports[k].N_left + reports[k].N_right > reports[k_max].N_left + reports[k_max].N_right)
+      k_max = k;
+  const std::vector<std::pair<const char*, std::size_t>> states = {
+      {"initial", 0}, {"maximum", k_max}, {"residual", reports.size() - 1}};
+  std::vector<std::pair<const char*, std::vector<double>>> series = {{"frame", {}},
+                                                                     {"time_s", {}},
+                                                                     {"G_N", {}},
+                                                                     {"P_N", {}},
+                                                                     {"T_left_N", {}},
+                                                                     {"T_right_N", {}},
+                                                                     {"N_left_N", {}},
+                                                                     {"N_right_N", {}},
+                                                                     {"P_G", {}},
+                                                                     {"T_left_G", {}},
+                                                                     {"T_right_G", {}},
+                                                                     {"N_left_G", {}},
+                                                                     {"N_right_G", {}},
+                                                                     {"balance_G", {}},
+                                                                     {"phi_w_left_deg", {}},
+                                                                     {"phi_w_right_deg", {}}};
+  for (std::size_t k = 0; k < reports.size(); ++k) {
+    const auto& r = reports[k];
+    const double v[] = {static_cast<double>(a.from) + static_cast<double>(k),
+                        r.time,
+                        r.G,
+                        r.P,
+                        r.T_left,
+                        r.T_right,
+                        r.N_left,
+                        r.N_right,
+                        r.P / r.G,
+                        r.T_left / r.G,
+                        r.T_right / r.G,
+                        r.N_left / r.G,
+                        r.N_right / r.G,
+                        r.balance,
+                        r.phi_left_deg,
+                        r.phi_right_deg};
+    for (std::size_t c = 0; c < series.size(); ++c) series[c].second.push_back(v[c]);
+  }
+  H5FieldFile h(a.output, "granoscope-silo");
+  h.attr("source", a.input);
+  h.attr("d50", d50);
+  h.attr("bin", o.bin);
+  h.group("/series");
+  for (const auto& [name, v] : series) h.write(std::string("/series/") + name, v);
+  h.group("/profiles");
+  std::vector<double> st, ph, s11l, s21l, s11r, s21r;
+  for (std::size_t i = 0; i < states.size(); ++i) {
+    const auto& [name, k] = states[i];
+    const auto& r = reports[k];
+    const std::string g = std::string("/profiles/") + name;
+    h.group(g);
+    h.attr("frame", static_cast<long long>(a.from + static_cast<long>(k)), g);
+    h.attr("time_s", r.time, g);
+    h.write(g + "/height_m", r.profile.height);
+    h.write(g + "/sigma11_left_Pa", r.profile.sigma11_left);
+    h.write(g + "/sigma21_left_Pa", r.profile.sigma21_left);
+    h.write(g + "/sigma11_right_Pa", r.profile.sigma11_right);
+    h.write(g + "/sigma21_right_Pa", r.profile.sigma21_right);
+    for (std::size_t b = 0; b < r.profile.height.size(); ++b) {
+      st.push_back(static_cast<double>(i));
+      ph.push_back(r.profile.height[b]);
+      s11l.push_back(r.profile.sigma11_left[b]);
+      s21l.push_back(r.profile.sigma21_left[b]);
+      s11r.push_back(r.profile.sigma11_right[b]);
+      s21r.push_back(r.profile.sigma21_right[b]);
+    }
+    std::printf(
+        "%-8s frame %ld (t = %.4g s): P/G %.3f, T/G %.3f / %.3f, N/G %.3f / %.3f (left / right), "
+        "phi_w %.1f / %.1f deg, (P + T_left + T_right)/G %.3f\n",
+        name, a.from + static_cast<long>(k), r.time, r.P / r.G, r.T_left / r.G, r.T_right / r.G,
+        r.N_left / r.G, r.N_right / r.G, r.phi_left_deg, r.phi_right_deg, r.balance);
+  }
+  h.commit();
+  if (!a.csv.empty()) {
+    std::vector<VtkArray> cols;
+    for (const auto& [name, v] : series) cols.push_back({name, 1, v});
+    write_csv_table(a.csv, cols);
+  }
+  if (!a.profiles_csv.empty())
+    write_csv_table(a.profiles_csv, {{"state", 1, st},
+                                     {"height_m", 1, ph},
+                                     {"sigma11_left_Pa", 1, s11l},
+                                     {"sigma21_left_Pa", 1, s21l},
+                                     {"sigma11_right_Pa", 1, s11r},
+                                     {"sigma21_right_Pa", 1, s21r}});
+}
+
+}  // namespace
+
+void register_analyze_silo(CLI::App& app) {
+  auto& analyze = analyze_command(app);
+  auto a = std::make_shared<SiloArgs>();
+  auto* s = analyze.add_subcommand(
+      "silo",
+      "Silo report (seed 004 §5.3): P/G, T/G, N/G and phi_w per side wall over the frames, and "
+      "the wall stress profiles sigma11, sigma21 at the initial, maximum and residual states");
+  s->add_option("input", a->input, "trajectory of a silo run (HDF5 or any snapshot format)")
+      ->required();
+  s->add_option("-o,--output", a->output, "output HDF5 (format granoscope-silo)")->required();
+  s->add_option("--csv", a->csv, "also write the series as CSV");
+  s->add_option("--profiles-csv", a->profiles_csv,
+                "also write the profiles as CSV (state 0 initial, 1 maximum, 2 residual)");
+  s->add_option("--from", a->from, "first frame (the initial state; default 0)");
+  s->add_option("--up", a->up, "vertical direction x y z (default 0 0 1)")->expected(3);
+  s->add_option("--across", a->across, "from the left wall to the right (default 1 0 0)")
+      ->expected(3);
+  s->add_option("--bin", a->bin, "profile bin along the height in m");
+  s->add_option("--bin-d50", a->bin_d50, "profile bin in d50 (default 5)");
+  s->add_option("--depth", a->depth, "silo depth in m (default: extent of the particles)");
+  s->add_option("--d50", a->d50, "d50 in m (default: from the last frame)");
+  s->add_option("--gravity", a->gravity, "m/s^2 for the weight G (default 9.81)");
+  s->callback([a] { run_silo(*a); });
+}
+
+}  // namespace gs::cli
