@@ -65,12 +65,11 @@ std::vector<std::unique_ptr<LoadingProgramme>> scene_programmes(Scene& s) {
     SiloWalls idx;
     try {
       s.walls = silo_walls(s.silo, d50, f.sizes.dmax_m, idx);
-      if (s.silo.mode == "gravitational") {
-        // What falls through the outlet is removed two grains below the bottom.
-        const double big = 10 * (s.silo.width_m + s.silo.height_m + s.silo.depth_m);
-        s.outlet = std::make_pair(Eigen::Vector3d(-big, -big, -2 * f.sizes.dmax_m),
-                                  Eigen::Vector3d(big, big, big));
-      }
+      // What falls through the outlet (or, while filling, bounces over a wall) is removed two
+      // grains below the side walls' lower end.
+      const double big = 10 * (s.silo.width_m + s.silo.height_m + s.silo.depth_m);
+      s.outlet = std::make_pair(Eigen::Vector3d(-big, -big, idx.floor_z_m - 2 * f.sizes.dmax_m),
+                                Eigen::Vector3d(big, big, big));
       out.push_back(
           std::make_unique<LayeredFilling>(f, s.fill_first, s.fill_layers, s.output.every));
       out.push_back(std::make_unique<SiloFlow>(s.silo, idx));
