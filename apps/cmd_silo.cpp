@@ -3,6 +3,7 @@
 // frame, and the wall stress profiles σ11, σ21 against the height at the initial, maximum
 // (largest N) and residual (last) states.
 #include <CLI/CLI.hpp>
+#include <cmath>
 #include <cstdio>
 #include <iostream>
 #include <optional>
@@ -27,6 +28,7 @@ struct SiloArgs {
   std::vector<double> up{0.0, 0.0, 1.0}, across{1.0, 0.0, 0.0};
   std::optional<double> bin, bin_d50, depth, d50;
   long from = 0;
+  std::optional<double> from_time;
   double gravity = 9.81;
 };
 
@@ -41,6 +43,13 @@ void run_silo(const SiloArgs& a) {
   if (a.from < 0 || a.from >= n)
     throw InputError(a.input, "--from: no such frame (" + std::to_string(n) + " frames)",
                      std::to_string(a.from));
+  long from = a.from;
+  if (a.from_time) {  // the first frame at or after that time
+    from = 0;
+    while (from < n && t.frames[static_cast<std::size_t>(from)].time < *a.from_time - 1e-12) ++from;
+    if (from == n || !std::isfinite(*a.from_time))
+      throw InputError(a.input, "--from-time: after the last frame", value_str(*a.from_time));
+  }
   const Frame& last = t.frames.back();
   if (last.particles.empty()) throw InputError(a.input, "the last frame has no particles");
   const double d50 = a.d50 ? *a.d50 : ga::d50(last);
@@ -54,7 +63,7 @@ void run_silo(const SiloArgs& a) {
   require_positive(a.input, "--gravity", a.gravity);
   o.gravity = a.gravity;
   std::vector<ga::SiloFrameReport> reports;
-  for (long i = a.from; i < n; ++i) {
+  for (long i = from; i < n; ++i) {
     try {
       reports.push_back(ga::silo_report(t.frames[static_cast<std::size_t>(i)], o));
     } catch (const std::invalid_argument& e) {
@@ -87,7 +96,7 @@ void run_silo(const SiloArgs& a) {
                                                                      {"phi_w_right_deg", {}}};
   for (std::size_t k = 0; k < reports.size(); ++k) {
     const auto& r = reports[k];
-    const double v[] = {static_cast<double>(a.from) + static_cast<double>(k),
+    const double v[] = {static_cast<double>(from) + static_cast<double>(k),
                         r.time,
                         r.G,
                         r.P,
@@ -118,7 +127,7 @@ void run_silo(const SiloArgs& a) {
     const auto& r = reports[k];
     const std::string g = std::string("/profiles/") + name;
     h.group(g);
-    h.attr("frame", static_cast<long long>(a.from + static_cast<long>(k)), g);
+    h.attr("frame", static_cast<long long>(from + static_cast<long>(k)), g);
     h.attr("time_s", r.time, g);
     h.write(g + "/height_m", r.profile.height);
     h.write(g + "/sigma11_left_Pa", r.profile.sigma11_left);
@@ -136,7 +145,7 @@ void run_silo(const SiloArgs& a) {
     std::printf(
         "%-8s frame %ld (t = %.4g s): P/G %.3f, T/G %.3f / %.3f, N/G %.3f / %.3f (left / right), "
         "phi_w %.1f / %.1f deg, (P + T_left + T_right)/G %.3f\n",
-        name, a.from + static_cast<long>(k), r.time, r.P / r.G, r.T_left / r.G, r.T_right / r.G,
+        name, from + static_cast<long>(k), r.time, r.P / r.G, r.T_left / r.G, r.T_right / r.G,
         r.N_left / r.G, r.N_right / r.G, r.phi_left_deg, r.phi_right_deg, r.balance);
   }
   h.commit();
@@ -170,6 +179,9 @@ void register_analyze_silo(CLI::App& app) {
   s->add_option("--profiles-csv", a->profiles_csv,
                 "also write the profiles as CSV (state 0 initial, 1 maximum, 2 residual)");
   s->add_option("--from", a->from, "first frame (the initial state; default 0)");
+  s->add_option("--from-time", a->from_time,
+                "first frame at or after this time in s (a silo run: curve.csv's first time_s, "
+                "the end of the filling)");
   s->add_option("--up", a->up, "vertical direction x y z (default 0 0 1)")->expected(3);
   s->add_option("--across", a->across, "from the left wall to the right (default 1 0 0)")
       ->expected(3);
