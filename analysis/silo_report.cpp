@@ -7,6 +7,69 @@
 
 namespace gs::analysis {
 
+namespace {
+
+/// The distance (m, from index `from` towards `step` = ±1) at which the second difference of
+/// `v` first changes sign, interpolated linearly; NaN when it does not.
+double inflection(const std::vector<double>& v, int from, int step, double bin) {
+  auto d2 = [&](int i) { return v[i - 1] - 2 * v[i] + v[i + 1]; };
+  const int n = static_cast<int>(v.size());
+  int i = std::clamp(from, 1, n - 2);
+  for (; i + step >= 1 && i + step <= n - 2; i += step) {
+    const double a = d2(i), b = d2(i + step);
+    if ((a < 0 && b >= 0) || (a > 0 && b <= 0)) {
+      const double t = a / (a - b);
+      return (i + step * t) * bin;
+    }
+  }
+  return NAN;
+}
+
+void wall_zones(const Frame& f, const SiloReportOptions& o, const Eigen::Vector3d& up,
+                const Eigen::Vector3d& across, double bottom, double top,
+                const std::unordered_map<std::int64_t, int>& role, SiloFrameReport& r) {
+  if (!(o.zone_band > 0)) throw std::invalid_argument("zone band must be positive");
+  // The walls' base planes across: the extreme wall points of each side.
+  double x0 = HUGE_VAL, x1 = -HUGE_VAL;
+  for (const Wall& w : f.walls) {
+    const auto it = role.find(w.id);
+    if (it == role.end()) continue;
+    if (it->second == 1) x0 = std::min(x0, w.a.dot(across));
+    if (it->second == 2) x1 = std::max(x1, w.a.dot(across));
+  }
+  if (!(x1 > x0)) return;
+  r.zone_height = o.zone_height > 0 ? o.zone_height : 0.5 * (top - bottom);
+  const double z = bottom + r.zone_height;
+  const Eigen::Vector3d depth_axis = up.cross(across);
+  const int n = std::max(3, static_cast<int>(std::ceil((x1 - x0) / o.zone_bin)));
+  std::vector<double> sum(n, 0.0), count(n, 0.0);
+  for (const Particle& p : f.particles) {
+    if (std::abs(p.position.dot(up) - z) > 0.5 * o.zone_band) continue;
+    const double x = p.position.dot(across) - x0;
+    if (x < 0 || x >= n * o.zone_bin) continue;
+    const int b = static_cast<int>(x / o.zone_bin);
+    sum[b] += std::abs(p.rotation.dot(depth_axis));
+    count[b] += 1;
+  }
+  std::vector<double> mean(n, 0.0);
+  for (int b = 0; b < n; ++b) mean[b] = count[b] > 0 ? sum[b] / count[b] : 0.0;
+  std::vector<double> s(n);
+  for (int b = 0; b < n; ++b)
+    s[b] = (mean[std::max(0, b - 1)] + 2 * mean[b] + mean[std::min(n - 1, b + 1)]) / 4;
+  r.zone_across.resize(n);
+  for (int b = 0; b < n; ++b) r.zone_across[b] = x0 + (b + 0.5) * o.zone_bin;
+  r.zone_rotation = s;
+  const int half = n / 2;
+  const int pl = static_cast<int>(std::max_element(s.begin(), s.begin() + half) - s.begin());
+  const int pr = static_cast<int>(std::max_element(s.begin() + (n - half), s.end()) - s.begin());
+  // (bin centres are at (b + 1/2)·bin from the base plane)
+  r.zone_left = inflection(s, pl, +1, o.zone_bin) + 0.5 * o.zone_bin;
+  const double right = inflection(s, pr, -1, o.zone_bin);
+  r.zone_right = std::isnan(right) ? NAN : (x1 - x0) - (right + 0.5 * o.zone_bin);
+}
+
+}  // namespace
+
 SiloFrameReport silo_report(const Frame& f, const SiloReportOptions& o) {
   if (!(o.bin > 0) || !std::isfinite(o.bin)) throw std::invalid_argument("bin must be positive");
   if (!(o.depth >= 0) || !std::isfinite(o.depth))
@@ -110,6 +173,7 @@ SiloFrameReport silo_report(const Frame& f, const SiloReportOptions& o) {
       pr.contacts_right[b] += 1;
     }
   }
+  if (o.zone_bin > 0) wall_zones(f, o, up, across, bottom, top, role, r);
   const bool loaded = std::abs(r.T_left) + std::abs(r.N_left) + std::abs(r.T_right) +
                           std::abs(r.N_right) + std::abs(r.P) >
                       0;

@@ -16,9 +16,18 @@
 //    point (bins of `bin` m from the bottom's top up), σ11 = Σ(−F·b̂)/(bin·depth),
 //    σ21 = Σ(−F·up)/(bin·depth), depth the extent of the particles along up × across (their
 //    centres ± radii) unless given.
+//  * Wall shear zones at a height (§5.3.1, Table 5.4; the procedure of §4.2.3): the particles'
+//    rotation about the depth axis (cumulative, from the snapshot) averaged in bins across the
+//    silo (`zone_bin` wide) within a horizontal band (`zone_band` thick) centred at `zone_height`
+//    above the bottom (default: half the height of the fill), smoothed by [1 2 1]/4; from the
+//    largest mean |rotation| in the half next to a wall, the first sign change of the second
+//    difference towards the middle (linear interpolation) is the zone's inner boundary, and its
+//    distance from the wall's base plane (the extreme wall point across) the zone's thickness
+//    (NaN when the profile has no such point).
 #pragma once
 
 #include <Eigen/Core>
+#include <cmath>
 #include <vector>
 
 #include "snapshot.hpp"
@@ -31,6 +40,9 @@ struct SiloReportOptions {
   double bin = 0;                                     // m, > 0
   double depth = 0;                                   // m; 0: the particles' extent
   double gravity = 9.81;
+  double zone_bin = 0;     // m; 0: no shear-zone profile
+  double zone_band = 0;    // m, > 0 with zone_bin
+  double zone_height = 0;  // m above the bottom; 0: half the fill's height
 };
 
 struct SiloProfile {
@@ -46,6 +58,10 @@ struct SiloFrameReport {
   std::size_t side_walls_left = 0, side_walls_right = 0, bottom_walls = 0;
   double bottom_level = 0;  // m along up
   SiloProfile profile;
+  // Shear zones (with zone_bin > 0): the rotation profile across, and each wall zone's thickness.
+  double zone_height = 0;                          // m above the bottom
+  std::vector<double> zone_across, zone_rotation;  // bin centres (m along across), mean |rot|
+  double zone_left = NAN, zone_right = NAN;        // m
 };
 
 /// Throws std::invalid_argument when the frame has no left or right side wall or no bottom,

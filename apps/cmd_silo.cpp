@@ -26,7 +26,8 @@ namespace ga = gs::analysis;
 struct SiloArgs {
   std::string input, output, csv, profiles_csv;
   std::vector<double> up{0.0, 0.0, 1.0}, across{1.0, 0.0, 0.0};
-  std::optional<double> bin, bin_d50, depth, d50;
+  std::optional<double> bin, bin_d50, depth, d50, zone_height;
+  double zone_bin_d50 = 1.0, zone_band_d50 = 5.0;
   long from = 0;
   std::optional<double> from_time;
   double gravity = 9.81;
@@ -62,6 +63,12 @@ void run_silo(const SiloArgs& a) {
   o.depth = a.depth.value_or(0.0);
   require_positive(a.input, "--gravity", a.gravity);
   o.gravity = a.gravity;
+  require_positive(a.input, "--zone-bin-d50", a.zone_bin_d50);
+  require_positive(a.input, "--zone-band-d50", a.zone_band_d50);
+  o.zone_bin = a.zone_bin_d50 * d50;
+  o.zone_band = a.zone_band_d50 * d50;
+  if (a.zone_height) require_positive(a.input, "--zone-height", *a.zone_height);
+  o.zone_height = a.zone_height.value_or(0.0);
   std::vector<ga::SiloFrameReport> reports;
   for (long i = from; i < n; ++i) {
     try {
@@ -134,6 +141,11 @@ void run_silo(const SiloArgs& a) {
     h.write(g + "/sigma21_left_Pa", r.profile.sigma21_left);
     h.write(g + "/sigma11_right_Pa", r.profile.sigma11_right);
     h.write(g + "/sigma21_right_Pa", r.profile.sigma21_right);
+    h.attr("zone_height_m", r.zone_height, g);
+    h.attr("zone_left_m", r.zone_left, g);
+    h.attr("zone_right_m", r.zone_right, g);
+    h.write(g + "/zone_across_m", r.zone_across);
+    h.write(g + "/zone_rotation_rad", r.zone_rotation);
     for (std::size_t b = 0; b < r.profile.height.size(); ++b) {
       st.push_back(static_cast<double>(i));
       ph.push_back(r.profile.height[b]);
@@ -144,9 +156,11 @@ void run_silo(const SiloArgs& a) {
     }
     std::printf(
         "%-8s frame %ld (t = %.4g s): P/G %.3f, T/G %.3f / %.3f, N/G %.3f / %.3f (left / right), "
-        "phi_w %.1f / %.1f deg, (P + T_left + T_right)/G %.3f\n",
+        "phi_w %.1f / %.1f deg, (P + T_left + T_right)/G %.3f; wall zones %.1f / %.1f d50 at "
+        "%.3g m\n",
         name, from + static_cast<long>(k), r.time, r.P / r.G, r.T_left / r.G, r.T_right / r.G,
-        r.N_left / r.G, r.N_right / r.G, r.phi_left_deg, r.phi_right_deg, r.balance);
+        r.N_left / r.G, r.N_right / r.G, r.phi_left_deg, r.phi_right_deg, r.balance,
+        r.zone_left / d50, r.zone_right / d50, r.zone_height);
   }
   h.commit();
   if (!a.csv.empty()) {
@@ -190,6 +204,11 @@ void register_analyze_silo(CLI::App& app) {
   s->add_option("--depth", a->depth, "silo depth in m (default: extent of the particles)");
   s->add_option("--d50", a->d50, "d50 in m (default: from the last frame)");
   s->add_option("--gravity", a->gravity, "m/s^2 for the weight G (default 9.81)");
+  s->add_option("--zone-height", a->zone_height,
+                "height of the wall shear zones above the bottom in m (default: half the fill)");
+  s->add_option("--zone-band-d50", a->zone_band_d50,
+                "thickness of the band the rotation profile is taken in, d50 (default 5)");
+  s->add_option("--zone-bin-d50", a->zone_bin_d50, "bins across the silo, d50 (default 1)");
   s->callback([a] { run_silo(*a); });
 }
 

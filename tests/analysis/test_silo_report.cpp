@@ -115,3 +115,41 @@ TEST(SiloReport, RefusesWhatIsNoSilo) {
   o.across = Eigen::Vector3d(1, 0, 1);
   EXPECT_THROW(analysis::silo_report(silo(), o), std::invalid_argument);
 }
+
+// The wall zones: rotations across a 20 mm silo falling off from each wall as a logistic
+// 1/(1 + exp((x − 5 mm)/1 mm)) (and its mirror from the right wall), one particle per 1 mm bin at
+// mid-height: the inflection point, hence each zone's thickness, is at 5 mm (a logistic is
+// point-symmetric about it, and so is its smoothing).
+TEST(SiloReport, WallZoneThicknessAtTheInflectionOfTheRotationProfile) {
+  Frame f;
+  f.walls = {wall(100, WallKind::Plane, {0, 0, 0}, {1, 0, 0}, {0, 0, 0}),
+             wall(101, WallKind::Plane, {0.02, 0, 0}, {-1, 0, 0}, {0, 0, 0}),
+             wall(102, WallKind::Plane, {0, 0, 0}, {0, 0, 1}, {0, 0, 0})};
+  auto logistic = [](double x) { return 1 / (1 + std::exp((x - 0.005) / 0.001)); };
+  for (int b = 0; b < 20; ++b) {
+    Particle p;
+    p.id = b;
+    p.radius = 4e-4;
+    p.mass = 1e-6;
+    const double x = (b + 0.5) * 1e-3;
+    p.position = Eigen::Vector3d(x, 0.002, 0.01);
+    // (the sign of the rotation does not matter: the profile is of |rotation about y|)
+    p.rotation = Eigen::Vector3d(0.3, (b % 2 ? -1 : 1) * (logistic(x) + logistic(0.02 - x)), 0);
+    f.particles.push_back(p);
+  }
+  analysis::SiloReportOptions o;
+  o.bin = 0.005;
+  o.zone_bin = 0.001;
+  o.zone_band = 0.002;
+  o.zone_height = 0.01;
+  const auto r = analysis::silo_report(f, o);
+  ASSERT_EQ(r.zone_across.size(), 20u);
+  // (the other wall's tail, e^-10 of the peak at 5 mm, breaks the symmetry by 1e-3 of a bin)
+  EXPECT_NEAR(r.zone_left, 0.005, 2e-6);
+  EXPECT_NEAR(r.zone_right, 0.005, 2e-6);
+  EXPECT_EQ(r.zone_left, r.zone_right);  // (the two walls' profiles mirror each other)
+  // Out of the band: no particle, a flat profile, no zone.
+  o.zone_height = 0.02;
+  const auto none = analysis::silo_report(f, o);
+  EXPECT_TRUE(std::isnan(none.zone_left));
+}
