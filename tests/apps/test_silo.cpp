@@ -174,6 +174,24 @@ TEST(Silo, BadInputsFailWithOneLine) {
        "[[walls]]: a laboratory test builds its own walls"},
   };
   gs::test::expect_bad_scenes(dir.path, cases);
+  // A report on a run that has no silo walls: one line naming the frame.
+  std::ofstream(dir / "free.csv") << "id,x,y,z,r\n0,0,0,0,0.001\n1,0.01,0,0,0.001\n";
+  std::ofstream(dir / "free.toml")
+      << "[scene]\nname = \"free\"\npacking = \"free.csv\"\n[material]\nyoung_Pa = 1e7\n"
+         "stiffness_ratio = 0.3\nfriction_deg = 25.0\ndensity_kg_m3 = 2600.0\n"
+         "[solver]\ndt_s = 1e-6\nsteps = 10\n[output]\nevery = 5\n";
+  ASSERT_EQ(
+      run_cli("simulate " + (dir / "free.toml").string() + " -q -o " + (dir / "free").string(),
+              dir.path)
+          .rc,
+      0);
+  const auto r = run_cli("analyze silo " + (dir / "free" / "trajectory.h5").string() + " -o " +
+                             (dir / "x.h5").string(),
+                         dir.path);
+  EXPECT_EQ(r.rc, 2);
+  EXPECT_NE(r.err.find("frame 0: no left and right side walls"), std::string::npos) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(dir / "x.h5"));
 }
 
 // Killed once while filling and once while the outlet discharges, resumed: every output equals
