@@ -292,8 +292,8 @@ TEST(LabScenes, BadScenesExitTwoWithOneLine) {
         "preparation.pressure_Pa: negative (-1)"}},
       {"unknown test",
        {"test = \"triaxial\"", "test = \"oedometer\"",
-        "scene.test: expected \"triaxial\", \"plane_strain\", \"direct_shear\" or "
-        "\"biaxial_periodic\" (oedometer)"}},
+        "scene.test: expected \"triaxial\", \"plane_strain\", \"direct_shear\", "
+        "\"biaxial_periodic\" or \"silo\" (oedometer)"}},
   };
   for (const auto& [what, c] : cases) {
     std::string text = base;
