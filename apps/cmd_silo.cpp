@@ -53,8 +53,8 @@ void run_silo(const SiloArgs& a) {
   }
   const Frame& last = t.frames.back();
   if (last.particles.empty()) throw InputError(a.input, "the last frame has no particles");
-  const double d50 = a.d50 ? *a.d50 : ga::d50(last);
   if (a.d50) require_positive(a.input, "--d50", *a.d50);
+  const double d50 = a.d50 ? *a.d50 : ga::d50(last);
   ga::SiloReportOptions o;
   o.up = vec(a.up);
   o.across = vec(a.across);

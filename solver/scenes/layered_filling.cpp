@@ -199,7 +199,7 @@ void LayeredFilling::control(Simulation& sim) {
   if (done_) return;
   const std::int64_t since = sim.step_count() - last_insert_step_;
   if (since < spec_.min_steps) return;
-  const double ek = settling_energy(sim);
+  const double ek = settling_energy(sim), threshold_J = threshold(sim);
   // A layer placed at rest has next to no kinetic energy while it starts to fall: it has
   // settled only once it has moved (its energy went above the threshold) or has had the time
   // to fall through the region's height.
@@ -207,13 +207,12 @@ void LayeredFilling::control(Simulation& sim) {
   const double fall_height = std::abs((spec_.region_hi_m - spec_.region_lo_m).dot(g.normalized()));
   const bool fallen = moved_ || static_cast<double>(since) * sim.config().dt >=
                                     std::sqrt(2 * fall_height / g.norm());
-  if (ek >= threshold(sim)) moved_ = true;
-  if (ek >= threshold(sim) || !fallen) {
+  if (ek >= threshold_J) moved_ = true;
+  if (ek >= threshold_J || !fallen) {
     if (since >= spec_.max_steps)
       throw FillError("fill: layer " + std::to_string(inserted_) + " did not settle within " +
                       std::to_string(spec_.max_steps) + " steps (translational kinetic energy " +
-                      std::to_string(ek) + " J, threshold " + std::to_string(threshold(sim)) +
-                      " J)");
+                      std::to_string(ek) + " J, threshold " + std::to_string(threshold_J) + " J)");
     return;
   }
   if (inserted_ < static_cast<int>(layers_.size())) {

@@ -271,10 +271,9 @@ void read_lab_sections(const Reader& r, const toml::table& root, Scene& s) {
     x.front_back_friction_deg =
         r.number(t, sec, "front_back_friction_deg", false, x.front_back_friction_deg);
     x.bottom_friction_deg = r.number(t, sec, "bottom_friction_deg", false, -1);
-    for (const char* k : {"wall_friction_deg", "front_back_friction_deg"}) {
-      const double v = r.number(t, sec, k, false, 0);
+    for (const auto& [k, v] : {std::pair{"wall_friction_deg", x.wall_friction_deg},
+                               std::pair{"front_back_friction_deg", x.front_back_friction_deg}})
       if (!(v >= 0 && v < 90)) r.fail(sec + "." + k, "outside [0, 90)", value_str(v));
-    }
     x.mode = r.string(t, sec, "mode", false, x.mode);
     if (x.mode != "quasi_static" && x.mode != "gravitational")
       r.fail("silo.mode", "expected \"quasi_static\" or \"gravitational\"", x.mode);

@@ -30,7 +30,7 @@ std::vector<WallSpec> silo_walls(const SiloSpec& s, double d50_m, double dmax_m,
   require(s.height_m > 0, "silo.height_m", s.height_m, "must be positive");
   require(s.depth_m > 0, "silo.depth_m", s.depth_m, "must be positive");
   require(d50_m > 0, "silo.d50_m", d50_m, "must be positive");
-  require(dmax_m > 0, "silo.d50_m", dmax_m, "needs the grading's largest diameter");
+  require(dmax_m > 0, "fill.dmax_m", dmax_m, "must be positive");
   require(s.roughness >= 0, "silo.roughness", s.roughness, "must not be negative");
   const double hg = s.roughness * d50_m;
   require(s.roughness == 0 || hg >= 1e-3 * d50_m, "silo.roughness", s.roughness,

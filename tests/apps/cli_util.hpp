@@ -18,6 +18,9 @@
 #include <thread>
 #include <vector>
 
+#include "../io/test_util.hpp"
+#include "hdf5_trajectory.hpp"
+
 namespace gs::test {
 
 inline const std::string kGranoscope = std::string(GS_BINARY_DIR) + "/bin/granoscope";
@@ -132,6 +135,28 @@ inline void expect_bad_scenes(const std::filesystem::path& dir,
     EXPECT_EQ(r.rc, 2) << i;
     EXPECT_NE(r.err.find(cases[i].second), std::string::npos) << i << ": " << r.err;
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << i << ": " << r.err;
+  }
+}
+
+/// `scene` run straight into dir/straight, and for each step of `kill_after` killed there and
+/// resumed into dir/killed<step>: the output files `files` and every frame of the trajectory
+/// `trajectory` are the same as the straight run's.
+inline void expect_resume_bit_for_bit(const std::filesystem::path& dir, const std::string& scene,
+                                      const std::vector<long>& kill_after,
+                                      const std::vector<std::string>& files,
+                                      const std::string& trajectory) {
+  ASSERT_EQ(run_cli("simulate " + scene + " -q -o " + (dir / "straight").string(), dir).rc, 0);
+  const auto a = read_hdf5_trajectory(dir / "straight" / trajectory);
+  for (const long k : kill_after) {
+    const auto killed = dir / ("killed" + std::to_string(k));
+    ASSERT_TRUE(run_and_kill(scene, killed, k)) << "the run finished before step " << k;
+    const auto r = run_cli("simulate " + scene + " -q --resume -o " + killed.string(), dir);
+    ASSERT_EQ(r.rc, 0) << r.err;
+    for (const auto& f : files)
+      EXPECT_EQ(slurp(dir / "straight" / f), slurp(killed / f)) << f << " after " << k;
+    const auto b = read_hdf5_trajectory(killed / trajectory);
+    ASSERT_EQ(a.frames.size(), b.frames.size());
+    for (std::size_t i = 0; i < a.frames.size(); ++i) expect_same_frame(a.frames[i], b.frames[i]);
   }
 }
 

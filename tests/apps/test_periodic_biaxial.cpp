@@ -137,20 +137,7 @@ TEST(PeriodicBiaxial, BadInputsFailWithOneLine) {
 TEST(PeriodicBiaxial, ResumeIsBitForBitInBothPhases) {
   gs::test::ScratchDir dir("periodic_biaxial_resume");
   std::ofstream(dir / "kb.toml") << scene();
-  const std::string sc = (dir / "kb.toml").string();
-  ASSERT_EQ(run_cli("simulate " + sc + " -q -o " + (dir / "straight").string(), dir.path).rc, 0);
-  for (const long kill_after : {15000L, 30000L}) {  // (the preparation ends near 24 600)
-    const auto killed = dir / ("killed" + std::to_string(kill_after));
-    ASSERT_TRUE(gs::test::run_and_kill(sc, killed, kill_after))
-        << "the run finished before it could be killed";
-    const auto r = run_cli("simulate " + sc + " -q --resume -o " + killed.string(), dir.path);
-    ASSERT_EQ(r.rc, 0) << r.err;
-    for (const char* f : {"history.csv", "curve.csv", "preparation.csv"})
-      EXPECT_EQ(slurp(dir / "straight" / f), slurp(killed / f)) << f << " after " << kill_after;
-    const auto a = gs::read_hdf5_trajectory(dir / "straight" / "kb.h5");
-    const auto b = gs::read_hdf5_trajectory(killed / "kb.h5");
-    ASSERT_EQ(a.frames.size(), b.frames.size());
-    for (std::size_t i = 0; i < a.frames.size(); ++i)
-      gs::test::expect_same_frame(a.frames[i], b.frames[i]);
-  }
+  // (the preparation ends near step 24 600)
+  gs::test::expect_resume_bit_for_bit(dir.path, (dir / "kb.toml").string(), {15000, 30000},
+                                      {"history.csv", "curve.csv", "preparation.csv"}, "kb.h5");
 }

@@ -200,21 +200,7 @@ TEST(Silo, BadInputsFailWithOneLine) {
 TEST(Silo, ResumeIsBitForBitWhileFillingAndDischarging) {
   gs::test::ScratchDir dir("silo_resume");
   std::ofstream(dir / "silo.toml") << scene(kGravity);
-  const std::string sc = (dir / "silo.toml").string();
-  ASSERT_EQ(run_cli("simulate " + sc + " -q -o " + (dir / "straight").string(), dir.path).rc, 0);
-  for (const long kill_after : {45000L, 100000L}) {  // (the filling ends near 71 000)
-    const auto killed = dir / ("killed" + std::to_string(kill_after));
-    ASSERT_TRUE(gs::test::run_and_kill(sc, killed, kill_after))
-        << "the run finished before it could be killed";
-    const auto r = run_cli("simulate " + sc + " -q --resume -o " + killed.string(), dir.path);
-    ASSERT_EQ(r.rc, 0) << r.err;
-    for (const char* f : {"history.csv", "curve.csv"})
-      EXPECT_EQ(gs::test::slurp(dir / "straight" / f), gs::test::slurp(killed / f))
-          << f << " after " << kill_after;
-    const auto a = gs::read_hdf5_trajectory(dir / "straight" / "trajectory.h5");
-    const auto b = gs::read_hdf5_trajectory(killed / "trajectory.h5");
-    ASSERT_EQ(a.frames.size(), b.frames.size());
-    for (std::size_t i = 0; i < a.frames.size(); ++i)
-      gs::test::expect_same_frame(a.frames[i], b.frames[i]);
-  }
+  // (the filling ends near step 71 000)
+  gs::test::expect_resume_bit_for_bit(dir.path, (dir / "silo.toml").string(), {45000, 100000},
+                                      {"history.csv", "curve.csv"}, "trajectory.h5");
 }
