@@ -238,4 +238,19 @@ ShearZone shear_zone(const ScalarMap& m) {
   return z;
 }
 
+double profile_inflection(const std::vector<double>& v, int from, int step, double bin) {
+  const int n = static_cast<int>(v.size());
+  if (n < 3) return NAN;
+  auto d2 = [&](int i) { return v[i - 1] - 2 * v[i] + v[i + 1]; };
+  int i = std::clamp(from, 1, n - 2);
+  for (; i + step >= 1 && i + step <= n - 2; i += step) {
+    const double a = d2(i), b = d2(i + step);
+    if ((a < 0 && b >= 0) || (a > 0 && b <= 0)) {
+      const double t = a / (a - b);
+      return (i + step * t) * bin;
+    }
+  }
+  return NAN;
+}
+
 }  // namespace gs::analysis

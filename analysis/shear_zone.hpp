@@ -49,4 +49,9 @@ struct ShearZone {
 /// Throws std::invalid_argument when the map is degenerate or no band can be located.
 ShearZone shear_zone(const ScalarMap& map);
 
+/// The first inflection of a profile `v` sampled every `bin` (m): from index `from` towards
+/// `step` = ±1, where the second difference first changes sign, interpolated linearly; the
+/// distance (m) from index 0. NaN when it does not (or fewer than 3 samples).
+double profile_inflection(const std::vector<double>& v, int from, int step, double bin);
+
 }  // namespace gs::analysis

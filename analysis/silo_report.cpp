@@ -1,5 +1,7 @@
 #include "silo_report.hpp"
 
+#include "shear_zone.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -8,22 +10,6 @@
 namespace gs::analysis {
 
 namespace {
-
-/// The distance (m, from index `from` towards `step` = ±1) at which the second difference of
-/// `v` first changes sign, interpolated linearly; NaN when it does not.
-double inflection(const std::vector<double>& v, int from, int step, double bin) {
-  auto d2 = [&](int i) { return v[i - 1] - 2 * v[i] + v[i + 1]; };
-  const int n = static_cast<int>(v.size());
-  int i = std::clamp(from, 1, n - 2);
-  for (; i + step >= 1 && i + step <= n - 2; i += step) {
-    const double a = d2(i), b = d2(i + step);
-    if ((a < 0 && b >= 0) || (a > 0 && b <= 0)) {
-      const double t = a / (a - b);
-      return (i + step * t) * bin;
-    }
-  }
-  return NAN;
-}
 
 void wall_zones(const Frame& f, const SiloReportOptions& o, const Eigen::Vector3d& up,
                 const Eigen::Vector3d& across, double bottom, double top,
@@ -63,8 +49,8 @@ void wall_zones(const Frame& f, const SiloReportOptions& o, const Eigen::Vector3
   const int pl = static_cast<int>(std::max_element(s.begin(), s.begin() + half) - s.begin());
   const int pr = static_cast<int>(std::max_element(s.begin() + (n - half), s.end()) - s.begin());
   // (bin centres are at (b + 1/2)·bin from the base plane)
-  r.zone_left = inflection(s, pl, +1, o.zone_bin) + 0.5 * o.zone_bin;
-  const double right = inflection(s, pr, -1, o.zone_bin);
+  r.zone_left = profile_inflection(s, pl, +1, o.zone_bin) + 0.5 * o.zone_bin;
+  const double right = profile_inflection(s, pr, -1, o.zone_bin);
   r.zone_right = std::isnan(right) ? NAN : (x1 - x0) - (right + 0.5 * o.zone_bin);
 }
 

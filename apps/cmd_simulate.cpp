@@ -266,8 +266,40 @@ std::string history_row(solver::Simulation& sim) {
   return row;
 }
 
-void run(const Args& a) {
-  solver::Scene scene = solver::load_scene(a.scene);
+using Results = std::vector<std::pair<std::string, double>>;
+
+/// `results.csv` of a run: name,value rows.
+void write_results(const fs::path& path, const Results& r) {
+  AtomicOutput out(path);
+  {
+    std::ofstream o(out.temp_path());
+    o << "name,value\n";
+    char buf[64];
+    for (const auto& [k, v] : r) {
+      std::snprintf(buf, sizeof buf, "%.9g", v);
+      o << k << "," << buf << "\n";
+    }
+    if (!o.flush()) throw InputError(path.string(), "cannot write output");
+  }
+  out.commit();
+}
+
+Results read_results(const fs::path& path) {
+  Results r;
+  const std::string text = text::read_text_file(path, 1 << 20);
+  const auto lines = text::split_lines(text);  // (views into `text`)
+  for (std::size_t i = 1; i < lines.size(); ++i) {
+    const std::string line(lines[i]);
+    const auto comma = line.find(',');
+    if (comma == std::string::npos) continue;
+    r.emplace_back(line.substr(0, comma), std::strtod(line.c_str() + comma + 1, nullptr));
+  }
+  return r;
+}
+
+/// One run; its results when its last programme ended (not when --steps stopped it first).
+Results run(const Args& a, int sweep_point = -1) {
+  solver::Scene scene = solver::load_scene(a.scene, sweep_point);
   auto programmes = solver::scene_programmes(scene);
   if (a.threads > 0) scene.config.threads = a.threads;
   // Where the run stops at the latest: --steps, or a plain scene's own number of steps.
@@ -380,7 +412,7 @@ void run(const Args& a) {
         }
         std::printf("%s: the run is complete (%s); nothing to resume\n", scene.name.c_str(),
                     traj.string().c_str());
-        return;
+        return fs::exists(out / "results.csv") ? read_results(out / "results.csv") : Results{};
       }
       throw InputError(ckpt_index.string(), "no checkpoint to resume from");
     }
@@ -474,13 +506,17 @@ void run(const Args& a) {
     std::fflush(stderr);
   };
   if (log_progress) log_line(true);
+  bool ended = false;
   try {
     while (true) {
       if (programmes[k]->finished(sim)) {
         const std::string sum = programmes[k]->summary(sim);
         if (!sum.empty()) std::printf("%s\n", sum.c_str());
         curve_row();  // the state at the programme's end
-        if (k + 1 == programmes.size()) break;
+        if (k + 1 == programmes.size()) {
+          ended = true;
+          break;
+        }
         if (programmes[k]->name() == "preparation") {
           prep_curve.finish();
           Trajectory specimen;
@@ -550,6 +586,9 @@ void run(const Args& a) {
   curve.finish();
   prep_curve.finish();
   if (writer) writer->finish();
+  Results results;
+  if (ended) results = programmes[k]->results(sim);
+  if (!results.empty()) write_results(out / "results.csv", results);
   // The index first: a kill from here on leaves a complete run, which --resume recognises.
   fs::remove(ckpt_index, ec);
   fs::remove(out / ck["state"], ec);
@@ -567,7 +606,84 @@ void run(const Args& a) {
       std::abs(e.residual()) / std::max(1e-300, e.stored() + e.dissipated()));
   std::printf("wrote %s, %s", traj.string().c_str(), history.path().string().c_str());
   if (!scene.test.empty()) std::printf(", %s", curve.path().string().c_str());
+  if (!results.empty()) std::printf(", %s", (out / "results.csv").string().c_str());
   std::printf("\n");
+  return results;
+}
+
+/// A scene with [sweep]: one run per value, each in OUT/<key leaf>_<value>/ (resumed, or read
+/// back when complete, with --resume), and OUT/sweep.csv: the value and each run's results.
+void run_sweep(const Args& a, const solver::Scene& first) {
+  const solver::SweepInfo& sw = *first.sweep;
+  const std::string leaf = sw.key.substr(sw.key.rfind('.') + 1);
+  const fs::path out = a.out.empty() ? fs::path("out") / first.name : fs::path(a.out);
+  std::error_code ec;
+  fs::create_directories(out, ec);
+  if (ec) throw InputError(out.string(), "cannot create output directory", ec.message());
+  std::vector<std::pair<std::string, Results>> rows;
+  std::vector<std::string> failed;
+  for (std::size_t i = 0; i < sw.values.size(); ++i) {
+    Args one = a;
+    one.out = (out / (leaf + "_" + sw.values[i])).string();
+    const bool started = fs::exists(fs::path(one.out) / "checkpoint.txt") ||
+                         fs::exists(fs::path(one.out) / "results.csv");
+    one.resume = a.resume && started;
+    std::printf("sweep %s = %s (%zu of %zu) -> %s\n", sw.key.c_str(), sw.values[i].c_str(), i + 1,
+                sw.values.size(), one.out.c_str());
+    std::fflush(stdout);
+    try {
+      rows.emplace_back(sw.values[i], run(one, static_cast<int>(i)));
+    } catch (const InputError& e) {
+      // A point that fails (a blow-up, a jam) does not stop the others: its row stays empty.
+      std::printf("sweep %s = %s failed: %s\n", sw.key.c_str(), sw.values[i].c_str(), e.what());
+      std::fflush(stdout);
+      rows.emplace_back(sw.values[i], Results{});
+      failed.push_back(sw.values[i]);
+    }
+    // The table so far, after every point.
+    std::vector<std::string> names;
+    for (const auto& [v, r] : rows)
+      for (const auto& [n, x] : r)
+        if (std::find(names.begin(), names.end(), n) == names.end()) names.push_back(n);
+    AtomicOutput table(out / "sweep.csv");
+    {
+      std::ofstream o(table.temp_path());
+      o << leaf;
+      for (const auto& n : names) o << "," << n;
+      o << ",run\n";
+      char buf[64];
+      for (std::size_t j = 0; j < rows.size(); ++j) {
+        o << rows[j].first;
+        for (const auto& n : names) {
+          const auto it = std::find_if(rows[j].second.begin(), rows[j].second.end(),
+                                       [&](const auto& p) { return p.first == n; });
+          if (it != rows[j].second.end()) {
+            std::snprintf(buf, sizeof buf, "%.9g", it->second);
+            o << "," << buf;
+          } else {
+            o << ",";
+          }
+        }
+        o << "," << leaf << "_" << rows[j].first << "\n";
+      }
+      if (!o.flush()) throw InputError((out / "sweep.csv").string(), "cannot write output");
+    }
+    table.commit();
+  }
+  std::printf("wrote %s\n", (out / "sweep.csv").string().c_str());
+  if (!failed.empty()) {
+    std::string list;
+    for (const auto& v : failed) list += (list.empty() ? "" : ", ") + v;
+    throw InputError(a.scene,
+                     "sweep: " + std::to_string(failed.size()) + " of " +
+                         std::to_string(sw.values.size()) + " runs failed (see the output above)",
+                     list);
+  }
+}
+
+void run_scene(const Args& a) {
+  if (solver::scene_has_sweep(a.scene)) return run_sweep(a, solver::load_scene(a.scene));
+  run(a);
 }
 
 }  // namespace
@@ -586,7 +702,7 @@ void register_simulate(CLI::App& app) {
       ->check(CLI::Range(1, solver::kMaxThreads));
   cmd->add_flag("--resume", a->resume, "continue from the last checkpoint in the output directory");
   cmd->add_flag("-q,--quiet", a->quiet, "no progress line");
-  cmd->callback([a] { run(*a); });
+  cmd->callback([a] { run_scene(*a); });
 }
 
 }  // namespace gs::cli

@@ -68,6 +68,7 @@ int main(int argc, char** argv) {
   gs::cli::register_analyze_rev(app);
   gs::cli::register_analyze_contacts(app);
   gs::cli::register_analyze_silo(app);
+  gs::cli::register_analyze_interface(app);
   gs::cli::register_analyze_hhd(app);
   try {
     gs::cli::check_subcommand_names(app, argc, argv);

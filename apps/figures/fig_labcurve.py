@@ -3,6 +3,8 @@ curve.csv (and preparation.csv) beside the trajectory; nothing when there is non
   triaxial / plane strain: mobilised friction angle and σ1/σ3 vs ε1, volumetric strain vs ε1
   (dilation positive, as seed 004 Figs 4.2-4.8 and seed 000 Fig 3);
   direct shear: τ/σn and volumetric strain vs horizontal displacement u (seed 004 Fig 4.12);
+  interface shear: φs (μeff = T/P on the right) and εv vs u (seed 004 Figs 4.37-4.38, 4.73-4.74);
+  silo: P/G, T/G, N/G per wall vs the bottom's travel u or the discharge time (seed 004 §5.3.1);
   periodic biaxial (2D): σ22 − σ11 and σ22/σ11 vs ε22, area strain vs ε22 (seed 002 Fig 7b);
   preparation: void ratio and friction against steps."""
 import csv
@@ -67,6 +69,33 @@ def shear(c, title):
     return fig
 
 
+def interface(c, title):
+    return strength_and_dilatancy(
+        1e3 * c["u_m"], "horizontal displacement u (mm)", c["phi_s_deg"],
+        "mobilised surface friction angle φs (°)", lambda y, x: f"{y:.1f}° at u = {x:.2f} mm",
+        c["mu_eff"], "μeff = T/P", 100 * c["eps_v"], "volumetric strain εv (%, dilation +)", title)
+
+
+def silo(c, title):
+    fig, (a1, a2) = plt.subplots(2, 1, figsize=(6.5, 7), sharex=True)
+    quasi = np.any(c["u_m"] > 0)
+    x = 1e3 * c["u_m"] if quasi else c["flow_time_s"]
+    a1.plot(x, c["P_G"], "k-", label="P/G (bottom)")
+    for side, style in (("left", "-"), ("right", "--")):
+        a1.plot(x, c[f"T_{side}_G"], "b" + style, label=f"T/G {side}")
+        a1.plot(x, c[f"N_{side}_G"], "r" + style, label=f"N/G {side}")
+    a1.plot(x, c["balance_G"], color="0.6", lw=0.8, label="(P + 2T)/G")
+    a1.set_ylabel("wall force / weight G")
+    a1.legend(fontsize=7, ncol=2)
+    a2.plot(x, c["phi_w_left_deg"], "k-", label="left")
+    a2.plot(x, c["phi_w_right_deg"], "k--", label="right")
+    a2.set_ylabel("φw = atan(T/N) (°)")
+    a2.legend(fontsize=7)
+    a2.set_xlabel("bottom travel u (mm)" if quasi else "discharge time (s)")
+    a1.set_title(title)
+    return fig
+
+
 def biaxial(c, title):
     return strength_and_dilatancy(
         100 * c["eps22_shortening"], "vertical strain ε22 (%, shortening +)",
@@ -96,7 +125,11 @@ def make(path, out_dir, args):
     curve = os.path.join(here, "curve.csv")
     if os.path.exists(curve):
         c = read(curve)
-        if "u_m" in c:
+        if "mu_eff" in c:
+            fig = interface(c, f"{stem}: interface shear")
+        elif "P_G" in c:
+            fig = silo(c, f"{stem}: silo")
+        elif "u_m" in c:
             fig = shear(c, f"{stem}: direct shear")
         elif "eps22_shortening" in c:
             fig = biaxial(c, f"{stem}: periodic biaxial")

@@ -35,16 +35,27 @@ double max_diameter(const std::vector<Particle>& p) {
 
 /// Seeded specimen in the box [0, cloud]: the number of spheres is set by the target box and
 /// void ratio, the cloud is the loose box they are placed in.
-std::vector<Particle> generate(const Scene& s, const Eigen::Vector3d& cloud) {
+std::vector<Particle> generate(const Scene& s, const Eigen::Vector3d& cloud,
+                               const Eigen::Vector3d& lo = Eigen::Vector3d::Zero()) {
   const SpecimenSpec& sp = *s.specimen;
   std::mt19937_64 rng(sp.seed);
   const double solid = sp.size_m.prod() / (1 + sp.void_ratio);
   try {
     const auto d = draw_diameters(sp.sizes, solid, rng);
-    return random_sequential_packing(d, Eigen::Vector3d::Zero(), cloud, rng);
+    return random_sequential_packing(d, lo, lo + cloud, rng);
   } catch (const std::invalid_argument& e) {
     throw InputError(s.file.string(), std::string("[specimen]: ") + e.what());
   }
+}
+
+/// Union volume over the members' summed volume of the scene's clumps (1 without clumps): what
+/// a void ratio counts of a member sphere (the members of a clump overlap).
+double clump_solid_factor(const Scene& s) {
+  if (!s.clump_replace || s.clumps.empty()) return 1.0;
+  const ClumpShape shape = clump_shape(s.clump_replace->shape);
+  double sum = 0;
+  for (const auto& m : s.clump_replace->shape) sum += 4.0 / 3.0 * M_PI * std::pow(m.radius, 3);
+  return shape.volume / sum;
 }
 
 }  // namespace
@@ -126,6 +137,7 @@ std::vector<std::unique_ptr<LoadingProgramme>> scene_programmes(Scene& s) {
       lo.setZero();
       hi = s.specimen->size_m * scale;
       s.particles = generate(s, hi);
+      replace_spheres_by_clumps(s);
     } else {
       Frame f;
       f.particles = s.particles;
@@ -143,6 +155,45 @@ std::vector<std::unique_ptr<LoadingProgramme>> scene_programmes(Scene& s) {
     } else {
       test = std::make_unique<PlaneStrainCompression>(s.plane_strain);
     }
+  } else if (s.test == "interface_shear") {
+    // Seed 004 §4.3–4.4: the specimen's cloud is made above the surface's crests.
+    const auto& sp = *s.specimen;
+    InterfaceShearGeometry& g = s.interface_geometry;
+    InterfaceSurfaceSpec& f = s.interface_surface;
+    g.length_m = sp.size_m.x();
+    g.width_m = sp.size_m.y();
+    g.height_m = sp.size_m.z();
+    g.travel_m = s.interface_shear.max_displacement_m;
+    const double dmax = sp.sizes.dmax_m;
+    if (f.kind == "saw_tooth" && !(f.d50_m > 0)) f.d50_m = mass_quantile(sp.sizes, 0.5);
+    g.wall_thickness_m = std::max(2 * dmax, 0.05 * g.length_m);
+    InterfaceShearWalls idx;
+    try {
+      // The crest height is known once the surface is built: build, then place the cloud.
+      InterfaceShearGeometry probe = g;
+      probe.platen_z_m = 1e300;
+      probe.frame_top_m = 2e300;
+      (void)interface_shear_walls(f, probe, dmax, idx);
+      const double cloud_h = g.height_m * (1 / (1 + sp.void_ratio)) / sp.cloud_solid_fraction;
+      s.particles =
+          generate(s, {g.length_m, g.width_m, cloud_h}, Eigen::Vector3d(0, 0, probe.crest_z_m));
+      replace_spheres_by_clumps(s);
+      g.clump_solid_factor = clump_solid_factor(s);
+      g.platen_z_m = probe.crest_z_m + cloud_h;
+      g.frame_top_m = g.platen_z_m + g.wall_thickness_m;
+      s.walls = interface_shear_walls(f, g, dmax, idx);
+      // Grains pushed off the surface's ends fall away (removed there).
+      const double big = 1e3 * (g.length_m + g.height_m + g.travel_m);
+      s.outlet = std::make_pair(Eigen::Vector3d(g.surface_x0_m, -big, -big),
+                                Eigen::Vector3d(g.surface_x1_m, big, big));
+      gauge = interface_shear_gauge(g, idx);
+      // For `analyze interface` (the run's metadata): where the surface is.
+      s.parameters.emplace_back("interface_shear.surface_mean_z_m", value_str(g.mean_z_m));
+      s.parameters.emplace_back("interface_shear.surface_crest_z_m", value_str(g.crest_z_m));
+      test = std::make_unique<InterfaceShear>(s.interface_shear, g, idx);
+    } catch (const std::invalid_argument& e) {
+      throw InputError(s.file.string(), e.what());
+    }
   } else {  // direct shear
     ShearBoxGeometry& g = s.shear_box;
     double top;
@@ -153,6 +204,7 @@ std::vector<std::unique_ptr<LoadingProgramme>> scene_programmes(Scene& s) {
       g.height_m = sp.size_m.z();
       top = g.height_m * (1 / (1 + sp.void_ratio)) / sp.cloud_solid_fraction;
       s.particles = generate(s, {g.length_m, g.width_m, top});
+      replace_spheres_by_clumps(s);
     } else {
       Frame f;
       f.particles = s.particles;

@@ -8,6 +8,8 @@
 #include <cstdint>
 #include <map>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "simulation.hpp"
 
@@ -34,6 +36,11 @@ class LoadingProgramme {
   virtual std::int64_t frame_index(const Simulation& sim) const = 0;
   /// Lines for the end-of-run report.
   virtual std::string summary(const Simulation& sim) const = 0;
+  /// Named end-of-run numbers (peak friction, residual strain …): `results.csv` of the run and
+  /// one row of a sweep's table. Empty for a programme with none.
+  virtual std::vector<std::pair<std::string, double>> results(const Simulation&) const {
+    return {};
+  }
   /// Exact state for checkpoints (doubles as hexadecimal floats: bit-for-bit resume).
   virtual std::string save_state() const = 0;
   virtual void load_state(const std::string& state) = 0;

@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <iterator>
 #include <map>
 #include <sstream>
@@ -135,8 +137,8 @@ struct Reader {
 };
 
 void read_lab_sections(const Reader& r, const toml::table& root, Scene& s) {
-  for (const char* name :
-       {"triaxial", "plane_strain", "direct_shear", "biaxial_periodic", "silo"}) {
+  for (const char* name : {"triaxial", "plane_strain", "direct_shear", "interface_shear",
+                           "biaxial_periodic", "silo"}) {
     if (root.contains(name) && s.test != name)
       r.fail(std::string("[") + name + "]", "does not match scene.test", s.test);
   }
@@ -233,6 +235,95 @@ void read_lab_sections(const Reader& r, const toml::table& root, Scene& s) {
     g.gap_m = r.number(t, "direct_shear", "gap_m", false, -1);
     g.side_friction_deg = r.number(t, "direct_shear", "side_friction_deg", false, 0);
     g.platen_friction_deg = r.number(t, "direct_shear", "platen_friction_deg", false, -1);
+  } else if (s.test == "interface_shear") {
+    // Seed 004 §4.3–4.4 (interface_shear.hpp, docs/interface_shear.md).
+    const std::string sec = "interface_shear";
+    const auto* t = r.table(sec, true);
+    r.only(t, sec,
+           {"surface",
+            "roughness",
+            "d50_m",
+            "tooth_slope_deg",
+            "tooth_spacing_ratio",
+            "depth_ratio",
+            "wavelength_m",
+            "segments_per_wavelength",
+            "surface_friction_deg",
+            "frame_friction_deg",
+            "platen_friction_deg",
+            "gap_m",
+            "normal_stress_Pa",
+            "shear_velocity_m_s",
+            "max_displacement_m",
+            "frame_every_m",
+            "servo_gain",
+            "max_platen_speed_m_s",
+            "residual_fraction",
+            "internal_friction_deg",
+            "flat_friction"});
+    auto& f = s.interface_surface;
+    f.kind = r.string(t, sec, "surface", true, "");
+    if (f.kind != "saw_tooth" && f.kind != "sinusoid" && f.kind != "flat")
+      r.fail(sec + ".surface", "expected \"saw_tooth\", \"sinusoid\" or \"flat\"", f.kind);
+    const bool saw = f.kind == "saw_tooth", sine = f.kind == "sinusoid";
+    for (const char* k : {"roughness", "d50_m", "tooth_slope_deg", "tooth_spacing_ratio"})
+      if (!saw && t->contains(k)) r.fail(sec + "." + k, "is for surface = \"saw_tooth\"");
+    for (const char* k : {"depth_ratio", "wavelength_m", "segments_per_wavelength"})
+      if (!sine && t->contains(k)) r.fail(sec + "." + k, "is for surface = \"sinusoid\"");
+    if (saw) {
+      f.roughness = r.number(t, sec, "roughness", true, 0);
+      if (!(f.roughness > 0))
+        r.fail(sec + ".roughness", "must be positive (a flat plate: surface = \"flat\")",
+               value_str(f.roughness));
+      f.d50_m = r.number(t, sec, "d50_m", false, 0);
+      f.tooth_slope_deg = r.number(t, sec, "tooth_slope_deg", false, f.tooth_slope_deg);
+      f.tooth_spacing_ratio =
+          r.positive(t, sec, "tooth_spacing_ratio", false, f.tooth_spacing_ratio);
+    }
+    if (sine) {
+      f.depth_ratio = r.number(t, sec, "depth_ratio", true, 0);
+      if (!(f.depth_ratio >= 0 && f.depth_ratio < 1))
+        r.fail(sec + ".depth_ratio", "outside [0, 1)", value_str(f.depth_ratio));
+      f.wavelength_m = r.positive(t, sec, "wavelength_m", true, 0);
+      f.segments_per_wavelength = static_cast<int>(
+          r.integer(t, sec, "segments_per_wavelength", false, f.segments_per_wavelength, 4));
+      if (f.segments_per_wavelength > 4096)
+        r.fail(sec + ".segments_per_wavelength", "more than 4096",
+               std::to_string(f.segments_per_wavelength));
+    }
+    auto angle = [&](const char* k, double fallback) {
+      const double v = r.number(t, sec, k, false, fallback);
+      if (t->contains(k) && !(v >= 0 && v < 90))
+        r.fail(sec + "." + k, "outside [0, 90)", value_str(v));
+      return v;
+    };
+    f.friction_deg = angle("surface_friction_deg", -1);
+    auto& g = s.interface_geometry;
+    g.frame_friction_deg = angle("frame_friction_deg", 0);
+    g.platen_friction_deg = angle("platen_friction_deg", -1);
+    g.gap_m = r.number(t, sec, "gap_m", false, -1);
+    if (t->contains("gap_m") && !(g.gap_m >= 0))
+      r.fail(sec + ".gap_m", "must not be negative", value_str(g.gap_m));
+    auto& x = s.interface_shear;
+    x.normal_stress_Pa = r.positive(t, sec, "normal_stress_Pa", true, 0);
+    x.shear_velocity_m_s = r.positive(t, sec, "shear_velocity_m_s", true, 0);
+    x.max_displacement_m = r.positive(t, sec, "max_displacement_m", true, 0);
+    x.frame_every_m = r.number(t, sec, "frame_every_m", false, 0);
+    x.servo_gain = r.positive(t, sec, "servo_gain", false, x.servo_gain);
+    x.max_platen_speed_m_s =
+        r.positive(t, sec, "max_platen_speed_m_s", false, x.max_platen_speed_m_s);
+    x.residual_fraction = r.positive(t, sec, "residual_fraction", false, x.residual_fraction);
+    if (!(x.residual_fraction < 1))
+      r.fail(sec + ".residual_fraction", "must be below 1", value_str(x.residual_fraction));
+    x.internal_friction_deg = angle("internal_friction_deg", x.internal_friction_deg);
+    if (!(x.internal_friction_deg > 0))
+      r.fail(sec + ".internal_friction_deg", "must be positive",
+             value_str(x.internal_friction_deg));
+    x.flat_friction = r.number(t, sec, "flat_friction", false, -1);
+    if (t->contains("flat_friction") && !(x.flat_friction >= 0 && x.flat_friction < 10))
+      r.fail(sec + ".flat_friction", "outside [0, 10)", value_str(x.flat_friction));
+    if (!root.contains("specimen"))
+      r.fail("[specimen]", "missing (the interface shear test generates its specimen)");
   } else if (s.test == "silo") {
     // Seed 004 §5.2 (silo_flow.hpp, docs/silo.md).
     const auto* t = r.table("silo", true);
@@ -308,6 +399,7 @@ void read_lab_sections(const Reader& r, const toml::table& root, Scene& s) {
     const double test_stress = s.test == "triaxial"           ? s.triaxial.confining_Pa
                                : s.test == "plane_strain"     ? s.plane_strain.confining_Pa
                                : s.test == "biaxial_periodic" ? s.biaxial_periodic.lateral_stress_Pa
+                               : s.test == "interface_shear"  ? s.interface_shear.normal_stress_Pa
                                                               : s.direct_shear.normal_stress_Pa;
     p.pressure_Pa = r.number(prep, "preparation", "pressure_Pa", false, test_stress);
     if (p.pressure_Pa < 0) r.fail("preparation.pressure_Pa", "negative", value_str(p.pressure_Pa));
@@ -349,6 +441,33 @@ void read_lab_sections(const Reader& r, const toml::table& root, Scene& s) {
     r.fail("[preparation]", "needs scene.test");
   }
 }
+
+}  // namespace
+
+void replace_spheres_by_clumps(Scene& s) {
+  if (!s.clump_replace || s.particles.empty() || !s.clumps.empty()) return;
+  const auto& cr = *s.clump_replace;
+  std::mt19937_64 rng(cr.seed);
+  auto rep =
+      replace_by_clumps(s.particles, cr.shape, s.config.material.density, cr.model, rng, 0, 0);
+  // Members take the spheres' place (ids 0…), clumps are numbered after them.
+  s.particles = rep.members;
+  std::int64_t next = static_cast<std::int64_t>(s.particles.size());
+  for (auto& c : rep.clumps) {
+    c.id = next++;
+    c.template_name = cr.template_name;
+    for (const auto i : c.members) s.particles[i].clump_id = c.id;
+  }
+  s.clumps = std::move(rep.clumps);
+  if (s.dt_auto_safety > 0) {
+    std::vector<double> radii;
+    for (const auto& p : s.particles) radii.push_back(p.radius);
+    s.dt_pwave = pwave_timestep(radii, s.config.material.density, s.config.material.young_ec);
+    s.config.dt = s.dt_auto_safety * s.dt_pwave;
+  }
+}
+
+namespace {
 
 /// [[clump_template]] (name, members = [[x, y, z, r], …] in metres in the template frame) and
 /// [clumps] (packing = CSV of template,x,y,z,qw,qx,qy,qz[,scale]: the template rotated by the
@@ -414,20 +533,15 @@ void read_clumps(const Reader& r, const toml::table& root, const std::filesystem
     const std::string name = r.string(clumps, "clumps", "replace", true, "");
     const auto it = templates.find(name);
     if (it == templates.end()) r.fail("clumps.replace", "unknown clump template", name);
+    auto& rep = s.clump_replace.emplace();
+    rep.template_name = name;
+    rep.shape = it->second;
+    rep.model = model;
+    rep.seed = static_cast<std::uint64_t>(r.integer(clumps, "clumps", "seed", false, 1, 0));
+    // A generated specimen is replaced once it is made (scene_programmes).
+    if (s.specimen) return;
     if (s.particles.empty()) r.fail("clumps.replace", "the packing has no spheres to replace");
-    std::mt19937_64 rng(
-        static_cast<std::uint64_t>(r.integer(clumps, "clumps", "seed", false, 1, 0)));
-    auto rep =
-        replace_by_clumps(s.particles, it->second, s.config.material.density, model, rng, 0, 0);
-    // Members take the spheres' place (ids 0…), clumps are numbered after them.
-    s.particles = rep.members;
-    std::int64_t next = static_cast<std::int64_t>(s.particles.size());
-    for (auto& c : rep.clumps) {
-      c.id = next++;
-      c.template_name = name;
-      for (const auto i : c.members) s.particles[i].clump_id = c.id;
-    }
-    s.clumps = std::move(rep.clumps);
+    replace_spheres_by_clumps(s);
     return;
   }
   if (clumps->contains("seed")) r.fail("clumps.seed", "only with replace");
@@ -608,7 +722,29 @@ void check_output_names(const Reader& r, const Scene& s) {
 
 }  // namespace
 
-Scene load_scene(const std::filesystem::path& path) {
+namespace {
+// The shortest text that reads back as `d` (0.1, not 0.10000000000000001): a run directory's name.
+std::string shortest_text(double d) {
+  char buf[40];
+  for (int digits = 1; digits <= 17; ++digits) {
+    std::snprintf(buf, sizeof buf, "%.*g", digits, d);
+    if (std::strtod(buf, nullptr) == d) break;
+  }
+  return buf;
+}
+}  // namespace
+
+bool scene_has_sweep(const std::filesystem::path& path) {
+  try {
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(path, ec)) return false;
+    return toml::parse_file(path.string()).contains("sweep");
+  } catch (const std::exception&) {
+    return false;
+  }
+}
+
+Scene load_scene(const std::filesystem::path& path, int sweep_point) {
   const std::string file = path.string();
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec)) throw InputError(file, "no such scene file");
@@ -623,6 +759,48 @@ Scene load_scene(const std::filesystem::path& path) {
   const Reader r{file, root};
   Scene s;
   s.file = path;
+  // [sweep]: key = "section.key", values = [...]: one run per value (cmd_simulate); point i
+  // loads the scene with the key set to values[i] (point 0 when none is asked for).
+  if (const auto* sw = r.table("sweep", false)) {
+    r.only(sw, "sweep", {"key", "values"});
+    const std::string key = r.string(sw, "sweep", "key", true, "");
+    const auto* values = (*sw)["values"].as_array();
+    if (!values || values->empty()) r.fail("sweep.values", "expected a non-empty array");
+    std::vector<std::string> parts;
+    {
+      std::string part;
+      std::istringstream in(key);
+      while (std::getline(in, part, '.')) parts.push_back(part);
+    }
+    if (parts.size() < 2 || parts[0] == "sweep")
+      r.fail("sweep.key", "expected SECTION.KEY of another section", key);
+    toml::table* t = &root;
+    for (std::size_t i = 0; i + 1 < parts.size(); ++i) {
+      t = (*t)[parts[i]].as_table();
+      if (!t) r.fail("sweep.key", "no such section", key);
+    }
+    auto& info = s.sweep.emplace();
+    info.key = key;
+    for (std::size_t i = 0; i < values->size(); ++i) {
+      const auto& v = *values->get(i);
+      if (const auto d = v.value<double>(); d && v.is_number())
+        info.values.push_back(shortest_text(*d));
+      else if (const auto str = v.value<std::string>())
+        info.values.push_back(*str);
+      else
+        r.fail("sweep.values", "expected numbers or strings", std::to_string(i));
+      const std::string& text = info.values.back();
+      if (text.empty() || text.find('/') != std::string::npos || text == "." || text == "..")
+        r.fail("sweep.values", "a value names a run directory: no '/' and not empty", text);
+    }
+    if (sweep_point >= static_cast<int>(values->size()))
+      r.fail("sweep.values", "no such point", std::to_string(sweep_point));
+    info.point = std::max(0, sweep_point);
+    values->get(static_cast<std::size_t>(info.point))->visit([&](auto&& v) {
+      t->insert_or_assign(parts.back(), v);
+    });
+    root.erase("sweep");
+  }
   for (const auto& [k, v] : root) {
     static const char* sections[] = {"scene",
                                      "material",
@@ -634,6 +812,7 @@ Scene load_scene(const std::filesystem::path& path) {
                                      "triaxial",
                                      "plane_strain",
                                      "direct_shear",
+                                     "interface_shear",
                                      "mesh",
                                      "outlet",
                                      "clump_template",
@@ -641,7 +820,8 @@ Scene load_scene(const std::filesystem::path& path) {
                                      "fill",
                                      "cell",
                                      "biaxial_periodic",
-                                     "silo"};
+                                     "silo",
+                                     "sweep"};
     if (std::find(std::begin(sections), std::end(sections), k.str()) == std::end(sections))
       r.fail("[" + std::string(k.str()) + "]", "unknown section");
   }
@@ -650,10 +830,11 @@ Scene load_scene(const std::filesystem::path& path) {
   s.name = r.string(scene, "scene", "name", true, "");
   s.test = r.string(scene, "scene", "test", false, "");
   if (!s.test.empty() && s.test != "triaxial" && s.test != "plane_strain" &&
-      s.test != "direct_shear" && s.test != "biaxial_periodic" && s.test != "silo")
+      s.test != "direct_shear" && s.test != "interface_shear" && s.test != "biaxial_periodic" &&
+      s.test != "silo")
     r.fail("scene.test",
-           "expected \"triaxial\", \"plane_strain\", \"direct_shear\", \"biaxial_periodic\" "
-           "or \"silo\"",
+           "expected \"triaxial\", \"plane_strain\", \"direct_shear\", \"interface_shear\", "
+           "\"biaxial_periodic\" or \"silo\"",
            s.test);
   const auto* specimen = r.table("specimen", false);
   const bool has_packing = scene->contains("packing");
@@ -796,7 +977,7 @@ Scene load_scene(const std::filesystem::path& path) {
       sp.thickness_m = r.positive(specimen, "specimen", "thickness_m", false, 2 * sp.sizes.dmax_m);
     }
   }
-  double auto_dt_safety = 0;  // "auto": dt is set at the end, once clumps and fillings are in
+  double& auto_dt_safety = s.dt_auto_safety;  // "auto": dt is set once clumps and fillings are in
   if (sol->contains("dt_s") && (*sol)["dt_s"].is_string()) {
     if (r.string(sol, "solver", "dt_s", true, "") != "auto")
       r.fail("solver.dt_s", "expected a number or \"auto\"");
@@ -843,6 +1024,9 @@ Scene load_scene(const std::filesystem::path& path) {
   }
   read_lab_sections(r, root, s);
 
+  if (s.test == "interface_shear" && root.contains("outlet"))
+    r.fail("[outlet]",
+           "the interface shear test removes what falls off its surface; remove [outlet]");
   if (s.test == "silo" && root.contains("outlet"))
     r.fail("[outlet]", "the silo removes what leaves through its outlet; remove [outlet]");
   if (!s.test.empty() && root.contains("walls"))

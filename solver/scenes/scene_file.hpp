@@ -10,7 +10,9 @@
 #include <memory>
 #include <optional>
 
+#include "clump_shapes.hpp"
 #include "direct_shear.hpp"
+#include "interface_shear.hpp"
 #include "layered_filling.hpp"
 #include "loading_programme.hpp"
 #include "periodic_biaxial.hpp"
@@ -55,8 +57,16 @@ struct SpecimenSpec {
   double thickness_m = 0;
 };
 
+/// [sweep]: one run per value of a scene key.
+struct SweepInfo {
+  std::string key;                  // "section.key"
+  std::vector<std::string> values;  // as text (the run directories' names)
+  int point = 0;                    // the point loaded
+};
+
 struct Scene {
   std::string name;
+  std::optional<SweepInfo> sweep;
   std::filesystem::path file;
   SimulationConfig config;
   std::vector<Particle> particles;
@@ -64,6 +74,15 @@ struct Scene {
   /// [[clump_template]] + [clumps]: rigid clumps whose members were appended to `particles`
   /// (Simulation::set_clumps).
   std::vector<ClumpBody> clumps;
+  /// [clumps] replace = TEMPLATE: every sphere becomes a clump of its volume (seed 003 §2.4);
+  /// a generated specimen is replaced once scene_programmes has made it.
+  struct ClumpReplace {
+    std::string template_name;
+    std::vector<ClumpMember> shape;
+    ClumpMassModel model = ClumpMassModel::MemberSum;
+    std::uint64_t seed = 1;
+  };
+  std::optional<ClumpReplace> clump_replace;
   /// [outlet]: particles leaving [keep_lo, keep_hi] are removed (Simulation::set_outlet).
   std::optional<std::pair<Eigen::Vector3d, Eigen::Vector3d>> outlet;
   /// [fill]: layers inserted into a region before the `steps` run (LayeredFilling); the fill
@@ -85,10 +104,12 @@ struct Scene {
   std::int64_t steps = 0;
   OutputSpec output;
   std::vector<std::pair<std::string, std::string>> parameters;  // flattened, for run metadata
-  double dt_pwave = 0;  // YADE's PWaveTimeStep of the packing (s)
+  double dt_pwave = 0;        // YADE's PWaveTimeStep of the packing (s)
+  double dt_auto_safety = 0;  // dt_s = "auto": dt = dt_safety · dt_pwave (0: dt given)
 
   // Laboratory tests (docs/scenes.md): empty `test` is a plain run of `steps` steps.
-  std::string test;  // "", "triaxial", "plane_strain", "direct_shear", "biaxial_periodic", "silo"
+  // "", "triaxial", "plane_strain", "direct_shear", "interface_shear", "biaxial_periodic", "silo"
+  std::string test;
   std::optional<SpecimenSpec> specimen;
   std::optional<PreparationSpec> preparation;
   double wall_friction_deg = 0;  // smooth walls by default (seed 004 §4.1.2, seed 000 §3)
@@ -97,6 +118,9 @@ struct Scene {
   DirectShearSpec direct_shear;
   ShearBoxGeometry shear_box;
   PeriodicBiaxialSpec biaxial_periodic;
+  InterfaceShearSpec interface_shear;
+  InterfaceSurfaceSpec interface_surface;
+  InterfaceShearGeometry interface_geometry;
   SiloSpec silo;
 };
 
@@ -133,8 +157,18 @@ class FixedSteps final : public LoadingProgramme {
   std::int64_t first_ = 0;
 };
 
+/// Replaces the scene's spheres by clumps (scene.clump_replace; nothing when there are none or
+/// clumps already), the time step recomputed when it is "auto".
+void replace_spheres_by_clumps(Scene& scene);
+
 /// Reads and checks a scene file. Throws InputError "FILE: key: what (value)".
-Scene load_scene(const std::filesystem::path& path);
+/// Whether the file parses as TOML with a [sweep] section (false on any error: load_scene
+/// reports it).
+bool scene_has_sweep(const std::filesystem::path& path);
+
+/// `sweep_point`: with a [sweep] section, the point to load (its key set to values[point];
+/// negative: point 0). The scene's `sweep` then names the key, the values and the point.
+Scene load_scene(const std::filesystem::path& path, int sweep_point = -1);
 
 /// Dotted keys whose values differ between two scenes given as TOML text (keys present in only
 /// one included), sorted. What `simulate --resume` compares with the scene of the run it resumes.

@@ -24,16 +24,18 @@ SpecimenPreparation::SpecimenPreparation(PreparationSpec spec, SpecimenGauge gau
     throw std::invalid_argument("servo_gain of a cell is a fraction in (0, 1]");
 }
 
-double box_void_ratio(const ParticleState& p, const Eigen::Vector3d& lo,
-                      const Eigen::Vector3d& hi) {
+double box_void_ratio(const ParticleState& p, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi,
+                      double clump_solid_factor) {
   double solid = 0;
   for (std::size_t i = 0; i < p.size(); ++i) {
+    if (!p.removed.empty() && p.removed[i]) continue;
     const Eigen::Vector3d& c = p.pos[i];
     const double r = p.radius[i];
+    const double share = !p.clump.empty() && p.clump[i] >= 0 ? clump_solid_factor : 1.0;
     if (((c.array() - r) >= lo.array()).all() && ((c.array() + r) <= hi.array()).all())
-      solid += 4.0 / 3.0 * M_PI * r * r * r;  // wholly inside
+      solid += share * 4.0 / 3.0 * M_PI * r * r * r;  // wholly inside
     else if (((c.array() + r) > lo.array()).all() && ((c.array() - r) < hi.array()).all())
-      solid += sphere_box_volume(c, r, lo, hi);
+      solid += share * sphere_box_volume(c, r, lo, hi);
   }
   return (hi - lo).prod() / solid - 1;
 }
@@ -50,7 +52,7 @@ SpecimenGauge cell_gauge(int axes, double max_rate_1_s) {
 double SpecimenPreparation::void_ratio(const Simulation& sim) const {
   if (gauge_.cell_axes > 0) return cell_void_ratio(sim);
   const auto [lo, hi] = gauge_.box(sim);
-  return box_void_ratio(sim.particles(), lo, hi);
+  return box_void_ratio(sim.particles(), lo, hi, gauge_.clump_solid_factor);
 }
 
 double SpecimenPreparation::core_void_ratio(const Simulation& sim) const {
@@ -59,7 +61,7 @@ double SpecimenPreparation::core_void_ratio(const Simulation& sim) const {
   lo.array() += spec_.core_inset_m;
   hi.array() -= spec_.core_inset_m;
   if (((hi - lo).array() <= 0).any()) return std::numeric_limits<double>::quiet_NaN();
-  return box_void_ratio(sim.particles(), lo, hi);
+  return box_void_ratio(sim.particles(), lo, hi, gauge_.clump_solid_factor);
 }
 
 void SpecimenPreparation::start(Simulation& sim) {

@@ -50,13 +50,19 @@ struct SpecimenGauge {
   /// cell's (cell_void_ratio).
   int cell_axes = 0;
   double cell_max_rate_1_s = 1.0;
+  /// What a clump member counts of its sphere's volume in the void ratio (its clump's union
+  /// volume over the members' sum; 1 for spheres).
+  double clump_solid_factor = 1.0;
 };
 
 /// The gauge of a periodic cell servo-controlled on `axes` axes.
 SpecimenGauge cell_gauge(int axes, double max_rate_1_s);
 
-/// Void ratio of the box [lo, hi] from the exact sphere–box intersection volumes.
-double box_void_ratio(const ParticleState& p, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi);
+/// Void ratio of the box [lo, hi] from the exact sphere–box intersection volumes; the members of
+/// clumps count `clump_solid_factor` of their volume (their clump's union volume over the
+/// members' sum, for clumps of one template).
+double box_void_ratio(const ParticleState& p, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi,
+                      double clump_solid_factor = 1.0);
 
 class SpecimenPreparation final : public LoadingProgramme {
  public:

@@ -913,6 +913,68 @@ TEST_F(Figures, LabCurveDirectShearAndBadCurve) {
   EXPECT_TRUE(pngs(dir / "bad").empty());
 }
 
+// fig_labcurve on an interface-shear curve and on a silo curve (headers as InterfaceShear and
+// SiloFlow write them). Exact answers: φs and εv (%) against 1000 u (mm); P/G against the
+// bottom's travel (mm) in the quasi-static mode.
+TEST_F(Figures, LabCurveInterfaceShearAndSilo) {
+  gs::Trajectory t;
+  gs::Frame f;
+  gs::Particle q;
+  q.id = 1;
+  q.radius = 1e-3;
+  f.particles.push_back(q);
+  t.frames = {f};
+  gs::write_hdf5_trajectory(dir / "lab.h5", t);
+  const std::size_t n = 6;
+  {
+    std::ofstream o(dir / "curve.csv");
+    o << "step,time_s,u_m,u_over_L,T_N,P_N,tau_Pa,sigma_n_Pa,mu_eff,phi_s_deg,surface_T_N,"
+         "surface_P_N,surface_mu,dh_m,eps_v,void_ratio,coordination,particles_outside,"
+         "inertial_number\n";
+    for (std::size_t i = 0; i < n; ++i)
+      o << i << ",0," << 1e-3 * i << ",0,1,2,1,2," << 0.1 * i << "," << 5.0 * i << ",1,2,0.5,0,"
+        << 0.002 * i << ",0.7,4,0,1e-4\n";
+  }
+  const CliRun is = run("figures " + p("lab.h5") + " -o " + p("is") + " --type labcurve");
+  ASSERT_EQ(is.rc, 0) << is.err;
+  const Plotted pi = read_plotted(dir / "is" / "lab_curve.png");
+  const int ai = pi.axes("lab: interface shear");
+  ASSERT_GE(ai, 0);
+  const auto c = read_csv(dir / "curve.csv");
+  std::vector<double> umm, phi, evpct;
+  for (std::size_t i = 0; i < n; ++i) {
+    umm.push_back(1e3 * c.at("u_m")[i]);
+    phi.push_back(c.at("phi_s_deg")[i]);
+    evpct.push_back(100 * c.at("eps_v")[i]);
+  }
+  expect_same(pi.nums("line_x", ai, 0), umm, "u (mm)");
+  expect_same(pi.nums("line_y", ai, 0), phi, "phi_s");
+  int aev = -1;
+  for (int i = 0; pi.has("title", i); ++i)
+    if (pi.text("ylabel", i) == "volumetric strain εv (%, dilation +)") aev = i;
+  ASSERT_GE(aev, 0);
+  expect_same(pi.nums("line_y", aev, 0), evpct, "eps_v (%)");
+  {
+    std::ofstream o(dir / "curve.csv");
+    o << "time_s,flow_time_s,u_m,G_N,P_N,T_left_N,T_right_N,N_left_N,N_right_N,P_G,T_left_G,"
+         "T_right_G,N_left_G,N_right_G,balance_G,phi_w_left_deg,phi_w_right_deg,"
+         "discharged_kg,discharged_fraction,inertial_number,void_ratio\n";
+    for (std::size_t i = 0; i < n; ++i)
+      o << i << ",0," << 1e-3 * i << ",10,5,2,2,4,4," << 0.5 + 0.01 * i
+        << ",0.2,0.2,0.4,0.4,1,26,26,0,0,1e-5,0.6\n";
+  }
+  const CliRun si = run("figures " + p("lab.h5") + " -o " + p("si") + " --type labcurve");
+  ASSERT_EQ(si.rc, 0) << si.err;
+  const Plotted ps = read_plotted(dir / "si" / "lab_curve.png");
+  const int as = ps.axes("lab: silo");
+  ASSERT_GE(as, 0);
+  const auto cs = read_csv(dir / "curve.csv");
+  std::vector<double> smm;
+  for (std::size_t i = 0; i < n; ++i) smm.push_back(1e3 * cs.at("u_m")[i]);
+  expect_same(ps.nums("line_x", as, 0), smm, "u (mm)");
+  expect_same(ps.nums("line_y", as, 0), cs.at("P_G"), "P/G");
+}
+
 // Files of the right format with malformed datasets: one line `error: FILE: fig_x: what`, exit
 // 2, no figure, never a Python traceback (fig_dic used to crash in imshow on a 2-D field).
 TEST_F(Figures, MalformedInputsAreOneErrorLine) {

@@ -1,0 +1,139 @@
+// `granoscope analyze interface RUN.h5`: the interface shear zone of seed 004 §4.3–4.4 in one
+// frame of an interface shear run (analysis/interface_zone.hpp): the profiles of the mean
+// rotation and of the horizontal displacement against the height above the surface, the zone's
+// boundaries and thickness from the rotation profile's inflections, and the slip at the surface.
+#include <CLI/CLI.hpp>
+#include <cmath>
+#include <cstdio>
+#include <optional>
+#include <string>
+
+#include "analyze_common.hpp"
+#include "commands.hpp"
+#include "errors.hpp"
+#include "field_output.hpp"
+#include "grain_size.hpp"
+#include "interface_zone.hpp"
+#include "trajectory_io.hpp"
+
+namespace gs::cli {
+namespace {
+
+namespace ga = gs::analysis;
+
+struct InterfaceArgs {
+  std::string input, output, csv;
+  long frame = -1, from = 0;
+  std::optional<double> surface_z, d50, bin, bin_d50;
+  double inset_d50 = 2.0;
+};
+
+long frame_index(const std::string& file, const char* name, long i, long n) {
+  const long k = i < 0 ? n + i : i;
+  if (k < 0 || k >= n)
+    throw InputError(file, std::string(name) + ": no such frame (" + std::to_string(n) + " frames)",
+                     std::to_string(i));
+  return k;
+}
+
+void run_interface(const InterfaceArgs& a) {
+  const Trajectory t = read_snapshots(a.input);
+  if (t.frames.empty()) throw InputError(a.input, "no frames");
+  const long n = static_cast<long>(t.frames.size());
+  const long k = frame_index(a.input, "--frame", a.frame, n);
+  const long r = frame_index(a.input, "--from", a.from, n);
+  const Frame& f = t.frames[static_cast<std::size_t>(k)];
+  if (f.particles.empty())
+    throw InputError(a.input, "frame " + std::to_string(k) + " has no particles");
+  if (a.d50) require_positive(a.input, "--d50", *a.d50);
+  const double d50 = a.d50 ? *a.d50 : ga::d50(f);
+  ga::InterfaceZoneOptions o;
+  // The surface's mean level: given, or what the interface shear run recorded.
+  if (a.surface_z) {
+    if (!std::isfinite(*a.surface_z))
+      throw InputError(a.input, "--surface-z: not finite", value_str(*a.surface_z));
+    o.surface_z = *a.surface_z;
+  } else {
+    bool found = false;
+    for (const auto& [key, v] : t.metadata.parameters)
+      if (key == "interface_shear.surface_mean_z_m") {
+        char* end = nullptr;
+        o.surface_z = std::strtod(v.c_str(), &end);
+        found = end != v.c_str() && std::isfinite(o.surface_z);
+      }
+    if (!found)
+      throw InputError(a.input,
+                       "--surface-z: needed (the file does not record an interface shear surface)");
+  }
+  o.bin = length_option(a.input, "--bin", a.bin, a.bin_d50, 1.0, d50);
+  if (!(a.inset_d50 >= 0) || !std::isfinite(a.inset_d50))
+    throw InputError(a.input, "--inset-d50: must not be negative", value_str(a.inset_d50));
+  o.x_inset = a.inset_d50 * d50;
+  if (r != k) o.reference = &t.frames[static_cast<std::size_t>(r)];
+  ga::InterfaceZone z;
+  try {
+    z = ga::interface_zone(f, o);
+  } catch (const std::invalid_argument& e) {
+    throw InputError(a.input, "frame " + std::to_string(k) + ": " + e.what());
+  }
+  H5FieldFile h(a.output, "granoscope-interface");
+  h.attr("source", a.input);
+  h.attr("frame", static_cast<long long>(k));
+  h.attr("reference_frame", static_cast<long long>(r));
+  h.attr("time_s", f.time);
+  h.attr("d50", d50);
+  h.attr("bin", o.bin);
+  h.attr("surface_z_m", o.surface_z);
+  h.attr("x_lo_m", z.x_lo);
+  h.attr("x_hi_m", z.x_hi);
+  h.attr("peak_height_m", z.peak_height);
+  h.attr("zone_lower_m", z.lower);
+  h.attr("zone_upper_m", z.upper);
+  h.attr("zone_thickness_m", z.thickness);
+  h.attr("u_top_m", z.u_top);
+  h.attr("u_surface_m", z.u_surface);
+  h.attr("slip_ratio", z.slip_ratio);
+  h.write("/height_m", z.height);
+  h.write("/rotation_rad", z.rotation);
+  h.write("/displacement_x_m", z.displacement);
+  h.write("/count", z.count);
+  h.commit();
+  if (!a.csv.empty())
+    write_csv_table(a.csv, {{"height_m", 1, z.height},
+                            {"rotation_rad", 1, z.rotation},
+                            {"displacement_x_m", 1, z.displacement},
+                            {"count", 1, z.count}});
+  std::printf(
+      "interface zone, frame %ld (t = %.4g s): rotation peak %.2f d50 above the surface, zone "
+      "%.2f to %.2f d50 (thickness %.2f d50); displacement since frame %ld: top %.4g m, at the "
+      "surface %.4g m (slip ratio %.3f)\n",
+      k, f.time, z.peak_height / d50, z.lower / d50, z.upper / d50, z.thickness / d50, r, z.u_top,
+      z.u_surface, z.slip_ratio);
+}
+
+}  // namespace
+
+void register_analyze_interface(CLI::App& app) {
+  auto& analyze = analyze_command(app);
+  auto a = std::make_shared<InterfaceArgs>();
+  auto* s = analyze.add_subcommand(
+      "interface",
+      "Interface shear zone (seed 004 §4.3-4.4): rotation and displacement profiles against the "
+      "height above the surface, the zone's thickness from the rotation profile's inflections, "
+      "the slip at the surface");
+  s->add_option("input", a->input, "trajectory of an interface shear run")->required();
+  s->add_option("-o,--output", a->output, "output HDF5 (format granoscope-interface)")->required();
+  s->add_option("--csv", a->csv, "also write the profiles as CSV");
+  s->add_option("--frame", a->frame, "frame index, negative from the end (default -1: the last)");
+  s->add_option("--from", a->from, "reference frame of the displacements (default 0)");
+  s->add_option("--surface-z", a->surface_z,
+                "the surface's mean level in m (default: recorded by the interface shear run)");
+  s->add_option("--bin", a->bin, "profile bin in m");
+  s->add_option("--bin-d50", a->bin_d50, "profile bin in d50 (default 1)");
+  s->add_option("--inset-d50", a->inset_d50,
+                "profiles this far in from the specimen's ends, d50 (default 2)");
+  s->add_option("--d50", a->d50, "d50 in m (default: from the frame)");
+  s->callback([a] { run_interface(*a); });
+}
+
+}  // namespace gs::cli

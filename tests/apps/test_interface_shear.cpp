@@ -1,0 +1,134 @@
+// `simulate` of the interface shear test (seed 004 §4.3–4.4) end to end: on a flat surface the
+// specimen slides as a block and the surface's friction is what the test measures (Coulomb:
+// T = tan μs · P exactly once every contact slides); a sweep over the roughness writes one run
+// per value and the table of their results; a killed run resumes bit for bit; bad inputs.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+
+#include "../io/test_util.hpp"
+#include "cli_util.hpp"
+
+namespace {
+
+using gs::test::read_csv_table;
+using gs::test::replaced;
+using gs::test::run_cli;
+
+// ~330 spheres of 0.8–1.2 mm in a 12 × 4 × 6 mm box under σn = 100 kPa, no gravity (so that the
+// platen's force is all the surface carries), Table 4.4's sphere material.
+std::string scene(const std::string& surface, const std::string& extra = "") {
+  return "[scene]\nname = \"is\"\ntest = \"interface_shear\"\n"
+         "[specimen]\nsize_m = [0.012, 0.004, 0.006]\ndmin_m = 0.0008\ndmax_m = 0.0012\n"
+         "void_ratio = 0.6\nseed = 1\ncloud_solid_fraction = 0.3\n"
+         "[material]\nyoung_Pa = 3.0e8\nstiffness_ratio = 0.3\nfriction_deg = 18.0\n"
+         "density_kg_m3 = 2600.0\nrolling_stiffness = 0.7\nrolling_limit = 0.4\n"
+         "rolling_limit_radius = \"mean\"\n"
+         "[solver]\ndt_s = \"auto\"\ndt_safety = 0.6\ndamping = 0.08\nthreads = 2\n"
+         "[preparation]\nstage_steps = 2000\nmax_wall_speed_m_s = 0.5\n"
+         "[interface_shear]\n" +
+         surface +
+         "surface_friction_deg = 18.0\nnormal_stress_Pa = 1.0e5\nshear_velocity_m_s = 0.05\n" +
+         extra +
+         "[output]\nevery = 100000\ncurve_every = 200\nhistory_every = 1000\n"
+         "checkpoint_every = 10000\n";
+}
+
+}  // namespace
+
+// Seed 004 §4.3.3: on the nearly flat surface "the entire sand mass behaved like a rigid body"
+// and φs is the surface's friction. With every surface contact sliding, the surface's own
+// T/P is tan 18° to rounding, and the frame's μeff = T/P is that too once the block slides
+// steadily (no gravity: the platen's force is the surface's).
+TEST(InterfaceShear, FlatSurfaceSlidesAtItsFriction) {
+  gs::test::ScratchDir dir("is_flat");
+  std::ofstream(dir / "is.toml") << scene("surface = \"flat\"\n", "max_displacement_m = 0.001\n");
+  const auto r = run_cli(
+      "simulate " + (dir / "is.toml").string() + " -q -o " + (dir / "out").string(), dir.path);
+  ASSERT_EQ(r.rc, 0) << r.err;
+  const auto c = read_csv_table(dir / "out" / "curve.csv");
+  ASSERT_GE(c.rows.size(), 50u);
+  const double mu = std::tan(18.0 * M_PI / 180.0);
+  const std::size_t last = c.rows.size() - 1;
+  EXPECT_NEAR(c.num(last, "u_m"), 0.001, 1e-6);
+  EXPECT_NEAR(c.num(last, "surface_mu"), mu, 1e-6 * mu);
+  EXPECT_NEAR(c.num(last, "sigma_n_Pa"), 1e5, 0.01e5);
+  // The surface carries what the platen pushes: P_surface = P_platen (no gravity) to 1 %.
+  EXPECT_NEAR(c.num(last, "surface_P_N"), c.num(last, "P_N"), 0.01 * c.num(last, "P_N"));
+  const std::string text = gs::test::slurp(dir / "out" / "results.csv");
+  auto value = [&](const std::string& name) {
+    const auto at = text.find("\n" + name + ",");
+    EXPECT_NE(at, std::string::npos) << name;
+    return std::strtod(text.c_str() + at + name.size() + 2, nullptr);
+  };
+  EXPECT_NEAR(value("mu_eff_res"), mu, 0.01 * mu);
+  EXPECT_NEAR(value("phi_s_res_deg"), 18.0, 0.2);
+  // A block sliding on a flat plate neither dilates nor contracts (Table 4.5, R_n = 0.01: 0).
+  EXPECT_LT(std::abs(value("eps_v_res")), 1e-3);
+}
+
+// A sweep over R_n: one run directory per value, each with its results, and sweep.csv with one
+// row per value; run again with --resume, the complete runs are read back, not rerun.
+TEST(InterfaceShear, SweepWritesOneRunPerValueAndTheirTable) {
+  gs::test::ScratchDir dir("is_sweep");
+  std::ofstream(dir / "is.toml") << scene(
+      "surface = \"saw_tooth\"\nroughness = 1.0\nd50_m = 0.001\n",
+      "max_displacement_m = 0.0003\n[sweep]\nkey = \"interface_shear.roughness\"\n"
+      "values = [0.5, 1.0]\n");
+  const auto r = run_cli(
+      "simulate " + (dir / "is.toml").string() + " -q -o " + (dir / "out").string(), dir.path);
+  ASSERT_EQ(r.rc, 0) << r.err;
+  const auto t = read_csv_table(dir / "out" / "sweep.csv");
+  ASSERT_EQ(t.rows.size(), 2u);
+  EXPECT_EQ(t.num(0, "roughness"), 0.5);
+  EXPECT_EQ(t.num(1, "roughness"), 1.0);
+  for (std::size_t i = 0; i < 2; ++i) {
+    const auto run = dir / "out" / (i == 0 ? "roughness_0.5" : "roughness_1");
+    ASSERT_TRUE(std::filesystem::exists(run / "curve.csv")) << run;
+    const auto c = read_csv_table(run / "curve.csv");
+    EXPECT_NEAR(c.num(c.rows.size() - 1, "u_m"), 0.0003, 1e-6);
+    EXPECT_GT(t.num(i, "mu_eff_max"), 0.0);
+    // Each run's scene: its own roughness (the teeth are R_n·d50 high).
+    const std::string copy = gs::test::slurp(run / "results.csv");
+    EXPECT_NE(copy.find("mu_eff_max,"), std::string::npos);
+  }
+  const std::string before = gs::test::slurp(dir / "out" / "sweep.csv");
+  const auto again = run_cli(
+      "simulate " + (dir / "is.toml").string() + " -q --resume -o " + (dir / "out").string(),
+      dir.path);
+  ASSERT_EQ(again.rc, 0) << again.err;
+  EXPECT_NE(again.out.find("nothing to resume"), std::string::npos) << again.out;
+  EXPECT_EQ(gs::test::slurp(dir / "out" / "sweep.csv"), before);
+}
+
+// Killed while shearing (the preparation ends near step 60 000), resumed: the curve, the history
+// and the results are the uninterrupted run's.
+TEST(InterfaceShear, ResumeIsBitForBit) {
+  gs::test::ScratchDir dir("is_resume");
+  std::ofstream(dir / "is.toml") << scene(
+      "surface = \"saw_tooth\"\nroughness = 0.5\nd50_m = 0.001\n", "max_displacement_m = 0.0008\n");
+  gs::test::expect_resume_bit_for_bit(dir.path, (dir / "is.toml").string(), {70000},
+                                      {"history.csv", "curve.csv", "results.csv"}, "trajectory.h5");
+}
+
+TEST(InterfaceShear, BadInputIsOneLine) {
+  gs::test::ScratchDir dir("is_bad");
+  const std::string saw = "surface = \"saw_tooth\"\nroughness = 1.0\nd50_m = 0.001\n";
+  const std::string u = "max_displacement_m = 0.001\n";
+  gs::test::expect_bad_scenes(
+      dir.path,
+      {{scene(replaced(saw, "roughness = 1.0", "roughness = 0.00048828125"), u),
+        "interface_shear.roughness: gives teeth below 1e-3·d50 (0.00048828125)"},
+       {scene(saw + "depth_ratio = 0.2\n", u),
+        "interface_shear.depth_ratio: is for surface = \"sinusoid\""},
+       {scene("surface = \"sinusoid\"\nwavelength_m = 0.015\ndepth_ratio = 1.5\n", u),
+        "interface_shear.depth_ratio: outside [0, 1) (1.5)"},
+       {scene("surface = \"bumpy\"\n", u), "interface_shear.surface: expected"},
+       {scene(saw, u + "[sweep]\nkey = \"nowhere.roughness\"\nvalues = [1.0]\n"),
+        "sweep.key: no such section (nowhere.roughness)"},
+       {scene(saw, u + "[sweep]\nkey = \"interface_shear.roughness\"\nvalues = []\n"),
+        "sweep.values: expected a non-empty array"},
+       {scene(saw, u + "[sweep]\nkey = \"interface_shear.roughness\"\nvalues = [\"a/b\"]\n"),
+        "sweep.values: a value names a run directory"}});
+}
