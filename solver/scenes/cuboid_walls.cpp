@@ -1,5 +1,7 @@
 #include "cuboid_walls.hpp"
 
+#include "errors.hpp"
+
 #include <cmath>
 
 namespace gs::solver {
@@ -74,6 +76,26 @@ SpecimenGauge cuboid_gauge() {
   g.inward = [](const Simulation&, std::size_t w) { return cuboid_inward(w); };
   g.area_m2 = [](const Simulation& sim, std::size_t w) { return cuboid_face_area(sim, w); };
   return g;
+}
+
+SpecimenGauge platen_gauge(double length_m, double width_m, double platen_thickness_m,
+                           std::size_t platen, double floor_z_m) {
+  SpecimenGauge gauge;
+  gauge.servo_walls = {platen};
+  const double area = length_m * width_m, t = platen_thickness_m;
+  gauge.inward = [](const Simulation&, std::size_t) { return Eigen::Vector3d(0, 0, -1); };
+  gauge.area_m2 = [area](const Simulation&, std::size_t) { return area; };
+  const Eigen::Vector3d lo(0, 0, floor_z_m);
+  const Eigen::Vector2d footprint(length_m, width_m);
+  gauge.box = [lo, footprint, t, platen](const Simulation& sim) {
+    return std::make_pair(
+        lo, Eigen::Vector3d(footprint.x(), footprint.y(), sim.walls()[platen].pos.z() - 0.5 * t));
+  };
+  return gauge;
+}
+
+void require_value(bool ok, const std::string& key, double value, const std::string& what) {
+  if (!ok) throw std::invalid_argument(key + ": " + what + " (" + value_str(value) + ")");
 }
 
 }  // namespace gs::solver

@@ -34,6 +34,15 @@ Eigen::Vector3d cuboid_inward(std::size_t f);
 /// Area of face f of the current box.
 double cuboid_face_area(const Simulation& sim, std::size_t f);
 
+/// Gauge of a specimen under a servo-controlled box platen (direct and interface shear): the
+/// platen (its underside pressing −z over length × width) is the only servo wall; the box is
+/// [0, length] × [0, width] from `floor_z` up to the platen's underside.
+SpecimenGauge platen_gauge(double length_m, double width_m, double platen_thickness_m,
+                           std::size_t platen, double floor_z_m);
+
+/// A scene key's check: throws std::invalid_argument "KEY: WHAT (VALUE)" unless `ok`.
+void require_value(bool ok, const std::string& key, double value, const std::string& what);
+
 /// Σ 4/3·π·r³ over all particles.
 double solid_volume(const Simulation& sim);
 

@@ -36,19 +36,7 @@ std::vector<WallSpec> shear_box_walls(const ShearBoxGeometry& g, ShearBoxWalls& 
 }
 
 SpecimenGauge shear_box_gauge(const ShearBoxGeometry& g, const ShearBoxWalls& w) {
-  SpecimenGauge gauge;
-  gauge.servo_walls = {w.platen};
-  const double area = g.length_m * g.width_m, t = g.wall_thickness_m;
-  const std::size_t platen = w.platen;
-  gauge.inward = [](const Simulation&, std::size_t) { return Eigen::Vector3d(0, 0, -1); };
-  gauge.area_m2 = [area](const Simulation&, std::size_t) { return area; };
-  const Eigen::Vector2d footprint(g.length_m, g.width_m);
-  gauge.box = [footprint, t, platen](const Simulation& sim) {
-    return std::make_pair(
-        Eigen::Vector3d::Zero().eval(),
-        Eigen::Vector3d(footprint.x(), footprint.y(), sim.walls()[platen].pos.z() - 0.5 * t));
-  };
-  return gauge;
+  return platen_gauge(g.length_m, g.width_m, g.wall_thickness_m, w.platen, 0.0);
 }
 
 DirectShear::DirectShear(DirectShearSpec spec, ShearBoxGeometry geometry, ShearBoxWalls walls)

@@ -14,10 +14,6 @@ namespace gs::solver {
 
 namespace {
 
-void require(bool ok, const std::string& key, double v, const std::string& what) {
-  if (!ok) throw std::invalid_argument(key + ": " + what + " (" + value_str(v) + ")");
-}
-
 double rad(double deg) {
   return deg * M_PI / 180.0;
 }
@@ -43,12 +39,12 @@ std::vector<WallSpec> interface_shear_walls(const InterfaceSurfaceSpec& s,
                                             InterfaceShearGeometry& g, double dmax_m,
                                             InterfaceShearWalls& index) {
   const std::string sec = "interface_shear.";
-  require(g.length_m > 0, "specimen.size_m", g.length_m, "length must be positive");
-  require(g.width_m > 0, "specimen.size_m", g.width_m, "width must be positive");
-  require(g.height_m > 0, "specimen.size_m", g.height_m, "height must be positive");
-  require(dmax_m > 0, "specimen.dmax_m", dmax_m, "must be positive");
-  require(g.travel_m > 0, sec + "max_displacement_m", g.travel_m, "must be positive");
-  require(g.wall_thickness_m > 0, "wall thickness", g.wall_thickness_m, "must be positive");
+  require_value(g.length_m > 0, "specimen.size_m", g.length_m, "length must be positive");
+  require_value(g.width_m > 0, "specimen.size_m", g.width_m, "width must be positive");
+  require_value(g.height_m > 0, "specimen.size_m", g.height_m, "height must be positive");
+  require_value(dmax_m > 0, "specimen.dmax_m", dmax_m, "must be positive");
+  require_value(g.travel_m > 0, sec + "max_displacement_m", g.travel_m, "must be positive");
+  require_value(g.wall_thickness_m > 0, "wall thickness", g.wall_thickness_m, "must be positive");
   if (g.gap_m < 0) g.gap_m = dmax_m;
   const double L = g.length_m, W = g.width_m, t = g.wall_thickness_m;
   // The surface runs from before the frame's start to beyond its end of travel, whole periods;
@@ -58,20 +54,21 @@ std::vector<WallSpec> interface_shear_walls(const InterfaceSurfaceSpec& s,
   std::vector<WallSpec> w;
   index.surface_begin = 0;
   if (s.kind == "saw_tooth") {
-    require(s.d50_m > 0, sec + "d50_m", s.d50_m, "must be positive");
-    require(s.roughness > 0, sec + "roughness", s.roughness,
-            "must be positive (flat: surface = \"flat\")");
+    require_value(s.d50_m > 0, sec + "d50_m", s.d50_m, "must be positive");
+    require_value(s.roughness > 0, sec + "roughness", s.roughness,
+                  "must be positive (flat: surface = \"flat\")");
     const double hg = s.roughness * s.d50_m;
-    require(hg >= 1e-3 * s.d50_m, sec + "roughness", s.roughness, "gives teeth below 1e-3·d50");
-    require(s.tooth_slope_deg > 0 && s.tooth_slope_deg < 90, sec + "tooth_slope_deg",
-            s.tooth_slope_deg, "outside (0, 90)");
+    require_value(hg >= 1e-3 * s.d50_m, sec + "roughness", s.roughness,
+                  "gives teeth below 1e-3·d50");
+    require_value(s.tooth_slope_deg > 0 && s.tooth_slope_deg < 90, sec + "tooth_slope_deg",
+                  s.tooth_slope_deg, "outside (0, 90)");
     const double base = 2 * hg / std::tan(rad(s.tooth_slope_deg));
     const double sg = s.tooth_spacing_ratio * hg;
-    require(sg >= base * (1 - 1e-9), sec + "tooth_spacing_ratio", s.tooth_spacing_ratio,
-            "teeth wider than their spacing");
+    require_value(sg >= base * (1 - 1e-9), sec + "tooth_spacing_ratio", s.tooth_spacing_ratio,
+                  "teeth wider than their spacing");
     const double before = std::ceil(margin / sg), after = std::ceil((L + g.travel_m + margin) / sg);
-    require(before + after <= 2e5, sec + "roughness", s.roughness,
-            "more than 200 000 teeth along the surface");
+    require_value(before + after <= 2e5, sec + "roughness", s.roughness,
+                  "more than 200 000 teeth along the surface");
     SawToothSpec st;
     st.origin = Eigen::Vector3d(-before * sg, 0, 0);
     st.length_m = (before + after) * sg;
@@ -88,11 +85,11 @@ std::vector<WallSpec> interface_shear_walls(const InterfaceSurfaceSpec& s,
     g.surface_x0_m = st.origin.x();
     g.surface_x1_m = st.origin.x() + st.length_m;
   } else if (s.kind == "sinusoid" && s.depth_ratio != 0) {
-    require(s.wavelength_m > 0, sec + "wavelength_m", s.wavelength_m, "must be positive");
-    require(s.depth_ratio > 0 && s.depth_ratio < 1, sec + "depth_ratio", s.depth_ratio,
-            "outside [0, 1)");
-    require(s.segments_per_wavelength >= 4, sec + "segments_per_wavelength",
-            s.segments_per_wavelength, "must be at least 4");
+    require_value(s.wavelength_m > 0, sec + "wavelength_m", s.wavelength_m, "must be positive");
+    require_value(s.depth_ratio > 0 && s.depth_ratio < 1, sec + "depth_ratio", s.depth_ratio,
+                  "outside [0, 1)");
+    require_value(s.segments_per_wavelength >= 4, sec + "segments_per_wavelength",
+                  s.segments_per_wavelength, "must be at least 4");
     const double l = s.wavelength_m, d = s.depth_ratio * l;
     const double before = std::ceil(margin / l), after = std::ceil((L + g.travel_m + margin) / l);
     SinusoidSpec ss;
@@ -124,8 +121,8 @@ std::vector<WallSpec> interface_shear_walls(const InterfaceSurfaceSpec& s,
   g.surface_triangles = 0;
   for (std::size_t k = index.surface_begin; k < index.surface_end; ++k)
     g.surface_triangles += w[k].facets.size();
-  require(g.platen_z_m > g.crest_z_m, "platen", g.platen_z_m, "below the surface's crests");
-  require(g.frame_top_m > g.platen_z_m, "frame top", g.frame_top_m, "below the platen");
+  require_value(g.platen_z_m > g.crest_z_m, "platen", g.platen_z_m, "below the surface's crests");
+  require_value(g.frame_top_m > g.platen_z_m, "frame top", g.frame_top_m, "below the platen");
   const double x0 = g.surface_x0_m, x1 = g.surface_x1_m, zb = g.trough_z_m - t;
   const double zf = g.crest_z_m + g.gap_m;  // the frame's lower edge
   const double ff = g.frame_friction_deg;
@@ -148,19 +145,9 @@ std::vector<WallSpec> interface_shear_walls(const InterfaceSurfaceSpec& s,
 }
 
 SpecimenGauge interface_shear_gauge(const InterfaceShearGeometry& g, const InterfaceShearWalls& w) {
-  SpecimenGauge gauge;
-  gauge.servo_walls = {w.platen};
-  const double area = g.length_m * g.width_m, t = g.wall_thickness_m;
-  const std::size_t platen = w.platen;
-  gauge.inward = [](const Simulation&, std::size_t) { return Eigen::Vector3d(0, 0, -1); };
-  gauge.area_m2 = [area](const Simulation&, std::size_t) { return area; };
-  const Eigen::Vector3d lo(0, 0, g.crest_z_m);
-  const Eigen::Vector2d footprint(g.length_m, g.width_m);
+  SpecimenGauge gauge =
+      platen_gauge(g.length_m, g.width_m, g.wall_thickness_m, w.platen, g.crest_z_m);
   gauge.clump_solid_factor = g.clump_solid_factor;
-  gauge.box = [lo, footprint, t, platen](const Simulation& sim) {
-    return std::make_pair(
-        lo, Eigen::Vector3d(footprint.x(), footprint.y(), sim.walls()[platen].pos.z() - 0.5 * t));
-  };
   return gauge;
 }
 
@@ -168,16 +155,16 @@ InterfaceShear::InterfaceShear(InterfaceShearSpec spec, InterfaceShearGeometry g
                                InterfaceShearWalls w)
     : MeasuredProgramme({spec.max_displacement_m, spec.frame_every_m}), spec_(spec), g_(g), w_(w) {
   const std::string sec = "interface_shear.";
-  require(spec_.normal_stress_Pa > 0, sec + "normal_stress_Pa", spec_.normal_stress_Pa,
-          "must be positive");
-  require(spec_.shear_velocity_m_s > 0, sec + "shear_velocity_m_s", spec_.shear_velocity_m_s,
-          "must be positive");
-  require(spec_.max_displacement_m > 0, sec + "max_displacement_m", spec_.max_displacement_m,
-          "must be positive");
-  require(spec_.residual_fraction > 0 && spec_.residual_fraction < 1, sec + "residual_fraction",
-          spec_.residual_fraction, "outside (0, 1)");
-  require(spec_.internal_friction_deg > 0 && spec_.internal_friction_deg < 90,
-          sec + "internal_friction_deg", spec_.internal_friction_deg, "outside (0, 90)");
+  require_value(spec_.normal_stress_Pa > 0, sec + "normal_stress_Pa", spec_.normal_stress_Pa,
+                "must be positive");
+  require_value(spec_.shear_velocity_m_s > 0, sec + "shear_velocity_m_s", spec_.shear_velocity_m_s,
+                "must be positive");
+  require_value(spec_.max_displacement_m > 0, sec + "max_displacement_m", spec_.max_displacement_m,
+                "must be positive");
+  require_value(spec_.residual_fraction > 0 && spec_.residual_fraction < 1,
+                sec + "residual_fraction", spec_.residual_fraction, "outside (0, 1)");
+  require_value(spec_.internal_friction_deg > 0 && spec_.internal_friction_deg < 90,
+                sec + "internal_friction_deg", spec_.internal_friction_deg, "outside (0, 90)");
   if (!(spec_.frame_every_m > 0)) spec_.frame_every_m = spec_.max_displacement_m / 10;
   target_ = {spec_.max_displacement_m, spec_.frame_every_m};
 }

@@ -15,10 +15,6 @@ namespace gs::solver {
 
 namespace {
 
-void require(bool ok, const std::string& key, double v, const std::string& what) {
-  if (!ok) throw std::invalid_argument(key + ": " + what + " (" + value_str(v) + ")");
-}
-
 double rad(double deg) {
   return deg * M_PI / 180.0;
 }
@@ -26,26 +22,26 @@ double rad(double deg) {
 }  // namespace
 
 std::vector<WallSpec> silo_walls(const SiloSpec& s, double d50_m, double dmax_m, SiloWalls& index) {
-  require(s.width_m > 0, "silo.width_m", s.width_m, "must be positive");
-  require(s.height_m > 0, "silo.height_m", s.height_m, "must be positive");
-  require(s.depth_m > 0, "silo.depth_m", s.depth_m, "must be positive");
-  require(d50_m > 0, "silo.d50_m", d50_m, "must be positive");
-  require(dmax_m > 0, "fill.dmax_m", dmax_m, "must be positive");
-  require(s.roughness >= 0, "silo.roughness", s.roughness, "must not be negative");
+  require_value(s.width_m > 0, "silo.width_m", s.width_m, "must be positive");
+  require_value(s.height_m > 0, "silo.height_m", s.height_m, "must be positive");
+  require_value(s.depth_m > 0, "silo.depth_m", s.depth_m, "must be positive");
+  require_value(d50_m > 0, "silo.d50_m", d50_m, "must be positive");
+  require_value(dmax_m > 0, "fill.dmax_m", dmax_m, "must be positive");
+  require_value(s.roughness >= 0, "silo.roughness", s.roughness, "must not be negative");
   const double hg = s.roughness * d50_m;
-  require(s.roughness == 0 || hg >= 1e-3 * d50_m, "silo.roughness", s.roughness,
-          "gives teeth below 1e-3·d50");
-  require(s.tooth_slope_deg > 0 && s.tooth_slope_deg < 90, "silo.tooth_slope_deg",
-          s.tooth_slope_deg, "outside (0, 90)");
+  require_value(s.roughness == 0 || hg >= 1e-3 * d50_m, "silo.roughness", s.roughness,
+                "gives teeth below 1e-3·d50");
+  require_value(s.tooth_slope_deg > 0 && s.tooth_slope_deg < 90, "silo.tooth_slope_deg",
+                s.tooth_slope_deg, "outside (0, 90)");
   const double base = 2 * hg / std::tan(rad(s.tooth_slope_deg));  // both faces at α_g
   const double sg = s.tooth_spacing_ratio * hg;
-  require(s.roughness == 0 || sg >= base * (1 - 1e-9), "silo.tooth_spacing_ratio",
-          s.tooth_spacing_ratio, "teeth wider than their spacing");
-  require(2 * hg < 0.5 * s.width_m, "silo.roughness", s.roughness,
-          "teeth take more than half the width");
+  require_value(s.roughness == 0 || sg >= base * (1 - 1e-9), "silo.tooth_spacing_ratio",
+                s.tooth_spacing_ratio, "teeth wider than their spacing");
+  require_value(2 * hg < 0.5 * s.width_m, "silo.roughness", s.roughness,
+                "teeth take more than half the width");
   const bool quasi = s.mode == "quasi_static";
-  require(quasi || s.mode == "gravitational", "silo.mode", 0,
-          "expected \"quasi_static\" or \"gravitational\"");
+  require_value(quasi || s.mode == "gravitational", "silo.mode", 0,
+                "expected \"quasi_static\" or \"gravitational\"");
   const double t = std::max(2 * dmax_m, 0.02 * s.width_m);  // plate thickness
   // The side walls reach below the bottom by its travel (and a grain), so that nothing leaks
   // under them while the bottom moves down.
@@ -99,9 +95,10 @@ std::vector<WallSpec> silo_walls(const SiloSpec& s, double d50_m, double dmax_m,
   index.outlet = SIZE_MAX;
   const Eigen::Vector3d lo(-t, -t, -t), hi(W + t, D + t, 0);
   if (quasi) {
-    require(s.bottom_velocity_m_s > 0, "silo.bottom_velocity_m_s", s.bottom_velocity_m_s,
-            "must be positive");
-    require(s.bottom_travel_m > 0, "silo.bottom_travel_m", s.bottom_travel_m, "must be positive");
+    require_value(s.bottom_velocity_m_s > 0, "silo.bottom_velocity_m_s", s.bottom_velocity_m_s,
+                  "must be positive");
+    require_value(s.bottom_travel_m > 0, "silo.bottom_travel_m", s.bottom_travel_m,
+                  "must be positive");
     index.bottom.push_back(w.size());
     w.push_back(box_wall("bottom", lo, hi, bf));
   } else {
@@ -117,9 +114,9 @@ std::vector<WallSpec> silo_walls(const SiloSpec& s, double d50_m, double dmax_m,
       throw std::invalid_argument("silo.outlet: expected \"centre\" or \"right\" (" + s.outlet +
                                   ")");
     }
-    require(b > 0 && x1 >= 0, "silo.outlet_width_m", b, "outside the bottom");
-    require(b > dmax_m, "silo.outlet_width_m", b, "not wider than the largest grain");
-    require(s.settle_s >= 0, "silo.settle_s", s.settle_s, "must not be negative");
+    require_value(b > 0 && x1 >= 0, "silo.outlet_width_m", b, "outside the bottom");
+    require_value(b > dmax_m, "silo.outlet_width_m", b, "not wider than the largest grain");
+    require_value(s.settle_s >= 0, "silo.settle_s", s.settle_s, "must not be negative");
     if (x1 > 0) {
       index.bottom.push_back(w.size());
       w.push_back(box_wall("bottom_left", lo, {x1, hi.y(), 0}, bf));
@@ -163,18 +160,18 @@ SiloForces silo_forces(const Simulation& sim, const SiloWalls& w) {
 }
 
 SiloFlow::SiloFlow(SiloSpec spec, SiloWalls walls) : spec_(std::move(spec)), w_(std::move(walls)) {
-  require(spec_.flow_damping >= 0 && spec_.flow_damping < 1, "silo.flow_damping",
-          spec_.flow_damping, "outside [0, 1)");
+  require_value(spec_.flow_damping >= 0 && spec_.flow_damping < 1, "silo.flow_damping",
+                spec_.flow_damping, "outside [0, 1)");
   if (quasi_static()) {
-    require(spec_.frame_every_m >= 0, "silo.frame_every_m", spec_.frame_every_m,
-            "must not be negative");
+    require_value(spec_.frame_every_m >= 0, "silo.frame_every_m", spec_.frame_every_m,
+                  "must not be negative");
   } else {
-    require(spec_.max_discharge_s > 0, "silo.max_discharge_s", spec_.max_discharge_s,
-            "must be positive");
-    require(spec_.end_fraction > 0 && spec_.end_fraction <= 1, "silo.end_fraction",
-            spec_.end_fraction, "outside (0, 1]");
-    require(spec_.frame_every_s >= 0, "silo.frame_every_s", spec_.frame_every_s,
-            "must not be negative");
+    require_value(spec_.max_discharge_s > 0, "silo.max_discharge_s", spec_.max_discharge_s,
+                  "must be positive");
+    require_value(spec_.end_fraction > 0 && spec_.end_fraction <= 1, "silo.end_fraction",
+                  spec_.end_fraction, "outside (0, 1]");
+    require_value(spec_.frame_every_s >= 0, "silo.frame_every_s", spec_.frame_every_s,
+                  "must not be negative");
   }
 }
 

@@ -72,10 +72,12 @@ TEST(InterfaceShear, FlatSurfaceSlidesAtItsFriction) {
 // row per value; run again with --resume, the complete runs are read back, not rerun.
 TEST(InterfaceShear, SweepWritesOneRunPerValueAndTheirTable) {
   gs::test::ScratchDir dir("is_sweep");
-  std::ofstream(dir / "is.toml") << scene(
-      "surface = \"saw_tooth\"\nroughness = 1.0\nd50_m = 0.001\n",
-      "max_displacement_m = 0.0003\n[sweep]\nkey = \"interface_shear.roughness\"\n"
-      "values = [0.5, 1.0]\n");
+  // (a loose specimen, e0 = 0.75: a short preparation)
+  std::ofstream(dir / "is.toml") << replaced(
+      scene("surface = \"saw_tooth\"\nroughness = 1.0\nd50_m = 0.001\n",
+            "max_displacement_m = 0.0003\n[sweep]\nkey = \"interface_shear.roughness\"\n"
+            "values = [0.5, 1.0]\n"),
+      "void_ratio = 0.6", "void_ratio = 0.75");
   const auto r = run_cli(
       "simulate " + (dir / "is.toml").string() + " -q -o " + (dir / "out").string(), dir.path);
   ASSERT_EQ(r.rc, 0) << r.err;
