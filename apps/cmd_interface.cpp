@@ -12,7 +12,9 @@
 #include "commands.hpp"
 #include "errors.hpp"
 #include "field_output.hpp"
+#include "frame_motion.hpp"
 #include "grain_size.hpp"
+#include "hdf5_trajectory.hpp"
 #include "interface_zone.hpp"
 #include "trajectory_io.hpp"
 
@@ -22,62 +24,60 @@ namespace {
 namespace ga = gs::analysis;
 
 struct InterfaceArgs {
-  std::string input, output, csv;
-  long frame = -1, from = 0;
-  std::optional<double> surface_z, d50, bin, bin_d50;
+  FrameArgs in;  // input, --frame, --d50
+  std::string output, csv;
+  long from = 0;
+  std::optional<double> surface_z, bin, bin_d50;
   double inset_d50 = 2.0;
 };
 
-long frame_index(const std::string& file, const char* name, long i, long n) {
-  const long k = i < 0 ? n + i : i;
-  if (k < 0 || k >= n)
-    throw InputError(file, std::string(name) + ": no such frame (" + std::to_string(n) + " frames)",
-                     std::to_string(i));
-  return k;
+/// The surface's mean level an interface shear run recorded in its metadata (granoscope HDF5).
+std::optional<double> recorded_surface(const std::string& file) {
+  if (!is_hdf5_file(file)) return std::nullopt;
+  const TrajectoryReader reader(file);  // (alive through the loop)
+  for (const auto& [key, v] : reader.metadata().parameters)
+    if (key == "interface_shear.surface_mean_z_m") {
+      char* end = nullptr;
+      const double z = std::strtod(v.c_str(), &end);
+      if (end != v.c_str() && std::isfinite(z)) return z;
+    }
+  return std::nullopt;
 }
 
 void run_interface(const InterfaceArgs& a) {
-  const Trajectory t = read_snapshots(a.input);
-  if (t.frames.empty()) throw InputError(a.input, "no frames");
-  const long n = static_cast<long>(t.frames.size());
-  const long k = frame_index(a.input, "--frame", a.frame, n);
-  const long r = frame_index(a.input, "--from", a.from, n);
-  const Frame& f = t.frames[static_cast<std::size_t>(k)];
-  if (f.particles.empty())
-    throw InputError(a.input, "frame " + std::to_string(k) + " has no particles");
-  if (a.d50) require_positive(a.input, "--d50", *a.d50);
-  const double d50 = a.d50 ? *a.d50 : ga::d50(f);
+  const std::string& file = a.in.input;
+  const Frame f = a.in.load();
+  const long k = a.in.frame_index();
+  const double d50 = a.in.d50_of(f);
+  long r = a.from;
+  if (r < 0) r += static_cast<long>(frame_count(file));
+  const std::optional<Frame> reference =
+      r != k ? std::optional<Frame>(read_frame(file, r)) : std::nullopt;
   ga::InterfaceZoneOptions o;
   // The surface's mean level: given, or what the interface shear run recorded.
   if (a.surface_z) {
     if (!std::isfinite(*a.surface_z))
-      throw InputError(a.input, "--surface-z: not finite", value_str(*a.surface_z));
+      throw InputError(file, "--surface-z: not finite", value_str(*a.surface_z));
     o.surface_z = *a.surface_z;
+  } else if (const auto z = recorded_surface(file)) {
+    o.surface_z = *z;
   } else {
-    bool found = false;
-    for (const auto& [key, v] : t.metadata.parameters)
-      if (key == "interface_shear.surface_mean_z_m") {
-        char* end = nullptr;
-        o.surface_z = std::strtod(v.c_str(), &end);
-        found = end != v.c_str() && std::isfinite(o.surface_z);
-      }
-    if (!found)
-      throw InputError(a.input,
-                       "--surface-z: needed (the file does not record an interface shear surface)");
+    throw InputError(file,
+                     "--surface-z: needed (the file does not record an interface shear surface)");
   }
-  o.bin = length_option(a.input, "--bin", a.bin, a.bin_d50, 1.0, d50);
+  o.bin = length_option(file, "--bin", a.bin, a.bin_d50, 1.0, d50);
   if (!(a.inset_d50 >= 0) || !std::isfinite(a.inset_d50))
-    throw InputError(a.input, "--inset-d50: must not be negative", value_str(a.inset_d50));
+    throw InputError(file, "--inset-d50: must not be negative", value_str(a.inset_d50));
   o.x_inset = a.inset_d50 * d50;
-  if (r != k) o.reference = &t.frames[static_cast<std::size_t>(r)];
+  if (reference) o.reference = &*reference;
   ga::InterfaceZone z;
   try {
     z = ga::interface_zone(f, o);
   } catch (const std::invalid_argument& e) {
-    throw InputError(a.input, "frame " + std::to_string(k) + ": " + e.what());
+    throw InputError(file, "frame " + std::to_string(k) + ": " + e.what());
   }
   H5FieldFile h(a.output, "granoscope-interface");
-  h.attr("source", a.input);
+  h.attr("source", file);
   h.attr("frame", static_cast<long long>(k));
   h.attr("reference_frame", static_cast<long long>(r));
   h.attr("time_s", f.time);
@@ -121,18 +121,17 @@ void register_analyze_interface(CLI::App& app) {
       "Interface shear zone (seed 004 §4.3-4.4): rotation and displacement profiles against the "
       "height above the surface, the zone's thickness from the rotation profile's inflections, "
       "the slip at the surface");
-  s->add_option("input", a->input, "trajectory of an interface shear run")->required();
+  a->in.add_to(*s, false);
   s->add_option("-o,--output", a->output, "output HDF5 (format granoscope-interface)")->required();
   s->add_option("--csv", a->csv, "also write the profiles as CSV");
-  s->add_option("--frame", a->frame, "frame index, negative from the end (default -1: the last)");
-  s->add_option("--from", a->from, "reference frame of the displacements (default 0)");
+  s->add_option("--from", a->from,
+                "reference frame of the displacements, negative from the end (default 0)");
   s->add_option("--surface-z", a->surface_z,
                 "the surface's mean level in m (default: recorded by the interface shear run)");
   s->add_option("--bin", a->bin, "profile bin in m");
   s->add_option("--bin-d50", a->bin_d50, "profile bin in d50 (default 1)");
   s->add_option("--inset-d50", a->inset_d50,
                 "profiles this far in from the specimen's ends, d50 (default 2)");
-  s->add_option("--d50", a->d50, "d50 in m (default: from the frame)");
   s->callback([a] { run_interface(*a); });
 }
 

@@ -35,9 +35,9 @@ void append_mesh(const TriangleMesh& tm, double friction_deg, std::vector<WallSp
 
 }  // namespace
 
-std::vector<WallSpec> interface_shear_walls(const InterfaceSurfaceSpec& s,
-                                            InterfaceShearGeometry& g, double dmax_m,
-                                            InterfaceShearWalls& index) {
+std::vector<WallSpec> interface_surface_walls(const InterfaceSurfaceSpec& s,
+                                              InterfaceShearGeometry& g, double dmax_m,
+                                              InterfaceShearWalls& index) {
   const std::string sec = "interface_shear.";
   require_value(g.length_m > 0, "specimen.size_m", g.length_m, "length must be positive");
   require_value(g.width_m > 0, "specimen.size_m", g.width_m, "width must be positive");
@@ -45,7 +45,6 @@ std::vector<WallSpec> interface_shear_walls(const InterfaceSurfaceSpec& s,
   require_value(dmax_m > 0, "specimen.dmax_m", dmax_m, "must be positive");
   require_value(g.travel_m > 0, sec + "max_displacement_m", g.travel_m, "must be positive");
   require_value(g.wall_thickness_m > 0, "wall thickness", g.wall_thickness_m, "must be positive");
-  if (g.gap_m < 0) g.gap_m = dmax_m;
   const double L = g.length_m, W = g.width_m, t = g.wall_thickness_m;
   // The surface runs from before the frame's start to beyond its end of travel, whole periods;
   // what leaks out of the frame and is pushed off the surface's ends is removed (scene_programmes
@@ -121,6 +120,13 @@ std::vector<WallSpec> interface_shear_walls(const InterfaceSurfaceSpec& s,
   g.surface_triangles = 0;
   for (std::size_t k = index.surface_begin; k < index.surface_end; ++k)
     g.surface_triangles += w[k].facets.size();
+  return w;
+}
+
+void append_interface_box_walls(InterfaceShearGeometry& g, double dmax_m, std::vector<WallSpec>& w,
+                                InterfaceShearWalls& index) {
+  if (g.gap_m < 0) g.gap_m = dmax_m;
+  const double L = g.length_m, W = g.width_m, t = g.wall_thickness_m;
   require_value(g.platen_z_m > g.crest_z_m, "platen", g.platen_z_m, "below the surface's crests");
   require_value(g.frame_top_m > g.platen_z_m, "frame top", g.frame_top_m, "below the platen");
   const double x0 = g.surface_x0_m, x1 = g.surface_x1_m, zb = g.trough_z_m - t;
@@ -141,6 +147,13 @@ std::vector<WallSpec> interface_shear_walls(const InterfaceSurfaceSpec& s,
   index.platen = w.size();
   w.push_back(
       box_wall("platen", {0, 0, g.platen_z_m}, {L, W, g.platen_z_m + t}, g.platen_friction_deg));
+}
+
+std::vector<WallSpec> interface_shear_walls(const InterfaceSurfaceSpec& s,
+                                            InterfaceShearGeometry& g, double dmax_m,
+                                            InterfaceShearWalls& index) {
+  auto w = interface_surface_walls(s, g, dmax_m, index);
+  append_interface_box_walls(g, dmax_m, w, index);
   return w;
 }
 

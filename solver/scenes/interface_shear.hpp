@@ -50,7 +50,7 @@ struct InterfaceShearGeometry {
   double travel_m = 0;  // the frame's travel (max displacement): the surface is longer
   double frame_friction_deg = 0;
   double platen_friction_deg = -1;  // negative: the material's
-  // Set by interface_shear_walls: the surface's crest, mean and trough heights, and its extent.
+  // Set by interface_surface_walls: the surface's crest, mean and trough heights, its extent.
   double crest_z_m = 0, mean_z_m = 0, trough_z_m = 0;
   double surface_x0_m = 0, surface_x1_m = 0;
   std::size_t surface_triangles = 0;
@@ -66,9 +66,21 @@ struct InterfaceShearWalls {
   std::size_t platen = 0;
 };
 
-/// The surface and box walls. Throws std::invalid_argument naming the key and value: a
-/// roughness that gives teeth below 1e-3·d50, teeth wider than their spacing, a depth ratio
-/// outside [0, 1), a bad wavelength, non-positive dimensions.
+/// The surface's walls alone (indices 0 … of `index.surface_*`), setting the geometry's crest,
+/// mean and trough heights, extent and triangle count: what the specimen's cloud is placed
+/// above. Throws std::invalid_argument naming the key and value: a roughness that gives teeth
+/// below 1e-3·d50, teeth wider than their spacing, a depth ratio outside [0, 1), a bad
+/// wavelength, non-positive dimensions.
+std::vector<WallSpec> interface_surface_walls(const InterfaceSurfaceSpec& surface,
+                                              InterfaceShearGeometry& g, double dmax_m,
+                                              InterfaceShearWalls& index);
+
+/// The frame, closers, y sides and platen appended to `walls` (the surface's, from
+/// interface_surface_walls with the same geometry, whose platen_z_m and frame_top_m are now set).
+void append_interface_box_walls(InterfaceShearGeometry& g, double dmax_m,
+                                std::vector<WallSpec>& walls, InterfaceShearWalls& index);
+
+/// Both: the surface's walls, then the box's.
 std::vector<WallSpec> interface_shear_walls(const InterfaceSurfaceSpec& surface,
                                             InterfaceShearGeometry& g, double dmax_m,
                                             InterfaceShearWalls& index);

@@ -169,19 +169,16 @@ std::vector<std::unique_ptr<LoadingProgramme>> scene_programmes(Scene& s) {
     g.wall_thickness_m = std::max(2 * dmax, 0.05 * g.length_m);
     InterfaceShearWalls idx;
     try {
-      // The crest height is known once the surface is built: build, then place the cloud.
-      InterfaceShearGeometry probe = g;
-      probe.platen_z_m = 1e300;
-      probe.frame_top_m = 2e300;
-      (void)interface_shear_walls(f, probe, dmax, idx);
+      // The surface first: the cloud is placed above its crests, the box around the cloud.
+      s.walls = interface_surface_walls(f, g, dmax, idx);
       const double cloud_h = g.height_m * (1 / (1 + sp.void_ratio)) / sp.cloud_solid_fraction;
       s.particles =
-          generate(s, {g.length_m, g.width_m, cloud_h}, Eigen::Vector3d(0, 0, probe.crest_z_m));
+          generate(s, {g.length_m, g.width_m, cloud_h}, Eigen::Vector3d(0, 0, g.crest_z_m));
       replace_spheres_by_clumps(s);
       g.clump_solid_factor = clump_solid_factor(s);
-      g.platen_z_m = probe.crest_z_m + cloud_h;
+      g.platen_z_m = g.crest_z_m + cloud_h;
       g.frame_top_m = g.platen_z_m + g.wall_thickness_m;
-      s.walls = interface_shear_walls(f, g, dmax, idx);
+      append_interface_box_walls(g, dmax, s.walls, idx);
       // Grains pushed off the surface's ends fall away (removed there).
       const double big = 1e3 * (g.length_m + g.height_m + g.travel_m);
       s.outlet = std::make_pair(Eigen::Vector3d(g.surface_x0_m, -big, -big),

@@ -304,6 +304,17 @@ class Figures : public ::testing::Test {
     if (!std::getenv("GS_KEEP")) fs::remove_all(dir);
   }
   std::string p(const std::string& name) const { return (dir / name).string(); }
+  /// lab.h5: one frame of one particle, beside which a test writes curve.csv (fig_labcurve).
+  void write_lab_trajectory() const {
+    gs::Trajectory t;
+    gs::Frame f;
+    gs::Particle q;
+    q.id = 1;
+    q.radius = 1e-3;
+    f.particles.push_back(q);
+    t.frames = {f};
+    gs::write_hdf5_trajectory(dir / "lab.h5", t);
+  }
   CliRun run(const std::string& args, bool probe = true) const {
     const auto o = dir / "stdout.txt", e = dir / "stderr.txt";
     const std::string env = probe ? "GRANOSCOPE_PYTHON='" + wrapper.string() + "' " : "";
@@ -768,14 +779,7 @@ TEST_F(Figures, RunDefaultsPositionsAndHistoryPlotTheRun) {
 // twin axis, 100 eps_v below; preparation: whole-box and core void ratio, friction on the twin
 // axis, against steps.
 TEST_F(Figures, LabCurvesOfCompressionTestsPlotTheCurveColumns) {
-  gs::Trajectory t;
-  gs::Frame f;
-  gs::Particle q;
-  q.id = 1;
-  q.radius = 1e-3;
-  f.particles.push_back(q);
-  t.frames = {f};
-  gs::write_hdf5_trajectory(dir / "lab.h5", t);
+  write_lab_trajectory();
   const int n = 7;
   const double e1[n] = {0, 0.005, 0.01, 0.02, 0.03, 0.04, 0.05},
                phi[n] = {10, 20, 28, 33, 35.5, 34, 32}, s3 = 1e5,
@@ -870,14 +874,7 @@ TEST_F(Figures, LabCurvesOfCompressionTestsPlotTheCurveColumns) {
 // Exact answers: tau/sigma_n against 1000 u (mm), and the only figure is the curve (no
 // preparation.csv); a curve of neither kind is one error line naming it, exit 2, no figure.
 TEST_F(Figures, LabCurveDirectShearAndBadCurve) {
-  gs::Trajectory t;
-  gs::Frame f;
-  gs::Particle q;
-  q.id = 1;
-  q.radius = 1e-3;
-  f.particles.push_back(q);
-  t.frames = {f};
-  gs::write_hdf5_trajectory(dir / "lab.h5", t);
+  write_lab_trajectory();
   const int n = 7;
   const double ev[n] = {0, -0.001, -0.002, 0.0, 0.004, 0.008, 0.011};
   {
@@ -917,14 +914,7 @@ TEST_F(Figures, LabCurveDirectShearAndBadCurve) {
 // SiloFlow write them). Exact answers: φs and εv (%) against 1000 u (mm); P/G against the
 // bottom's travel (mm) in the quasi-static mode.
 TEST_F(Figures, LabCurveInterfaceShearAndSilo) {
-  gs::Trajectory t;
-  gs::Frame f;
-  gs::Particle q;
-  q.id = 1;
-  q.radius = 1e-3;
-  f.particles.push_back(q);
-  t.frames = {f};
-  gs::write_hdf5_trajectory(dir / "lab.h5", t);
+  write_lab_trajectory();
   const std::size_t n = 6;
   {
     std::ofstream o(dir / "curve.csv");

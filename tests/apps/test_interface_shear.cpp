@@ -66,6 +66,28 @@ TEST(InterfaceShear, FlatSurfaceSlidesAtItsFriction) {
   EXPECT_NEAR(value("phi_s_res_deg"), 18.0, 0.2);
   // A block sliding on a flat plate neither dilates nor contracts (Table 4.5, R_n = 0.01: 0).
   EXPECT_LT(std::abs(value("eps_v_res")), 1e-3);
+  // `analyze interface` finds the surface the run recorded: the block slides on it, so the
+  // grains at the surface move with the top (slip ratio 1; the frame moved 1 mm).
+  const auto traj = (dir / "out" / "trajectory.h5").string();
+  const auto a = run_cli("analyze interface " + traj + " -o " + (dir / "iz.h5").string() +
+                             " --csv " + (dir / "iz.csv").string(),
+                         dir.path);
+  ASSERT_EQ(a.rc, 0) << a.err;
+  const auto z = read_csv_table(dir / "iz.csv");
+  ASSERT_GE(z.rows.size(), 4u);
+  const std::size_t top = z.rows.size() - 1;
+  EXPECT_NEAR(z.num(top, "displacement_x_m"), 0.001, 0.05e-3);
+  EXPECT_NEAR(z.num(0, "displacement_x_m") / z.num(top, "displacement_x_m"), 1.0, 0.05);
+  EXPECT_NE(a.out.find("slip ratio"), std::string::npos) << a.out;
+  // A file that does not say where the surface is: --surface-z is asked for, in one line.
+  gs::Trajectory bare;
+  bare.frames.push_back(gs::read_hdf5_trajectory(traj).frames.back());
+  gs::write_hdf5_trajectory(dir / "bare.h5", bare);
+  const auto b =
+      run_cli("analyze interface " + (dir / "bare.h5").string() + " -o " + (dir / "b.h5").string(),
+              dir.path);
+  gs::test::expect_rejected(b, (dir / "bare.h5").string());
+  EXPECT_NE(b.err.find("--surface-z: needed"), std::string::npos) << b.err;
 }
 
 // A sweep over R_n: one run directory per value, each with its results, and sweep.csv with one
