@@ -34,6 +34,11 @@ struct ContactLoads {
 /// of arrays), so that the compiler vectorises the law across contacts. Lane j holds one
 /// contact: its geometry, the motion of its two bodies, its history and its parameters.
 /// Body 1 is the wall for wall contacts; the normal points from body 1 to body 2.
+/// On GEOM lanes (sphere pairs) the batch computes the geometry itself, as
+/// sphere_sphere_geometry does and in its order of operations, so the square roots and
+/// divisions run across lanes: NX, PEN, C1, C2 and PT are written from X1, X2, R1 and R2, and
+/// TOUCH says whether the pair touches (the law's loads of a lane that does not are garbage).
+/// Other lanes bring NX, PEN, C1, C2 and PT filled in and come out with TOUCH = 1.
 struct ContactBatch {
   static constexpr int kLanes = 32;
   // clang-format off
@@ -52,6 +57,9 @@ struct ContactBatch {
     FRESH,          // 1: the contact is new this step (history starts at zero)
     SVX, SVY, SVZ,  // periodic cell: velocity of body 2's image relative to body 2 (else unset)
     ONX, ONY, ONZ,  // last step's normal
+    GEOM,           // 1: a sphere pair whose geometry the batch computes from X1, X2 (below)
+    X1X, X1Y, X1Z,  // GEOM lanes: the centres (body 2's image on a periodic cell)
+    X2X, X2Y, X2Z,
     KN, KS, KR, KTW, TAN_FRICTION, MAX_ROLL, MAX_TWIST,  // KTW, MAX_TWIST: only with `twist`
     // history: read, and written back with this step's values
     SX, SY, SZ,     // shear force
@@ -64,6 +72,8 @@ struct ContactBatch {
     MX, MY, MZ,     // contact moment (body 1 receives −M, body 2 +M)
     FN,             // |normal force|
     FRICTION_DISSIPATION, ROLLING_DISSIPATION,
+    PTX, PTY, PTZ,  // contact point (GEOM lanes; the others pass theirs through)
+    TOUCH,          // 1: the pair touches (GEOM lanes: distinct centres, penetration ≥ 0)
     kFields
   };
   // clang-format on

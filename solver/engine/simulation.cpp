@@ -650,39 +650,59 @@ void Simulation::accumulate_walls() {
   }
 }
 
-[[gnu::always_inline]] inline bool Simulation::prepare_pair(std::size_t k, ContactBatch& B, int j,
-                                                            double& max_overlap_ratio) {
+[[gnu::always_inline]] inline bool Simulation::prepare_pair(std::size_t k, ContactBatch& B, int j) {
   using F = ContactBatch::Field;
-  ContactHistory& h = hist_[k];
+  const ContactHistory& h = hist_[k];
   const auto [a, b] = nl_.pairs[k];
-  ContactGeometry g;
-  BodyMotion m1, m2;
-  if (!pair_geometry(k, g, m1, m2, facet_forces_ ? &pair_facet_[k] : nullptr) ||
-      g.penetration < 0) {
-    // Coincident centres, or not touching (YADE erases the interaction).
-    h.real = false;
-    return false;
-  }
   auto put = [&](F f, const V3& x) {
     B.v[f][j] = x.x;
     B.v[f + 1][j] = x.y;
     B.v[f + 2][j] = x.z;
   };
-  put(F::NX, g.normal);
-  B.v[F::PEN][j] = g.penetration;
-  B.v[F::R1][j] = g.radius1;
-  B.v[F::R2][j] = g.radius2;
-  B.v[F::RATCHET][j] = g.ratchet_free ? 1 : 0;
-  put(F::V1X, m1.vel);
-  put(F::V2X, m2.vel);
-  put(F::W1X, m1.angvel);
-  put(F::W2X, m2.angvel);
-  put(F::C1X, g.point - m1.pos);
-  put(F::C2X, g.point - m2.pos);
+  if (b < kWallBase) {
+    // A sphere pair: the batch computes its geometry (sphere_sphere_geometry, across lanes).
+    V3 x2(p_.pos[b]);
+    if (periodic_ && !nl_.cell_dist[k].isZero())
+      x2 = x2 + cell_.shift_pos(nl_.cell_dist[k]);  // se32.position + shift2
+    B.v[F::GEOM][j] = 1;
+    put(F::X1X, V3(p_.pos[a]));
+    put(F::X2X, x2);
+    B.v[F::R1][j] = p_.radius[a];
+    B.v[F::R2][j] = p_.radius[b];
+    B.v[F::RATCHET][j] = 1;
+    put(F::V1X, V3(p_.vel[a]));
+    put(F::V2X, V3(p_.vel[b]));
+    put(F::W1X, V3(p_.angvel[a]));
+    put(F::W2X, V3(p_.angvel[b]));
+    if (periodic_)  // (a pair inside the cell: no shift; +0 either way)
+      put(F::SVX, !nl_.cell_dist[k].isZero() ? cell_.shift_vel(nl_.cell_dist[k]) : V3());
+  } else {
+    ContactGeometry g;
+    BodyMotion m1, m2;
+    if (!pair_geometry(k, g, m1, m2, facet_forces_ ? &pair_facet_[k] : nullptr) ||
+        g.penetration < 0) {
+      // Not touching (YADE erases the interaction).
+      hist_[k].real = false;
+      return false;
+    }
+    B.v[F::GEOM][j] = 0;
+    put(F::X1X, V3());  // (not read)
+    put(F::X2X, V3());
+    put(F::NX, g.normal);
+    B.v[F::PEN][j] = g.penetration;
+    B.v[F::R1][j] = g.radius1;
+    B.v[F::R2][j] = g.radius2;
+    B.v[F::RATCHET][j] = g.ratchet_free ? 1 : 0;
+    put(F::V1X, m1.vel);
+    put(F::V2X, m2.vel);
+    put(F::W1X, m1.angvel);
+    put(F::W2X, m2.angvel);
+    put(F::C1X, g.point - m1.pos);
+    put(F::C2X, g.point - m2.pos);
+    put(F::PTX, g.point);
+    if (periodic_) put(F::SVX, V3());
+  }
   B.v[F::FRESH][j] = h.real ? 0 : 1;
-  if (periodic_)  // (a pair inside the cell: no shift; +0 either way)
-    put(F::SVX,
-        b < kWallBase && !nl_.cell_dist[k].isZero() ? cell_.shift_vel(nl_.cell_dist[k]) : V3());
   put(F::ONX, V3(h.normal));
   put(F::SX, V3(h.shear_force));
   put(F::BX, V3(h.bending));
@@ -698,15 +718,6 @@ void Simulation::accumulate_walls() {
   }
   B.v[F::TAN_FRICTION][j] = p.tan_friction;
   B.v[F::MAX_ROLL][j] = p.max_roll;
-  // The history's geometry of this step.
-  g.normal.store(h.normal);
-  g.point.store(h.point);
-  h.overlap = g.penetration;
-  h.real = true;
-  active_[k] = 1;
-  const double rmin = b >= kWallBase ? p_.radius[a] : std::min(p_.radius[a], p_.radius[b]);
-  if (!(h.overlap <= cfg_.max_overlap_ratio * rmin))  // (the ratio only when it is too large)
-    max_overlap_ratio = std::max(max_overlap_ratio, h.overlap / rmin);
   return true;
 }
 
@@ -775,7 +786,7 @@ void Simulation::admit_deferred() {
 
 template <bool kIndexed>
 int Simulation::fill_batch(std::size_t& i, std::size_t end, ContactBatch& batch,
-                           std::uint32_t* lane_pair, double& max_overlap_ratio) {
+                           std::uint32_t* lane_pair) {
   // Pass 1 without branches (whether a candidate is within reach is a coin flip that the
   // branch predictor loses): candidates within reach are compacted, the others lose their
   // contact (YADE erases the interaction).
@@ -806,20 +817,34 @@ int Simulation::fill_batch(std::size_t& i, std::size_t end, ContactBatch& batch,
     near[m] = static_cast<std::uint32_t>(k);
     m += in_reach;
   }
-  // Pass 2: geometry, and the lanes of the pairs that touch.
+  // Pass 2: the lanes of the sphere pairs within reach and of the wall pairs that touch.
   int lanes = 0;
   for (int i = 0; i < m; ++i) {
     lane_pair[lanes] = near[i];
-    lanes += prepare_pair(near[i], batch, lanes, max_overlap_ratio);
+    lanes += prepare_pair(near[i], batch, lanes);
   }
   return lanes;
 }
 
-[[gnu::always_inline]] inline void Simulation::finish_pair(std::size_t k, const ContactBatch& B,
-                                                           int j, ContactLoads& L) {
+[[gnu::always_inline]] inline bool Simulation::finish_pair(std::size_t k, const ContactBatch& B,
+                                                           int j, ContactLoads& L,
+                                                           double& max_overlap_ratio) {
   using F = ContactBatch::Field;
   auto get = [&](F f) { return V3(B.v[f][j], B.v[f + 1][j], B.v[f + 2][j]); };
   ContactHistory& h = hist_[k];
+  if (B.v[F::TOUCH][j] == 0) {  // (a sphere pair within reach whose penetration is negative)
+    h.real = false;
+    return false;
+  }
+  // The history's geometry of this step.
+  get(F::NX).store(h.normal);
+  get(F::PTX).store(h.point);
+  h.overlap = B.v[F::PEN][j];
+  h.real = true;
+  active_[k] = 1;
+  const double rmin = std::min(B.v[F::R1][j], B.v[F::R2][j]);  // (both the sphere's at a wall)
+  if (!(h.overlap <= cfg_.max_overlap_ratio * rmin))  // (the ratio only when it is too large)
+    max_overlap_ratio = std::max(max_overlap_ratio, h.overlap / rmin);
   get(F::SX).store(h.shear_force);
   get(F::BX).store(h.bending);
   if (cfg_.twist_beta > 0) get(F::TX).store(h.twist);
@@ -830,6 +855,7 @@ int Simulation::fill_batch(std::size_t& i, std::size_t end, ContactBatch& batch,
   L.moment = get(F::MX);
   L.friction_dissipation = B.v[F::FRICTION_DISSIPATION][j];
   L.rolling_dissipation = B.v[F::ROLLING_DISSIPATION][j];
+  return true;
 }
 
 void Simulation::step() {
@@ -883,13 +909,13 @@ void Simulation::step() {
         particle_dissipation_[2 * cur + 1] = ro_cur;
       };
       for (std::size_t i = 0; i < nv;) {
-        const int m = indexed ? fill_batch<true>(i, nv, batch, lane_pair, max_overlap_ratio)
-                              : fill_batch<false>(i, nv, batch, lane_pair, max_overlap_ratio);
+        const int m = indexed ? fill_batch<true>(i, nv, batch, lane_pair)
+                              : fill_batch<false>(i, nv, batch, lane_pair);
         cohesive_frictional_batch(batch, m, dt, cfg_.twist_beta > 0, periodic_);
         for (int j = 0; j < m; ++j) {
           const std::uint32_t kk = lane_pair[j];
           ContactLoads L;
-          finish_pair(kk, batch, j, L);
+          if (!finish_pair(kk, batch, j, L, max_overlap_ratio)) continue;
           const auto [a, b] = nl_.pairs[kk];
           if (a != cur) {
             flush();
@@ -926,13 +952,13 @@ void Simulation::step() {
       ContactBatch batch;
       std::uint32_t lane_pair[ContactBatch::kLanes];
       for (std::size_t i = nv * t / nt; i < k_end;) {
-        const int m = indexed ? fill_batch<true>(i, k_end, batch, lane_pair, my_max_overlap)
-                              : fill_batch<false>(i, k_end, batch, lane_pair, my_max_overlap);
+        const int m = indexed ? fill_batch<true>(i, k_end, batch, lane_pair)
+                              : fill_batch<false>(i, k_end, batch, lane_pair);
         cohesive_frictional_batch(batch, m, dt, cfg_.twist_beta > 0, periodic_);
         for (int j = 0; j < m; ++j) {
           const std::uint32_t kk = lane_pair[j];
           ContactLoads& L = loads_[kk];
-          finish_pair(kk, batch, j, L);
+          if (!finish_pair(kk, batch, j, L, my_max_overlap)) continue;
           dissipation_[2 * kk] = L.friction_dissipation;
           dissipation_[2 * kk + 1] = L.rolling_dissipation;
         }

@@ -215,21 +215,23 @@ class Simulation {
                      std::uint32_t* facet = nullptr) const;
   /// pos, facets and normal of a rotating facet wall from its rotation and centre.
   static void place_rotated_facets(WallState& w);
-  /// Geometry, motions, history and parameters of candidate pair k into lane j of a batch;
-  /// false when the pair does not touch (its history is then marked not real). Raises
-  /// max_overlap_ratio past the blow-up limit.
-  bool prepare_pair(std::size_t k, ContactBatch& batch, int j, double& max_overlap_ratio);
+  /// Motions, history and parameters of candidate pair k into lane j of a batch, with the
+  /// geometry of a wall pair (a sphere pair's the batch computes); false when a wall pair does
+  /// not touch (its history is then marked not real).
+  bool prepare_pair(std::size_t k, ContactBatch& batch, int j);
   /// Fills a batch with the next touching pairs from k (advanced) up to end; returns the
   /// number of lanes, lane_pair[j] the pair of lane j.
   /// With kIndexed, positions i in [i, end) of pass_pairs_ instead of pairs themselves.
   template <bool kIndexed>
-  int fill_batch(std::size_t& i, std::size_t end, ContactBatch& batch, std::uint32_t* lane_pair,
-                 double& max_overlap_ratio);
+  int fill_batch(std::size_t& i, std::size_t end, ContactBatch& batch, std::uint32_t* lane_pair);
   /// The facet pairs whose gap the displacements since the build may have closed join the
   /// pairs the contact pass visits (in pair order).
   void admit_deferred();
-  /// The law's results in lane j back into pair k's history, and its loads.
-  void finish_pair(std::size_t k, const ContactBatch& batch, int j, ContactLoads& loads);
+  /// The law's results in lane j back into pair k's history, and its loads; false (the
+  /// history marked not real) when the pair does not touch. Raises max_overlap_ratio past the
+  /// blow-up limit.
+  bool finish_pair(std::size_t k, const ContactBatch& batch, int j, ContactLoads& loads,
+                   double& max_overlap_ratio);
   void update_servos();
   const PeriodicCell* cell_ptr() const { return periodic_ ? &cell_ : nullptr; }
   /// Clump loads from their members, the clumps' integration, and the members moved rigidly;

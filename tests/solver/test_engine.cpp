@@ -130,15 +130,28 @@ ContactBatch random_contact_batch(std::mt19937_64& rng) {
     put(F::SX, 2 * u(rng) * fn * tan_mu * random_unit(rng));
     put(F::BX, 2 * u(rng) * fn * std::abs(max_roll) * random_unit(rng));
     put(F::TX, 2 * u(rng) * fn * std::abs(max_twist) * n);
+    put(F::PTX, Eigen::Vector3d(u(rng), u(rng), u(rng)));
+    // Every other lane a sphere pair whose geometry the batch computes from the centres, about
+    // the same contact (lane 5: centres apart; lane 7: coincident centres).
+    b.v[F::GEOM][j] = j % 2;
+    const Eigen::Vector3d x1 = 0.01 * random_unit(rng);
+    const double gap = j == 5 ? 1e-5 : j == 7 ? -(r1 + r2) : -pen;
+    put(F::X1X, x1);
+    put(F::X2X, x1 + (r1 + r2 + gap) * n);
   }
   return b;
 }
 
 /// The fields the law writes (history and outputs), lanes [0, count).
+/// (The results of a lane that does not touch are not used: they count as 0 here.)
 std::vector<double> law_outputs(const ContactBatch& b, int count) {
   std::vector<double> out;
-  for (int f = ContactBatch::SX; f < ContactBatch::kFields; ++f)
-    for (int j = 0; j < count; ++j) out.push_back(b.v[f][j]);
+  auto field = [&](int f) {
+    for (int j = 0; j < count; ++j)
+      out.push_back(b.v[ContactBatch::TOUCH][j] != 0 || f == ContactBatch::TOUCH ? b.v[f][j] : 0);
+  };
+  for (int f = ContactBatch::NX; f <= ContactBatch::PEN; ++f) field(f);  // (GEOM lanes write them)
+  for (int f = ContactBatch::SX; f < ContactBatch::kFields; ++f) field(f);
   return out;
 }
 
@@ -250,7 +263,7 @@ TEST_P(SimdVariant, SameBitsAsThePlainKernels) {
         const auto a = law_outputs(*plain, count), b = law_outputs(*simd, count);
         for (std::size_t k = 0; k < a.size(); ++k)
           ASSERT_TRUE(same_bits(a[k], b[k]))
-              << "field " << ContactBatch::SX + static_cast<int>(k) / count << " lane "
+              << "output " << static_cast<int>(k) / count << " lane "
               << k % static_cast<std::size_t>(count) << ": " << a[k] << " vs " << b[k];
       }
     }
@@ -329,6 +342,62 @@ TEST_P(SimdVariant, SameBitsAsThePlainKernels) {
     EXPECT_TRUE(same_bits(ep.rolling_dissipation, eq.rolling_dissipation));
     EXPECT_TRUE(same_bits(ep.damping_dissipation, eq.damping_dissipation));
   }
+}
+
+// Exact answer: sphere_sphere_geometry, the scalar geometry of a sphere pair. The batch computes
+// it on GEOM lanes (touching, apart by 1e-12 m, just touching, coincident centres) with the
+// same bits, at every SIMD level, and says which lanes touch.
+TEST(ContactBatchGeometry, SpherePairLanesAreTheScalarGeometryBitForBit) {
+  using F = ContactBatch::Field;
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u(0, 1);
+  ContactBatch input{};
+  std::vector<ContactGeometry> expect(ContactBatch::kLanes);
+  std::vector<bool> touches(ContactBatch::kLanes);
+  for (int j = 0; j < ContactBatch::kLanes; ++j) {
+    const double r1 = 1e-3 * (0.5 + u(rng)), r2 = 1e-3 * (0.5 + u(rng));
+    const Eigen::Vector3d x1 = 0.01 * random_unit(rng), n = random_unit(rng);
+    const double gap = j == 3 ? 1e-12 : j == 4 ? 0.0 : j == 9 ? -(r1 + r2) : -0.05 * r1 * u(rng);
+    const Eigen::Vector3d x2 = x1 + (r1 + r2 + gap) * n;
+    input.v[F::GEOM][j] = 1;
+    input.v[F::R1][j] = r1;
+    input.v[F::R2][j] = r2;
+    for (int c = 0; c < 3; ++c) {
+      input.v[F::X1X + c][j] = x1[c];
+      input.v[F::X2X + c][j] = x2[c];
+    }
+    ContactGeometry g;
+    touches[static_cast<std::size_t>(j)] =
+        sphere_sphere_geometry(V3(x1), r1, V3(x2), r2, g) && !(g.penetration < 0);
+    expect[static_cast<std::size_t>(j)] = g;
+  }
+  int touching = 0;
+  const SimdLevel before = simd_level();
+  for (const SimdLevel level : {SimdLevel::Generic, SimdLevel::Avx2, SimdLevel::Avx512}) {
+    if (!simd_level_supported(level)) continue;
+    set_simd_level(level);
+    auto b = std::make_unique<ContactBatch>(input);
+    cohesive_frictional_batch(*b, ContactBatch::kLanes, 1e-6, false);
+    for (int j = 0; j < ContactBatch::kLanes; ++j) {
+      const auto& g = expect[static_cast<std::size_t>(j)];
+      const bool touch = touches[static_cast<std::size_t>(j)];
+      ASSERT_EQ(b->v[F::TOUCH][j] == 1, touch) << simd_level_name(level) << " lane " << j;
+      touching += touch;
+      if (!touch) continue;
+      const Eigen::Vector3d x1(b->v[F::X1X][j], b->v[F::X1Y][j], b->v[F::X1Z][j]);
+      const Eigen::Vector3d x2(b->v[F::X2X][j], b->v[F::X2Y][j], b->v[F::X2Z][j]);
+      auto field = [&](F f) { return Eigen::Vector3d(b->v[f][j], b->v[f + 1][j], b->v[f + 2][j]); };
+      EXPECT_TRUE(same_bits(field(F::NX), g.normal.eigen())) << "lane " << j;
+      EXPECT_TRUE(same_bits(b->v[F::PEN][j], g.penetration)) << "lane " << j;
+      EXPECT_TRUE(same_bits(field(F::PTX), g.point.eigen())) << "lane " << j;
+      // The arms the loads are computed from: the contact point less each centre.
+      const Eigen::Vector3d f1 = field(F::F1X);
+      EXPECT_TRUE(same_bits(field(F::A1X), cross(g.point - V3(x1), V3(f1)).eigen()))
+          << "lane " << j;
+    }
+  }
+  set_simd_level(before);
+  EXPECT_GT(touching, 28);
 }
 
 INSTANTIATE_TEST_SUITE_P(Engine, SimdVariant, ::testing::Values(SimdLevel::Avx2, SimdLevel::Avx512),
