@@ -1,6 +1,8 @@
 #include "silo_report.hpp"
 
+#include "contact_rose.hpp"
 #include "shear_zone.hpp"
+#include "sphere_box_volume.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -11,11 +13,9 @@ namespace gs::analysis {
 
 namespace {
 
-void wall_zones(const Frame& f, const SiloReportOptions& o, const Eigen::Vector3d& up,
-                const Eigen::Vector3d& across, double bottom, double top,
-                const std::unordered_map<std::int64_t, int>& role, SiloFrameReport& r) {
-  if (!(o.zone_band > 0)) throw std::invalid_argument("zone band must be positive");
-  // The walls' base planes across: the extreme wall points of each side.
+// The base planes of the side walls across: the extreme wall points of each side.
+std::pair<double, double> wall_bases(const Frame& f, const Eigen::Vector3d& across,
+                                     const std::unordered_map<std::int64_t, int>& role) {
   double x0 = HUGE_VAL, x1 = -HUGE_VAL;
   for (const Wall& w : f.walls) {
     const auto it = role.find(w.id);
@@ -23,6 +23,14 @@ void wall_zones(const Frame& f, const SiloReportOptions& o, const Eigen::Vector3
     if (it->second == 1) x0 = std::min(x0, w.a.dot(across));
     if (it->second == 2) x1 = std::max(x1, w.a.dot(across));
   }
+  return {x0, x1};
+}
+
+void wall_zones(const Frame& f, const SiloReportOptions& o, const Eigen::Vector3d& up,
+                const Eigen::Vector3d& across, double bottom, double top,
+                const std::unordered_map<std::int64_t, int>& role, SiloFrameReport& r) {
+  if (!(o.zone_band > 0)) throw std::invalid_argument("zone band must be positive");
+  const auto [x0, x1] = wall_bases(f, across, role);
   if (!(x1 > x0)) return;
   r.zone_height = o.zone_height > 0 ? o.zone_height : 0.5 * (top - bottom);
   const double z = bottom + r.zone_height;
@@ -52,6 +60,87 @@ void wall_zones(const Frame& f, const SiloReportOptions& o, const Eigen::Vector3
   r.zone_left = profile_inflection(s, pl, +1, o.zone_bin) + 0.5 * o.zone_bin;
   const double right = profile_inflection(s, pr, -1, o.zone_bin);
   r.zone_right = std::isnan(right) ? NAN : (x1 - x0) - (right + 0.5 * o.zone_bin);
+}
+
+void void_ratio_layers(const Frame& f, const SiloReportOptions& o, const Eigen::Vector3d& up,
+                       const Eigen::Vector3d& across, double bottom, double depth_lo,
+                       double depth_hi, double x0, double x1, SiloFrameReport& r) {
+  if (!(o.layer_bin > 0) || !(o.layer_band > 0) || !std::isfinite(o.layer_bin) ||
+      !std::isfinite(o.layer_band))
+    throw std::invalid_argument("layer bin and band must be positive");
+  if (!(x1 > x0)) return;
+  const Eigen::Vector3d depth_axis = up.cross(across);
+  const int n = std::max(1, static_cast<int>(std::floor((x1 - x0) / o.layer_bin + 1e-9)));
+  const double w = (x1 - x0) / n;  // (equal boxes filling the width)
+  for (const double fr : o.layer_fractions) {
+    if (!(fr > 0 && fr < 1)) throw std::invalid_argument("layer fractions must be in (0, 1)");
+    SiloLayer layer;
+    layer.height = fr * r.fill_height;  // (fill_height: set before the layers)
+    const double z = bottom + layer.height;
+    // (the band clipped to the fill: no space below the bottom or above the highest grain)
+    const double zlo = std::max(bottom, z - 0.5 * o.layer_band);
+    const double zhi = std::min(bottom + r.fill_height, z + 0.5 * o.layer_band);
+    std::vector<double> solid(static_cast<std::size_t>(n), 0.0);
+    for (const Particle& p : f.particles) {
+      // The centre in the (across, depth, up) frame, where the boxes are axis-aligned.
+      const Eigen::Vector3d c(p.position.dot(across), p.position.dot(depth_axis),
+                              p.position.dot(up));
+      if (!(c.z() + p.radius > zlo && c.z() - p.radius < zhi)) continue;
+      const int b0 = std::max(0, static_cast<int>(std::floor((c.x() - p.radius - x0) / w)));
+      const int b1 = std::min(n - 1, static_cast<int>(std::floor((c.x() + p.radius - x0) / w)));
+      for (int b = b0; b <= b1; ++b)
+        solid[static_cast<std::size_t>(b)] += sphere_box_volume(
+            c, p.radius, {x0 + b * w, depth_lo, zlo}, {x0 + (b + 1) * w, depth_hi, zhi});
+    }
+    const double box = w * (depth_hi - depth_lo) * (zhi - zlo);
+    for (int b = 0; b < n; ++b) {
+      layer.across.push_back(x0 + (b + 0.5) * w);
+      const double v = solid[static_cast<std::size_t>(b)];
+      layer.void_ratio.push_back(v > 0 ? box / v - 1 : NAN);
+    }
+    r.layers.push_back(std::move(layer));
+  }
+}
+
+void left_fabric(const Frame& f, const SiloReportOptions& o, const Eigen::Vector3d& up,
+                 const Eigen::Vector3d& across, double bottom, double x0, double x1,
+                 const std::unordered_map<std::int64_t, int>& role, SiloFrameReport& r) {
+  if (!(x1 > x0)) return;
+  const double mid = 0.5 * (x0 + x1);
+  std::vector<RoseContact> picked;
+  Eigen::Matrix2d F = Eigen::Matrix2d::Zero();
+  for (const Contact& c : f.contacts) {
+    if (role.count(c.id1) || role.count(c.id2)) continue;  // (particle–particle only)
+    if (!(c.point.dot(across) < mid) || !(c.point.dot(up) > bottom)) continue;
+    const Eigen::Vector2d n2(c.normal.dot(across), c.normal.dot(up));
+    const double len = n2.norm();
+    if (!(len > 0)) continue;
+    const Eigen::Vector2d u = n2 / len;
+    F += u * u.transpose();
+    RoseContact rc;
+    rc.normal = c.normal;
+    rc.fn = c.normal_force.norm();
+    rc.fs = c.shear_force.norm();
+    picked.push_back(rc);
+  }
+  r.fabric_contacts = picked.size();
+  if (picked.empty()) return;
+  Eigen::Matrix3d axes;
+  axes.row(0) = across.transpose();
+  axes.row(1) = up.transpose();
+  axes.row(2) = up.cross(across).transpose();
+  const Rose rose = contact_rose_2d(picked, axes, o.fabric_bins);
+  r.rose_angle_deg = rose.angle_deg;
+  r.rose_density = rose.density;
+  F /= static_cast<double>(picked.size());
+  // Major principal direction of the symmetric 2×2 tensor: θ = ½·atan2(2F12, F11 − F22).
+  double theta = 0.5 * std::atan2(2 * F(0, 1), F(0, 0) - F(1, 1)) * 180.0 / M_PI;
+  if (theta <= -90) theta += 180;
+  r.fabric_angle_deg = theta;
+  const double mean = 0.5 * F.trace();
+  const double dev =
+      std::sqrt(0.25 * (F(0, 0) - F(1, 1)) * (F(0, 0) - F(1, 1)) + F(0, 1) * F(0, 1));
+  r.fabric_anisotropy = dev / mean;  // ((F1 − F2) / (F1 + F2), the trace being 1)
 }
 
 }  // namespace
@@ -160,6 +249,13 @@ SiloFrameReport silo_report(const Frame& f, const SiloReportOptions& o) {
     }
   }
   if (o.zone_bin > 0) wall_zones(f, o, up, across, bottom, top, role, r);
+  r.fill_height = top - bottom;
+  const auto [x0, x1] = wall_bases(f, across, role);
+  r.width = x1 > x0 ? x1 - x0 : 0.0;
+  if (!o.layer_fractions.empty())
+    void_ratio_layers(f, o, up, across, bottom, o.depth > 0 ? 0.5 * (lo + hi) - 0.5 * depth : lo,
+                      o.depth > 0 ? 0.5 * (lo + hi) + 0.5 * depth : hi, x0, x1, r);
+  if (o.fabric_bins > 0) left_fabric(f, o, up, across, bottom, x0, x1, role, r);
   const bool loaded = std::abs(r.T_left) + std::abs(r.N_left) + std::abs(r.T_right) +
                           std::abs(r.N_right) + std::abs(r.P) >
                       0;

@@ -24,6 +24,17 @@
 //    difference towards the middle (linear interpolation) is the zone's inner boundary, and its
 //    distance from the wall's base plane (the extreme wall point across) the zone's thickness
 //    (NaN when the profile has no such point).
+//  * Void ratio across the width (§5.3.1; at 10, 25 and 40 cm of the seed's 0.5 m silo): in
+//    horizontal bands (`layer_band` thick, clipped to the fill: from the bottom to the highest
+//    grain's top) centred at fractions of the fill's height (`layer_fractions`), boxes `layer_bin`
+//    wide from one wall's base plane to the other's, through the particles' depth; e = V_box /
+//    V_solid − 1 with the exact sphere–box volumes. The boxes next to a saw-tooth wall hold teeth,
+//    which count as void.
+//  * Contact orientation in the left half (Fig 5.27): particle–particle contacts whose point
+//    lies in the left half and above the bottom, their normals projected on the across–up
+//    plane; the rose of `fabric_bins` bins (angle from the left wall's inward normal, towards
+//    up) and the major principal direction of the planar fabric tensor Σ n⊗n / N, as the angle
+//    from the wall normal in (−90°, 90°].
 #pragma once
 
 #include <Eigen/Core>
@@ -40,9 +51,19 @@ struct SiloReportOptions {
   double bin = 0;                                     // m, > 0
   double depth = 0;                                   // m; 0: the particles' extent
   double gravity = 9.81;
-  double zone_bin = 0;     // m; 0: no shear-zone profile
-  double zone_band = 0;    // m, > 0 with zone_bin
-  double zone_height = 0;  // m above the bottom; 0: half the fill's height
+  double zone_bin = 0;                  // m; 0: no shear-zone profile
+  double zone_band = 0;                 // m, > 0 with zone_bin
+  double zone_height = 0;               // m above the bottom; 0: half the fill's height
+  std::vector<double> layer_fractions;  // of the fill's height; empty: no void-ratio layers
+  double layer_bin = 0;                 // m, > 0 with layer_fractions
+  double layer_band = 0;                // m, > 0 with layer_fractions
+  int fabric_bins = 0;                  // rose bins over 360°; 0: no contact-orientation fabric
+};
+
+/// Void ratio across the silo at one height.
+struct SiloLayer {
+  double height = 0;                       // m above the bottom (band centre)
+  std::vector<double> across, void_ratio;  // box centres (m along across), e (NaN: no solid)
 };
 
 struct SiloProfile {
@@ -62,6 +83,14 @@ struct SiloFrameReport {
   double zone_height = 0;                          // m above the bottom
   std::vector<double> zone_across, zone_rotation;  // bin centres (m along across), mean |rot|
   double zone_left = NAN, zone_right = NAN;        // m
+  double fill_height = 0;                          // m: the highest particle top above the bottom
+  double width = 0;                                // m: between the side walls' base planes
+  std::vector<SiloLayer> layers;
+  // Left half contact orientation (with fabric_bins > 0).
+  std::vector<double> rose_angle_deg, rose_density;  // bin centres from the wall normal; 1/rad
+  double fabric_angle_deg = NAN;                     // major direction from the wall normal
+  double fabric_anisotropy = NAN;                    // (F1 − F2) / (F1 + F2) of the planar tensor
+  std::size_t fabric_contacts = 0;
 };
 
 /// Throws std::invalid_argument when the frame has no left or right side wall or no bottom,

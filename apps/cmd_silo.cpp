@@ -16,6 +16,7 @@
 #include "field_output.hpp"
 #include "grain_size.hpp"
 #include "silo_report.hpp"
+#include "silo_theory.hpp"
 #include "trajectory_io.hpp"
 
 namespace gs::cli {
@@ -31,7 +32,19 @@ struct SiloArgs {
   long from = 0;
   std::optional<double> from_time;
   double gravity = 9.81;
+  std::vector<double> layers{0.2, 0.5, 0.8};
+  double layer_bin_d50 = 2.0, layer_band_d50 = 5.0;
+  int rose_bins = 36;
+  double phi_i = 35.0, en_k = 0.63;
 };
+
+/// Janssen's P/G (seed 004 Eq 5.1) for a fill of height h in a plane silo of width b with
+/// friction on its side walls: P/G = (z0/h)·(1 − exp(−h/z0)), z0 = R/(K·μ), R = b/2 (the
+/// weight γ·b·h·depth cancels).
+double janssen_p_over_g(double K, double mu, double width, double height) {
+  const double R = 0.5 * width;
+  return ga::janssen_vertical_stress(1.0, K, mu, R, height) / height;
+}
 
 Eigen::Vector3d vec(const std::vector<double>& v) {
   return {v[0], v[1], v[2]};
@@ -69,6 +82,20 @@ void run_silo(const SiloArgs& a) {
   o.zone_band = a.zone_band_d50 * d50;
   if (a.zone_height) require_positive(a.input, "--zone-height", *a.zone_height);
   o.zone_height = a.zone_height.value_or(0.0);
+  for (const double f : a.layers)
+    if (!(f > 0 && f < 1))
+      throw InputError(a.input, "--layers: a fraction not in (0, 1)", value_str(f));
+  o.layer_fractions = a.layers;
+  require_positive(a.input, "--layer-bin-d50", a.layer_bin_d50);
+  require_positive(a.input, "--layer-band-d50", a.layer_band_d50);
+  o.layer_bin = a.layer_bin_d50 * d50;
+  o.layer_band = a.layer_band_d50 * d50;
+  if (a.rose_bins < 4 || a.rose_bins > 3600)
+    throw InputError(a.input, "--rose-bins: not in [4, 3600]", std::to_string(a.rose_bins));
+  o.fabric_bins = a.rose_bins;
+  if (!(a.phi_i > 0 && a.phi_i < 90))
+    throw InputError(a.input, "--phi-i: not in (0, 90) deg", value_str(a.phi_i));
+  require_positive(a.input, "--en-k", a.en_k);
   std::vector<ga::SiloFrameReport> reports;
   for (long i = from; i < n; ++i) {
     try {
@@ -146,6 +173,40 @@ void run_silo(const SiloArgs& a) {
     h.attr("zone_right_m", r.zone_right, g);
     h.write(g + "/zone_across_m", r.zone_across);
     h.write(g + "/zone_rotation_rad", r.zone_rotation);
+    // Void ratio across the width at the layers' heights (one row per layer).
+    std::vector<double> lh, la, le;
+    for (const auto& L : r.layers)
+      for (std::size_t b = 0; b < L.across.size(); ++b) {
+        lh.push_back(L.height);
+        la.push_back(L.across[b]);
+        le.push_back(L.void_ratio[b]);
+      }
+    h.write(g + "/layer_height_m", lh);
+    h.write(g + "/layer_across_m", la);
+    h.write(g + "/layer_void_ratio", le);
+    h.write(g + "/rose_left_angle_deg", r.rose_angle_deg);
+    h.write(g + "/rose_left_density", r.rose_density);
+    h.attr("fabric_left_angle_deg", r.fabric_angle_deg, g);
+    h.attr("fabric_left_anisotropy", r.fabric_anisotropy, g);
+    h.attr("fabric_left_contacts", static_cast<long long>(r.fabric_contacts), g);
+    // The slice method beside ours (Eq 5.1 with R = b/2; K from Eq 5.2 with this state's
+    // mean wall friction angle, and EN 1991-4's K).
+    const double phi_w = 0.5 * (r.phi_left_deg + r.phi_right_deg);
+    const double mu = std::tan(phi_w * M_PI / 180.0);
+    double k_dr = NAN, p_dr = NAN, p_en = NAN;
+    if (mu > 0 && r.width > 0 && r.fill_height > 0) {
+      if (phi_w <= a.phi_i) {
+        k_dr = ga::drescher_lateral_ratio(a.phi_i, phi_w);
+        p_dr = janssen_p_over_g(k_dr, mu, r.width, r.fill_height);
+      }
+      p_en = janssen_p_over_g(a.en_k, mu, r.width, r.fill_height);
+    }
+    h.attr("phi_w_mean_deg", phi_w, g);
+    h.attr("K_drescher", k_dr, g);
+    h.attr("P_G_drescher", p_dr, g);
+    h.attr("P_G_en1991", p_en, g);
+    h.attr("width_m", r.width, g);
+    h.attr("fill_height_m", r.fill_height, g);
     for (std::size_t b = 0; b < r.profile.height.size(); ++b) {
       st.push_back(static_cast<double>(i));
       ph.push_back(r.profile.height[b]);
@@ -161,6 +222,28 @@ void run_silo(const SiloArgs& a) {
         name, from + static_cast<long>(k), r.time, r.P / r.G, r.T_left / r.G, r.T_right / r.G,
         r.N_left / r.G, r.N_right / r.G, r.phi_left_deg, r.phi_right_deg, r.balance,
         r.zone_left / d50, r.zone_right / d50, r.zone_height);
+    std::printf("         P/G by the slice method (Eq 5.1, R = b/2, mu = tan %.1f deg): ", phi_w);
+    if (std::isnan(k_dr) && !(phi_w > 0))
+      std::printf("n/a (no wall friction mobilised)");
+    else if (std::isnan(k_dr))
+      std::printf("Drescher n/a (phi_w > phi_i = %g deg)", a.phi_i);
+    else
+      std::printf("Drescher %.3f (K %.3f, Eq 5.2, phi_i %g deg)", p_dr, k_dr, a.phi_i);
+    if (phi_w > 0) std::printf(", EN 1991-4 %.3f (K %g)", p_en, a.en_k);
+    std::printf("; ours %.3f\n", r.P / r.G);
+    for (const auto& L : r.layers) {
+      double e_wall = 0, e_mid = 0;
+      const std::size_t nb = L.void_ratio.size();
+      e_wall = 0.5 * (L.void_ratio.front() + L.void_ratio.back());
+      e_mid = L.void_ratio[nb / 2];
+      std::printf("         void ratio at %.3g m: %.3f next to the walls, %.3f in the middle\n",
+                  L.height, e_wall, e_mid);
+    }
+    if (r.fabric_contacts > 0)
+      std::printf(
+          "         left half: %zu contacts, major direction %.1f deg from the wall normal "
+          "(anisotropy %.3f)\n",
+          r.fabric_contacts, r.fabric_angle_deg, r.fabric_anisotropy);
   }
   h.commit();
   if (!a.csv.empty()) {
@@ -209,6 +292,18 @@ void register_analyze_silo(CLI::App& app) {
   s->add_option("--zone-band-d50", a->zone_band_d50,
                 "thickness of the band the rotation profile is taken in, d50 (default 5)");
   s->add_option("--zone-bin-d50", a->zone_bin_d50, "bins across the silo, d50 (default 1)");
+  s->add_option("--layers", a->layers,
+                "heights of the void-ratio layers as fractions of the fill (default 0.2 0.5 0.8: "
+                "10, 25 and 40 cm of the seed's 0.5 m)");
+  s->add_option("--layer-bin-d50", a->layer_bin_d50, "void-ratio boxes across, d50 (default 2)");
+  s->add_option("--layer-band-d50", a->layer_band_d50,
+                "thickness of the void-ratio layers, d50 (default 5)");
+  s->add_option("--rose-bins", a->rose_bins,
+                "bins of the left half's contact rose over 360 deg (default 36)");
+  s->add_option("--phi-i", a->phi_i,
+                "internal friction angle for Eq 5.2, deg (default 35, seed 004 §5.3.1)");
+  s->add_option("--en-k", a->en_k,
+                "EN 1991-4 lateral pressure ratio (default 0.63 = 0.45 x 1.4, seed 004 §5.3.1)");
   s->callback([a] { run_silo(*a); });
 }
 

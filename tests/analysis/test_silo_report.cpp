@@ -7,8 +7,10 @@
 #include <stdexcept>
 
 #include "silo_report.hpp"
+#include "silo_theory.hpp"
 
 using namespace gs;
+using namespace gs::analysis;
 
 namespace {
 
@@ -152,4 +154,124 @@ TEST(SiloReport, WallZoneThicknessAtTheInflectionOfTheRotationProfile) {
   o.zone_height = 0.02;
   const auto none = analysis::silo_report(f, o);
   EXPECT_TRUE(std::isnan(none.zone_left));
+}
+
+// Exact answers for the slice method of seed 004 §5.3.1: Eq 5.2 at φw = φi reduces to
+// K = cos²φ / (1 + sin²φ); at 35°/32° it is the printed 0.83. Eq 5.1 with the seed's own
+// inputs (γ = 16 kN/m³, b = 0.2 m, depth 0.6 m, h = 0.5 m, the printed K and the experimental
+// φw, R = b as the seed writes it) gives Table 5.3's Drescher row, 533 / 490 / 537 N, to 1 N.
+TEST(SiloTheory, DrescherRatioAndJanssenBottomForceAgainstTheSeed) {
+  const double phi = 35 * M_PI / 180;
+  EXPECT_NEAR(drescher_lateral_ratio(35, 35),
+              std::cos(phi) * std::cos(phi) / (1 + std::sin(phi) * std::sin(phi)), 1e-14);
+  EXPECT_NEAR(drescher_lateral_ratio(35, 32), 0.83, 0.005);
+  EXPECT_THROW(drescher_lateral_ratio(35, 36), std::invalid_argument);
+  EXPECT_THROW(drescher_lateral_ratio(35, 0), std::invalid_argument);
+  const double printed_k[] = {1.73, 1.21, 0.83}, phi_w[] = {17, 27, 32}, table[] = {533, 490, 537};
+  for (int i = 0; i < 3; ++i) {
+    const double mu = std::tan(phi_w[i] * M_PI / 180);
+    const double P = janssen_vertical_stress(16e3, printed_k[i], mu, 0.2, 0.5) * 0.2 * 0.6;
+    EXPECT_NEAR(P, table[i], 1.0) << "phi_w " << phi_w[i];
+  }
+  // Shallow fill: hydrostatic, γh·(1 − h/(2·z0)) to second order (z0 = R/(Kμ) = 0.5 m); deep fill:
+  // Janssen's asymptote γR/(Kμ).
+  EXPECT_NEAR(janssen_vertical_stress(1e4, 0.5, 0.4, 0.1, 1e-6), 1e4 * 1e-6 * (1 - 1e-6), 1e-14);
+  EXPECT_NEAR(janssen_vertical_stress(1e4, 0.5, 0.4, 0.1, 100), 1e4 * 0.1 / 0.2, 1e-9);
+  EXPECT_THROW(janssen_vertical_stress(1e4, 0.5, 0.0, 0.1, 1), std::invalid_argument);
+}
+
+namespace {
+
+/// Simple cubic packing of spheres of radius r between a left plane (x = 0) and a right plane
+/// (x = 20r), 2 deep (y in [0, 4r]) and 20 high on a bottom plane at z = 0: void ratio
+/// 6/π − 1 in any box aligned with the lattice cells.
+Frame cubic_silo(double r) {
+  Frame f;
+  f.walls = {wall(1000, WallKind::Plane, {0, 0, 0}, {1, 0, 0}, {0, 0, 0}),
+             wall(1001, WallKind::Plane, {20 * r, 0, 0}, {-1, 0, 0}, {0, 0, 0}),
+             wall(1002, WallKind::Plane, {0, 0, 0}, {0, 0, 1}, {0, 0, 0})};
+  std::int64_t id = 0;
+  for (int i = 0; i < 10; ++i)
+    for (int j = 0; j < 2; ++j)
+      for (int k = 0; k < 20; ++k) {
+        Particle p;
+        p.id = id++;
+        p.position = Eigen::Vector3d((2 * i + 1) * r, (2 * j + 1) * r, (2 * k + 1) * r);
+        p.radius = r;
+        p.mass = 1e-3;
+        f.particles.push_back(p);
+      }
+  return f;
+}
+
+Contact between(std::int64_t a, std::int64_t b, Eigen::Vector3d point, Eigen::Vector3d n) {
+  Contact c;
+  c.id1 = a;
+  c.id2 = b;
+  c.point = point;
+  c.normal = n.normalized();
+  c.normal_force = 0.1 * c.normal;
+  return c;
+}
+
+}  // namespace
+
+// Exact answer: 6/π − 1 in every box of the three layers (at 0.2, 0.5 and 0.8 of the 40r fill,
+// bands 4r thick, boxes 2r wide: all aligned with the lattice's cells).
+TEST(SiloReport, VoidRatioAcrossTheWidthOfACubicPacking) {
+  const double r = 0.001;
+  SiloReportOptions o;
+  o.bin = 5 * r;
+  o.layer_fractions = {0.2, 0.5, 0.8};
+  o.layer_bin = 2 * r;
+  o.layer_band = 4 * r;
+  const auto rep = silo_report(cubic_silo(r), o);
+  EXPECT_NEAR(rep.fill_height, 40 * r, 1e-15);
+  EXPECT_NEAR(rep.width, 20 * r, 1e-15);
+  ASSERT_EQ(rep.layers.size(), 3u);
+  for (const auto& L : rep.layers) {
+    ASSERT_EQ(L.void_ratio.size(), 10u);
+    for (std::size_t b = 0; b < 10; ++b) {
+      EXPECT_NEAR(L.void_ratio[b], 6 / M_PI - 1, 1e-9) << "layer " << L.height << " box " << b;
+      EXPECT_NEAR(L.across[b], (2 * b + 1) * r, 1e-15);
+    }
+  }
+  EXPECT_NEAR(rep.layers[1].height, 20 * r, 1e-15);
+  // Boxes of 3r (floor(20/3) = 6 boxes of 20r/6) cut the spheres: the mean over the width is
+  // still the packing's (the boxes tile the cells' rows).
+  o.layer_bin = 3 * r;
+  const auto cut = silo_report(cubic_silo(r), o);
+  double solid = 0;
+  for (const double e : cut.layers[1].void_ratio) solid += 1 / (1 + e);
+  EXPECT_NEAR(solid / 6, M_PI / 6, 1e-9);
+  o.layer_fractions = {1.2};
+  EXPECT_THROW(silo_report(cubic_silo(r), o), std::invalid_argument);
+}
+
+// Hand-computed fabric: in the left half, contacts at +30° and −30° from the wall normal (in the
+// across–up plane) give a planar tensor diag(cos²30°, sin²30°): major direction 0°, anisotropy
+// cos 60° = 1/2; the right half's vertical contact and wall contacts are left out. All at +30°:
+// direction 30°, anisotropy 1.
+TEST(SiloReport, LeftHalfContactOrientation) {
+  const double r = 0.001;
+  Frame f = cubic_silo(r);
+  const double c = std::cos(M_PI / 6), s = std::sin(M_PI / 6);
+  f.contacts = {between(0, 1, {5 * r, r, 10 * r}, {c, 0, s}),
+                between(2, 3, {6 * r, r, 12 * r}, {c, 0, -s}),
+                between(4, 5, {3 * r, 2 * r, 14 * r}, {-c, 0.3, -s}),  // (projected: -150° ≡ 30°)
+                between(6, 7, {4 * r, r, 16 * r}, {-c, 0, s}),
+                between(8, 9, {15 * r, r, 10 * r}, {0, 0, 1}),  // right half
+                between(1000, 9, {0, r, 10 * r}, {1, 0, 0})};   // wall contact
+  SiloReportOptions o;
+  o.bin = 5 * r;
+  o.fabric_bins = 12;
+  const auto rep = silo_report(f, o);
+  EXPECT_EQ(rep.fabric_contacts, 4u);
+  EXPECT_NEAR(rep.fabric_angle_deg, 0.0, 1e-9);
+  EXPECT_NEAR(rep.fabric_anisotropy, 0.5, 1e-12);
+  ASSERT_EQ(rep.rose_density.size(), 12u);
+  f.contacts = {f.contacts[0], f.contacts[2]};
+  const auto one = silo_report(f, o);
+  EXPECT_NEAR(one.fabric_angle_deg, 30.0, 1e-9);
+  EXPECT_NEAR(one.fabric_anisotropy, 1.0, 1e-12);
 }

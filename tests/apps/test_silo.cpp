@@ -8,6 +8,7 @@
 #include <cmath>
 #include <fstream>
 
+#include "../dic/h5_read.hpp"
 #include "../io/test_util.hpp"
 #include "cli_util.hpp"
 
@@ -119,6 +120,31 @@ TEST(Silo, QuasiStaticBottomMovesAndTheForcesBalanceTheWeight) {
                            dir.path);
   EXPECT_EQ(bad.rc, 2);
   EXPECT_NE(bad.err.find("--from: no such frame"), std::string::npos) << bad.err;
+  // The void-ratio layers, the left half's fabric and the slice method are in the report: the
+  // grains' solid volume over the boxes of a layer is at most the boxes' (e ≥ 0).
+  EXPECT_NE(rep.out.find("void ratio at"), std::string::npos) << rep.out;
+  EXPECT_NE(rep.out.find("left half:"), std::string::npos) << rep.out;
+  EXPECT_NE(rep.out.find("slice method"), std::string::npos) << rep.out;
+  const auto voids =
+      gs::test::h5::read(dir / "silo_report.h5", "/profiles/residual/layer_void_ratio");
+  ASSERT_GT(voids.size(), 6u);
+  int finite = 0;
+  for (const double v : voids.v) {
+    EXPECT_FALSE(v < 0);
+    finite += std::isfinite(v);
+  }
+  EXPECT_GT(finite, 6);
+  EXPECT_TRUE(gs::test::h5::has(dir / "silo_report.h5", "/profiles/residual/rose_left_density"));
+  for (const auto& [option, value] : std::vector<std::pair<std::string, std::string>>{
+           {"--layers", "1.5"}, {"--rose-bins", "2"}, {"--phi-i", "95"}, {"--en-k", "-1"}}) {
+    const auto b = run_cli("analyze silo " + (dir / "out" / "trajectory.h5").string() + " -o " +
+                               (dir / "x.h5").string() + " " + option + " " + value,
+                           dir.path);
+    EXPECT_EQ(b.rc, 2) << option;
+    EXPECT_NE(b.err.find("error: "), std::string::npos) << b.err;
+    EXPECT_NE(b.err.find(option), std::string::npos) << b.err;
+    EXPECT_FALSE(std::filesystem::exists(dir / "x.h5")) << option;
+  }
   // The wall forces are in the history too, per side wall (the meshes' groups).
   const auto h = read_csv_table(dir / "out" / "history.csv");
   for (const char* col : {"left_fz_N", "right_fx_N", "bottom_fz_N"}) (void)h.num(0, col);
