@@ -23,6 +23,7 @@ FIGURES = {
     "granoscope-rose": ["fig_rose"],
     "granoscope-chains": ["fig_chains"],
     "granoscope-walls": ["fig_walls"],
+    "granoscope-silo": ["fig_silo"],
     "granoscope-hhd": ["fig_hhd"],
     "granoscope-vortices": ["fig_vortices"],
 }

@@ -1005,3 +1005,76 @@ TEST_F(Figures, MalformedInputsAreOneErrorLine) {
     EXPECT_TRUE(pngs(dir / (file + "_figs")).empty()) << file;
   }
 }
+
+// `figures` of an `analyze silo` report: the forces over the weight are the report's series,
+// and the void ratio across a simple cubic packing is 6/π − 1 in every box (exact answer: the
+// boxes are aligned with the lattice cells), the rose of the left half is drawn for each state.
+TEST_F(Figures, SiloReportForcesVoidRatioAndRose) {
+  const double r = 1e-3;
+  gs::Trajectory t;
+  for (int k = 0; k < 3; ++k) {
+    gs::Frame f;
+    f.time = 0.1 * k;
+    auto wall = [&](std::int64_t id, Eigen::Vector3d a, Eigen::Vector3d b, Eigen::Vector3d F) {
+      gs::Wall w;
+      w.id = id;
+      w.a = a;
+      w.b = b;
+      w.force = F;
+      return w;
+    };
+    const double s = 1e-3 * (1 + k);  // (the side walls' load grows frame by frame)
+    f.walls = {wall(1000, {0, 0, 0}, {1, 0, 0}, {-s, 0, -0.5 * s}),
+               wall(1001, {20 * r, 0, 0}, {-1, 0, 0}, {s, 0, -0.5 * s}),
+               wall(1002, {0, 0, 0}, {0, 0, 1}, {0, 0, -0.01})};
+    std::int64_t id = 0;
+    for (int i = 0; i < 10; ++i)
+      for (int j = 0; j < 2; ++j)
+        for (int m = 0; m < 20; ++m) {
+          gs::Particle q;
+          q.id = id++;
+          q.position = Eigen::Vector3d((2 * i + 1) * r, (2 * j + 1) * r, (2 * m + 1) * r);
+          q.radius = r;
+          q.mass = 1e-5;
+          f.particles.push_back(q);
+        }
+    auto contact = [&](std::int64_t a, std::int64_t b, Eigen::Vector3d pt, Eigen::Vector3d n,
+                       Eigen::Vector3d F) {
+      gs::Contact c;
+      c.id1 = a;
+      c.id2 = b;
+      c.point = pt;
+      c.normal = n.normalized();
+      c.normal_force = F;
+      return c;
+    };
+    f.contacts = {contact(1000, 0, {0, r, r}, {1, 0, 0}, {s, 0, 0.5 * s}),
+                  contact(1001, 399, {20 * r, r, 39 * r}, {-1, 0, 0}, {-s, 0, 0.5 * s}),
+                  contact(0, 1, {r, 2 * r, r}, {0, 0, 1}, {0, 0, 0.1}),
+                  contact(2, 3, {3 * r, 2 * r, 5 * r}, {1, 0, 1}, {0.1, 0, 0.1})};
+    t.frames.push_back(f);
+  }
+  gs::write_hdf5_trajectory(dir / "silo.h5", t);
+  const CliRun a = run("analyze silo " + p("silo.h5") + " -o " + p("report.h5") +
+                           " --layer-bin-d50 1 --layer-band-d50 2",
+                       false);
+  ASSERT_EQ(a.rc, 0) << a.err;
+  const CliRun r2 = run("figures " + p("report.h5") + " -o " + p("f"));
+  ASSERT_EQ(r2.rc, 0) << r2.err;
+  EXPECT_EQ(pngs(dir / "f"),
+            (std::vector<std::string>{"silo_fabric.png", "silo_forces.png", "silo_profiles.png"}));
+  const Plotted forces = read_plotted(dir / "f" / "silo_forces.png");
+  const int af = forces.axes("silo: forces over the weight");
+  ASSERT_GE(af, 0);
+  expect_same(forces.nums("line_y", af, 0), gs::test::h5::read(dir / "report.h5", "/series/P_G").v,
+              "P/G");
+  expect_same(forces.nums("line_y", af, 3),
+              gs::test::h5::read(dir / "report.h5", "/series/N_left_G").v, "N/G left");
+  const Plotted fab = read_plotted(dir / "f" / "silo_fabric.png");
+  const int ae = fab.axes("silo: void ratio across");
+  ASSERT_GE(ae, 0);
+  const auto e = fab.nums("line_y", ae, 0);
+  ASSERT_EQ(e.size(), 10u);
+  for (const double v : e) EXPECT_NEAR(v, 6 / M_PI - 1, 1e-6);
+  EXPECT_GE(fab.axes("silo: left half contact normals (0 deg = wall normal)"), 0);
+}
