@@ -143,7 +143,82 @@ void left_fabric(const Frame& f, const SiloReportOptions& o, const Eigen::Vector
   r.fabric_anisotropy = dev / mean;  // ((F1 − F2) / (F1 + F2), the trace being 1)
 }
 
+void flow_pattern(const Frame& f, const SiloReportOptions& o, const Eigen::Vector3d& up,
+                  const Eigen::Vector3d& across, double bottom, double x0, double x1,
+                  SiloFrameReport& r) {
+  if (!(o.flow_wall_width > 0) || !std::isfinite(o.flow_wall_width) || !(o.flow_threshold > 0) ||
+      !(o.flow_threshold < 1))
+    throw std::invalid_argument("flow wall width must be positive and the threshold in (0, 1)");
+  if (!(x1 > x0) || !(r.fill_height > 0)) return;
+  const int nb = o.flow_bands;
+  const double w = o.flow_wall_width, band = r.fill_height / nb;
+  const int cols = std::max(1, static_cast<int>(std::floor((x1 - x0) / w)));
+  const double cw = (x1 - x0) / cols;
+  // Per band: the sum and count of the downward velocity per column of the width w across, and
+  // in the columns at the two walls (the column of width w at each base plane).
+  std::vector<double> sum(static_cast<std::size_t>(nb * cols), 0.0), cnt(sum.size(), 0.0);
+  std::vector<double> wl(static_cast<std::size_t>(nb), 0.0), nl(wl), wr(wl), nr(wl);
+  for (const Particle& p : f.particles) {
+    const double h = p.position.dot(up) - bottom, x = p.position.dot(across) - x0;
+    if (!(h >= 0 && h < r.fill_height) || !(x >= 0 && x < x1 - x0)) continue;
+    const auto b = static_cast<std::size_t>(std::min(nb - 1, static_cast<int>(h / band)));
+    const double down = -p.velocity.dot(up);
+    const auto c = static_cast<std::size_t>(std::min(cols - 1, static_cast<int>(x / cw)));
+    sum[b * static_cast<std::size_t>(cols) + c] += down;
+    cnt[b * static_cast<std::size_t>(cols) + c] += 1;
+    if (x < w) wl[b] += down, nl[b] += 1;
+    if (x >= (x1 - x0) - w) wr[b] += down, nr[b] += 1;
+  }
+  std::vector<double> fastest(static_cast<std::size_t>(nb), 0.0);
+  for (std::size_t b = 0; b < static_cast<std::size_t>(nb); ++b)
+    for (std::size_t c = 0; c < static_cast<std::size_t>(cols); ++c) {
+      const std::size_t k = b * static_cast<std::size_t>(cols) + c;
+      if (cnt[k] > 0) fastest[b] = std::max(fastest[b], sum[k] / cnt[k]);
+    }
+  r.flow_speed = *std::max_element(fastest.begin(), fastest.end());
+  if (!(r.flow_speed > 1e-6)) {
+    r.flow = FlowPattern::Rest;
+    return;
+  }
+  // The transition of a wall: the lowest band from which the wall moves in every band up to the
+  // one below the free surface's band.
+  auto transition = [&](const std::vector<double>& ws, const std::vector<double>& ns) {
+    const int top = std::max(0, nb - 2);
+    int from = top + 1;
+    for (int b = top; b >= 0; --b) {
+      const auto k = static_cast<std::size_t>(b);
+      const bool moves =
+          ns[k] > 0 && fastest[k] > 0 && ws[k] / ns[k] > o.flow_threshold * fastest[k];
+      if (!moves) break;
+      from = b;
+    }
+    return from > top ? NAN : from * band;
+  };
+  r.transition_left = transition(wl, nl);
+  r.transition_right = transition(wr, nr);
+  auto pattern = [&](double t) {
+    if (std::isnan(t)) return FlowPattern::Funnel;
+    return t <= 0.25 * r.fill_height ? FlowPattern::Mass : FlowPattern::Mixed;
+  };
+  r.flow = static_cast<FlowPattern>(std::min(static_cast<int>(pattern(r.transition_left)),
+                                             static_cast<int>(pattern(r.transition_right))));
+}
+
 }  // namespace
+
+const char* flow_pattern_name(FlowPattern p) {
+  switch (p) {
+    case FlowPattern::Rest:
+      return "at rest";
+    case FlowPattern::Funnel:
+      return "funnel";
+    case FlowPattern::Mixed:
+      return "mixed";
+    case FlowPattern::Mass:
+      return "mass";
+  }
+  return "?";
+}
 
 SiloFrameReport silo_report(const Frame& f, const SiloReportOptions& o) {
   if (!(o.bin > 0) || !std::isfinite(o.bin)) throw std::invalid_argument("bin must be positive");
@@ -256,6 +331,7 @@ SiloFrameReport silo_report(const Frame& f, const SiloReportOptions& o) {
     void_ratio_layers(f, o, up, across, bottom, o.depth > 0 ? 0.5 * (lo + hi) - 0.5 * depth : lo,
                       o.depth > 0 ? 0.5 * (lo + hi) + 0.5 * depth : hi, x0, x1, r);
   if (o.fabric_bins > 0) left_fabric(f, o, up, across, bottom, x0, x1, role, r);
+  if (o.flow_bands > 0) flow_pattern(f, o, up, across, bottom, x0, x1, r);
   const bool loaded = std::abs(r.T_left) + std::abs(r.N_left) + std::abs(r.T_right) +
                           std::abs(r.N_right) + std::abs(r.P) >
                       0;

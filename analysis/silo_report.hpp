@@ -30,6 +30,16 @@
 //    wide from one wall's base plane to the other's, through the particles' depth; e = V_box /
 //    V_solid − 1 with the exact sphere–box volumes. The boxes next to a saw-tooth wall hold teeth,
 //    which count as void.
+//  * Flow pattern (§5.3.2; mass, funnel or mixed flow) from the frame's velocities: the fill
+//    cut into `flow_bands` horizontal bands; in each, the mean downward velocity of the grains
+//    in a column `flow_wall_width` wide at each wall's base plane (wide enough to reach past the
+//    teeth) against the fastest column of that width across the band. A wall moves in a band
+//    when its column goes down faster than `flow_threshold` times the fastest column. The
+//    transition height of a wall is the lowest band from which the wall moves in every band
+//    up to the one below the free surface (NaN: stagnant up to there); a wall is in mass flow
+//    when its transition lies in the lowest quarter of the fill (only the dead zones at a flat
+//    bottom), funnel flow when it has none, mixed flow in between; the silo's pattern is the
+//    slower wall's. A frame whose fastest column moves slower than 1e-6 m/s is at rest.
 //  * Contact orientation in the left half (Fig 5.27): particle–particle contacts whose point
 //    lies in the left half and above the bottom, their normals projected on the across–up
 //    plane; the rose of `fabric_bins` bins (angle from the left wall's inward normal, towards
@@ -58,7 +68,13 @@ struct SiloReportOptions {
   double layer_bin = 0;                 // m, > 0 with layer_fractions
   double layer_band = 0;                // m, > 0 with layer_fractions
   int fabric_bins = 0;                  // rose bins over 360°; 0: no contact-orientation fabric
+  int flow_bands = 0;                   // 0: no flow pattern
+  double flow_wall_width = 0;           // m, > 0 with flow_bands
+  double flow_threshold = 0.1;          // of the fastest column's downward velocity
 };
+
+enum class FlowPattern : int { Rest = 0, Funnel = 1, Mixed = 2, Mass = 3 };
+const char* flow_pattern_name(FlowPattern p);
 
 /// Void ratio across the silo at one height.
 struct SiloLayer {
@@ -91,6 +107,10 @@ struct SiloFrameReport {
   double fabric_angle_deg = NAN;                     // major direction from the wall normal
   double fabric_anisotropy = NAN;                    // (F1 − F2) / (F1 + F2) of the planar tensor
   std::size_t fabric_contacts = 0;
+  // Flow pattern (with flow_bands > 0).
+  FlowPattern flow = FlowPattern::Rest;
+  double transition_left = NAN, transition_right = NAN;  // m above the bottom
+  double flow_speed = 0;                                 // m/s, the fastest column's
 };
 
 /// Throws std::invalid_argument when the frame has no left or right side wall or no bottom,

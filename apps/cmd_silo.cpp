@@ -36,6 +36,8 @@ struct SiloArgs {
   double layer_bin_d50 = 2.0, layer_band_d50 = 5.0;
   int rose_bins = 36;
   double phi_i = 35.0, en_k = 0.63;
+  int flow_bands = 10;
+  double flow_wall_d50 = 3.0, flow_threshold = 0.1;
 };
 
 /// Janssen's P/G (seed 004 Eq 5.1) for a fill of height h in a plane silo of width b with
@@ -96,6 +98,14 @@ void run_silo(const SiloArgs& a) {
   if (!(a.phi_i > 0 && a.phi_i < 90))
     throw InputError(a.input, "--phi-i: not in (0, 90) deg", value_str(a.phi_i));
   require_positive(a.input, "--en-k", a.en_k);
+  if (a.flow_bands < 0 || a.flow_bands > 10000)
+    throw InputError(a.input, "--flow-bands: not in [0, 10000]", std::to_string(a.flow_bands));
+  o.flow_bands = a.flow_bands;
+  require_positive(a.input, "--flow-wall-d50", a.flow_wall_d50);
+  o.flow_wall_width = a.flow_wall_d50 * d50;
+  if (!(a.flow_threshold > 0 && a.flow_threshold < 1))
+    throw InputError(a.input, "--flow-threshold: not in (0, 1)", value_str(a.flow_threshold));
+  o.flow_threshold = a.flow_threshold;
   std::vector<ga::SiloFrameReport> reports;
   for (long i = from; i < n; ++i) {
     try {
@@ -127,7 +137,12 @@ void run_silo(const SiloArgs& a) {
                                                                      {"N_right_G", {}},
                                                                      {"balance_G", {}},
                                                                      {"phi_w_left_deg", {}},
-                                                                     {"phi_w_right_deg", {}}};
+                                                                     {"phi_w_right_deg", {}},
+                                                                     {"discharged_kg", {}},
+                                                                     {"flow_pattern", {}},
+                                                                     {"transition_left_m", {}},
+                                                                     {"transition_right_m", {}},
+                                                                     {"flow_speed_m_s", {}}};
   for (std::size_t k = 0; k < reports.size(); ++k) {
     const auto& r = reports[k];
     const double v[] = {static_cast<double>(from) + static_cast<double>(k),
@@ -145,7 +160,12 @@ void run_silo(const SiloArgs& a) {
                         r.N_right / r.G,
                         r.balance,
                         r.phi_left_deg,
-                        r.phi_right_deg};
+                        r.phi_right_deg,
+                        (reports.front().G - r.G) / a.gravity,
+                        static_cast<double>(static_cast<int>(r.flow)),
+                        r.transition_left,
+                        r.transition_right,
+                        r.flow_speed};
     for (std::size_t c = 0; c < series.size(); ++c) series[c].second.push_back(v[c]);
   }
   H5FieldFile h(a.output, "granoscope-silo");
@@ -239,6 +259,11 @@ void run_silo(const SiloArgs& a) {
       std::printf("         void ratio at %.3g m: %.3f next to the walls, %.3f in the middle\n",
                   L.height, e_wall, e_mid);
     }
+    if (o.flow_bands > 0)
+      std::printf(
+          "         flow: %s (the walls move from %.3g / %.3g m up; fastest column "
+          "%.3g m/s)\n",
+          ga::flow_pattern_name(r.flow), r.transition_left, r.transition_right, r.flow_speed);
     if (r.fabric_contacts > 0)
       std::printf(
           "         left half: %zu contacts, major direction %.1f deg from the wall normal "
@@ -300,6 +325,13 @@ void register_analyze_silo(CLI::App& app) {
                 "thickness of the void-ratio layers, d50 (default 5)");
   s->add_option("--rose-bins", a->rose_bins,
                 "bins of the left half's contact rose over 360 deg (default 36)");
+  s->add_option("--flow-bands", a->flow_bands,
+                "bands of the fill for the flow pattern (default 10; 0: none)");
+  s->add_option("--flow-wall-d50", a->flow_wall_d50,
+                "width of the columns at the walls for the flow pattern, d50 (default 3)");
+  s->add_option("--flow-threshold", a->flow_threshold,
+                "a wall moves when its column goes down faster than this fraction of the "
+                "fastest column (default 0.1)");
   s->add_option("--phi-i", a->phi_i,
                 "internal friction angle for Eq 5.2, deg (default 35, seed 004 §5.3.1)");
   s->add_option("--en-k", a->en_k,

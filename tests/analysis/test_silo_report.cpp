@@ -275,3 +275,42 @@ TEST(SiloReport, LeftHalfContactOrientation) {
   EXPECT_NEAR(one.fabric_angle_deg, 30.0, 1e-9);
   EXPECT_NEAR(one.fabric_anisotropy, 1.0, 1e-12);
 }
+
+// Hand-set velocity fields on the cubic packing (10 bands of 4r, wall columns 2r): everything
+// going down is mass flow from the bottom; only the middle columns going down is funnel flow;
+// the walls moving in the upper half only is mixed flow with its transition at mid-height; one
+// wall stagnant is funnel flow whatever the other does; nothing moving is a silo at rest.
+TEST(SiloReport, FlowPatternFromTheVelocityField) {
+  const double r = 0.001;
+  SiloReportOptions o;
+  o.bin = 5 * r;
+  o.flow_bands = 10;
+  o.flow_wall_width = 2 * r;
+  auto run = [&](auto down) {
+    Frame f = cubic_silo(r);
+    for (Particle& p : f.particles) p.velocity = {0, 0, -down(p.position.x(), p.position.z())};
+    return silo_report(f, o);
+  };
+  const auto mass = run([](double, double) { return 1.0; });
+  EXPECT_EQ(mass.flow, FlowPattern::Mass);
+  EXPECT_DOUBLE_EQ(mass.transition_left, 0.0);
+  EXPECT_DOUBLE_EQ(mass.transition_right, 0.0);
+  EXPECT_DOUBLE_EQ(mass.flow_speed, 1.0);
+  const auto funnel = run([&](double x, double) { return x > 8 * r && x < 12 * r ? 1.0 : 0.0; });
+  EXPECT_EQ(funnel.flow, FlowPattern::Funnel);
+  EXPECT_TRUE(std::isnan(funnel.transition_left));
+  const auto mixed =
+      run([&](double x, double z) { return z > 20 * r || (x > 8 * r && x < 12 * r) ? 1.0 : 0.0; });
+  EXPECT_EQ(mixed.flow, FlowPattern::Mixed);
+  EXPECT_NEAR(mixed.transition_left, 20 * r, 1e-15);
+  EXPECT_NEAR(mixed.transition_right, 20 * r, 1e-15);
+  // A wall creeping at 5 % of the channel's speed is stagnant (threshold 10 %).
+  const auto creep = run([&](double x, double) { return x > 8 * r && x < 12 * r ? 1.0 : 0.05; });
+  EXPECT_EQ(creep.flow, FlowPattern::Funnel);
+  const auto right = run([&](double x, double) { return x > 4 * r ? 1.0 : 0.0; });
+  EXPECT_EQ(right.flow, FlowPattern::Funnel);
+  EXPECT_TRUE(std::isnan(right.transition_left));
+  EXPECT_DOUBLE_EQ(right.transition_right, 0.0);
+  EXPECT_EQ(run([](double, double) { return 0.0; }).flow, FlowPattern::Rest);
+  EXPECT_STREQ(flow_pattern_name(FlowPattern::Mixed), "mixed");
+}

@@ -125,6 +125,11 @@ TEST(Silo, QuasiStaticBottomMovesAndTheForcesBalanceTheWeight) {
   EXPECT_NE(rep.out.find("void ratio at"), std::string::npos) << rep.out;
   EXPECT_NE(rep.out.find("left half:"), std::string::npos) << rep.out;
   EXPECT_NE(rep.out.find("slice method"), std::string::npos) << rep.out;
+  EXPECT_NE(rep.out.find("flow: "), std::string::npos) << rep.out;
+  // The bottom moving down carries the grains down: the last frame is not at rest.
+  const auto pattern = gs::test::h5::read(dir / "silo_report.h5", "/series/flow_pattern");
+  ASSERT_GT(pattern.size(), 2u);
+  EXPECT_NE(pattern.v.back(), 0.0);
   const auto voids =
       gs::test::h5::read(dir / "silo_report.h5", "/profiles/residual/layer_void_ratio");
   ASSERT_GT(voids.size(), 6u);
@@ -135,8 +140,13 @@ TEST(Silo, QuasiStaticBottomMovesAndTheForcesBalanceTheWeight) {
   }
   EXPECT_GT(finite, 6);
   EXPECT_TRUE(gs::test::h5::has(dir / "silo_report.h5", "/profiles/residual/rose_left_density"));
-  for (const auto& [option, value] : std::vector<std::pair<std::string, std::string>>{
-           {"--layers", "1.5"}, {"--rose-bins", "2"}, {"--phi-i", "95"}, {"--en-k", "-1"}}) {
+  for (const auto& [option, value] :
+       std::vector<std::pair<std::string, std::string>>{{"--layers", "1.5"},
+                                                        {"--rose-bins", "2"},
+                                                        {"--phi-i", "95"},
+                                                        {"--en-k", "-1"},
+                                                        {"--flow-threshold", "1.5"},
+                                                        {"--flow-wall-d50", "0"}}) {
     const auto b = run_cli("analyze silo " + (dir / "out" / "trajectory.h5").string() + " -o " +
                                (dir / "x.h5").string() + " " + option + " " + value,
                            dir.path);
