@@ -64,12 +64,16 @@ void wall_zones(const Frame& f, const SiloReportOptions& o, const Eigen::Vector3
 
 void void_ratio_layers(const Frame& f, const SiloReportOptions& o, const Eigen::Vector3d& up,
                        const Eigen::Vector3d& across, double bottom, double depth_lo,
-                       double depth_hi, double x0, double x1, SiloFrameReport& r) {
+                       double depth_hi, double x0, double x1, const Frame* reference,
+                       SiloFrameReport& r) {
   if (!(o.layer_bin > 0) || !(o.layer_band > 0) || !std::isfinite(o.layer_bin) ||
       !std::isfinite(o.layer_band))
     throw std::invalid_argument("layer bin and band must be positive");
   if (!(x1 > x0)) return;
   const Eigen::Vector3d depth_axis = up.cross(across);
+  std::unordered_map<std::int64_t, double> ref_height;  // (the reference frame's heights by id)
+  if (reference)
+    for (const Particle& p : reference->particles) ref_height[p.id] = p.position.dot(up);
   const int n = std::max(1, static_cast<int>(std::floor((x1 - x0) / o.layer_bin + 1e-9)));
   const double w = (x1 - x0) / n;  // (equal boxes filling the width)
   for (const double fr : o.layer_fractions) {
@@ -81,11 +85,23 @@ void void_ratio_layers(const Frame& f, const SiloReportOptions& o, const Eigen::
     const double zlo = std::max(bottom, z - 0.5 * o.layer_band);
     const double zhi = std::min(bottom + r.fill_height, z + 0.5 * o.layer_band);
     std::vector<double> solid(static_cast<std::size_t>(n), 0.0);
+    std::vector<double> disp(solid), ndisp(solid), rot(solid), nrot(solid);
     for (const Particle& p : f.particles) {
       // The centre in the (across, depth, up) frame, where the boxes are axis-aligned.
       const Eigen::Vector3d c(p.position.dot(across), p.position.dot(depth_axis),
                               p.position.dot(up));
       if (!(c.z() + p.radius > zlo && c.z() - p.radius < zhi)) continue;
+      if (c.z() >= zlo && c.z() < zhi && c.x() >= x0 && c.x() < x1) {  // (the centre's box)
+        const auto b =
+            static_cast<std::size_t>(std::min(n - 1, static_cast<int>((c.x() - x0) / w)));
+        rot[b] += std::abs(p.rotation.dot(depth_axis));
+        nrot[b] += 1;
+        const auto it = ref_height.find(p.id);
+        if (it != ref_height.end()) {
+          disp[b] += it->second - c.z();
+          ndisp[b] += 1;
+        }
+      }
       const int b0 = std::max(0, static_cast<int>(std::floor((c.x() - p.radius - x0) / w)));
       const int b1 = std::min(n - 1, static_cast<int>(std::floor((c.x() + p.radius - x0) / w)));
       for (int b = b0; b <= b1; ++b)
@@ -97,6 +113,9 @@ void void_ratio_layers(const Frame& f, const SiloReportOptions& o, const Eigen::
       layer.across.push_back(x0 + (b + 0.5) * w);
       const double v = solid[static_cast<std::size_t>(b)];
       layer.void_ratio.push_back(v > 0 ? box / v - 1 : NAN);
+      const auto k = static_cast<std::size_t>(b);
+      layer.displacement_down.push_back(ndisp[k] > 0 ? disp[k] / ndisp[k] : NAN);
+      layer.rotation.push_back(nrot[k] > 0 ? rot[k] / nrot[k] : NAN);
     }
     r.layers.push_back(std::move(layer));
   }
@@ -220,7 +239,7 @@ const char* flow_pattern_name(FlowPattern p) {
   return "?";
 }
 
-SiloFrameReport silo_report(const Frame& f, const SiloReportOptions& o) {
+SiloFrameReport silo_report(const Frame& f, const SiloReportOptions& o, const Frame* reference) {
   if (!(o.bin > 0) || !std::isfinite(o.bin)) throw std::invalid_argument("bin must be positive");
   if (!(o.depth >= 0) || !std::isfinite(o.depth))
     throw std::invalid_argument("depth must not be negative");
@@ -329,7 +348,7 @@ SiloFrameReport silo_report(const Frame& f, const SiloReportOptions& o) {
   r.width = x1 > x0 ? x1 - x0 : 0.0;
   if (!o.layer_fractions.empty())
     void_ratio_layers(f, o, up, across, bottom, o.depth > 0 ? 0.5 * (lo + hi) - 0.5 * depth : lo,
-                      o.depth > 0 ? 0.5 * (lo + hi) + 0.5 * depth : hi, x0, x1, r);
+                      o.depth > 0 ? 0.5 * (lo + hi) + 0.5 * depth : hi, x0, x1, reference, r);
   if (o.fabric_bins > 0) left_fabric(f, o, up, across, bottom, x0, x1, role, r);
   if (o.flow_bands > 0) flow_pattern(f, o, up, across, bottom, x0, x1, r);
   const bool loaded = std::abs(r.T_left) + std::abs(r.N_left) + std::abs(r.T_right) +

@@ -29,7 +29,9 @@
 //    grain's top) centred at fractions of the fill's height (`layer_fractions`), boxes `layer_bin`
 //    wide from one wall's base plane to the other's, through the particles' depth; e = V_box /
 //    V_solid − 1 with the exact sphere–box volumes. The boxes next to a saw-tooth wall hold teeth,
-//    which count as void.
+//    which count as void. In the same boxes: the mean downward displacement since a reference
+//    frame (matched by particle id) and the mean |rotation| about the depth axis of the grains
+//    whose centre lies in the box (Figs 5.15–5.16).
 //  * Flow pattern (§5.3.2; mass, funnel or mixed flow) from the frame's velocities: the fill
 //    cut into `flow_bands` horizontal bands; in each, the mean downward velocity of the grains
 //    in a column `flow_wall_width` wide at each wall's base plane (wide enough to reach past the
@@ -76,10 +78,14 @@ struct SiloReportOptions {
 enum class FlowPattern : int { Rest = 0, Funnel = 1, Mixed = 2, Mass = 3 };
 const char* flow_pattern_name(FlowPattern p);
 
-/// Void ratio across the silo at one height.
+/// Void ratio, displacement and rotation across the silo at one height (Figs 5.15–5.17).
 struct SiloLayer {
   double height = 0;                       // m above the bottom (band centre)
   std::vector<double> across, void_ratio;  // box centres (m along across), e (NaN: no solid)
+  // Means over the grains whose centre is in a box (NaN: none): the downward displacement since
+  // the reference frame (NaN without one, or for grains it does not hold) and |rotation| about
+  // the depth axis (the snapshot's cumulative rotation).
+  std::vector<double> displacement_down, rotation;
 };
 
 struct SiloProfile {
@@ -116,6 +122,8 @@ struct SiloFrameReport {
 /// Throws std::invalid_argument when the frame has no left or right side wall or no bottom,
 /// for a bad bin, depth or direction (up and across not orthogonal unit-able vectors), or when
 /// its walls carry forces but the frame holds no particle–wall contact for the profiles.
-SiloFrameReport silo_report(const Frame& frame, const SiloReportOptions& options);
+/// `reference`: the frame the layers' displacements are measured from (none: NaN).
+SiloFrameReport silo_report(const Frame& frame, const SiloReportOptions& options,
+                            const Frame* reference = nullptr);
 
 }  // namespace gs::analysis

@@ -109,7 +109,8 @@ void run_silo(const SiloArgs& a) {
   std::vector<ga::SiloFrameReport> reports;
   for (long i = from; i < n; ++i) {
     try {
-      reports.push_back(ga::silo_report(t.frames[static_cast<std::size_t>(i)], o));
+      reports.push_back(ga::silo_report(t.frames[static_cast<std::size_t>(i)], o,
+                                        &t.frames[static_cast<std::size_t>(from)]));
     } catch (const std::invalid_argument& e) {
       throw InputError(a.input, "frame " + std::to_string(i) + ": " + e.what());
     }
@@ -194,16 +195,20 @@ void run_silo(const SiloArgs& a) {
     h.write(g + "/zone_across_m", r.zone_across);
     h.write(g + "/zone_rotation_rad", r.zone_rotation);
     // Void ratio across the width at the layers' heights (one row per layer).
-    std::vector<double> lh, la, le;
+    std::vector<double> lh, la, le, lu, lw;
     for (const auto& L : r.layers)
       for (std::size_t b = 0; b < L.across.size(); ++b) {
         lh.push_back(L.height);
         la.push_back(L.across[b]);
         le.push_back(L.void_ratio[b]);
+        lu.push_back(L.displacement_down[b]);
+        lw.push_back(L.rotation[b]);
       }
     h.write(g + "/layer_height_m", lh);
     h.write(g + "/layer_across_m", la);
     h.write(g + "/layer_void_ratio", le);
+    h.write(g + "/layer_displacement_down_m", lu);
+    h.write(g + "/layer_rotation_rad", lw);
     h.write(g + "/rose_left_angle_deg", r.rose_angle_deg);
     h.write(g + "/rose_left_density", r.rose_density);
     h.attr("fabric_left_angle_deg", r.fabric_angle_deg, g);

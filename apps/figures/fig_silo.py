@@ -3,9 +3,11 @@ silo_forces.png   P/G, T/G, N/G per side wall and phi_w against time (Figs 5.5-5
                   slice method's P/G at the three states (Eq 5.1-5.2, EN 1991-4);
 silo_profiles.png wall stresses sigma11 and sigma21 against the height at the initial, maximum
                   and residual states (Figs 5.8-5.11);
-silo_fabric.png   void ratio across the width at the layers' heights, the rotation profile the
-                  wall shear zones are read from (Table 5.4), and the polar histogram of the left
-                  half's contact normals (Fig 5.27), per state.
+silo_fabric.png   top: the last state's downward displacement, rotation and void ratio across
+                  the width at the layers' heights (Figs 5.15-5.17); bottom, per state: the void
+                  ratio across, the rotation profile the wall shear zones are read from
+                  (Table 5.4), and the polar histogram of the left half's contact normals
+                  (Fig 5.27).
 """
 import h5py
 import numpy as np
@@ -83,10 +85,27 @@ def make(input_path, out_dir, args):
     written.append(figutil.save(fig, out_dir, "silo_profiles.png"))
 
     # Void ratio layers, rotation profile, rose of the left half.
-    fig = plt.figure(figsize=(15, 5))
-    ax_e = fig.add_subplot(1, 3, 1)
-    ax_r = fig.add_subplot(1, 3, 2)
-    ax_p = fig.add_subplot(1, 3, 3, projection="polar")
+    fig = plt.figure(figsize=(15, 10))
+    # Top row: the residual state's layers (Figs 5.15-5.17: u, omega and e across the width).
+    last = states[list(states)[-1]]
+    lh = np.asarray(last.get("layer_height_m", []))
+    for col, (key, name, label, scale) in enumerate((
+            ("layer_displacement_down_m", "displacement", "downward displacement (mm)", 1e3),
+            ("layer_rotation_rad", "rotation", "mean |rotation| (rad)", 1.0),
+            ("layer_void_ratio", "void ratio", "void ratio e", 1.0))):
+        ax = fig.add_subplot(2, 3, col + 1)
+        for k, height in enumerate(np.unique(lh)):
+            m = lh == height
+            ax.plot(last["layer_across_m"][m], scale * np.asarray(last[key])[m],
+                    ["-", "--", ":", "-."][k % 4], color="k", label="%.3g m" % height)
+        ax.set_title("silo: %s across (%s)" % (name, list(states)[-1]))
+        ax.set_xlabel("across (m)")
+        ax.set_ylabel(label)
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=7, title="height above the bottom", title_fontsize=7)
+    ax_e = fig.add_subplot(2, 3, 4)
+    ax_r = fig.add_subplot(2, 3, 5)
+    ax_p = fig.add_subplot(2, 3, 6, projection="polar")
     for s, st in states.items():
         lh = np.asarray(st.get("layer_height_m", []))
         for k, height in enumerate(np.unique(lh)):
@@ -104,7 +123,7 @@ def make(input_path, out_dir, args):
             ax_p.plot(np.append(ang, ang[0]), np.append(dens, dens[0]), color=COLOURS[s],
                       label="%s: %.0f deg" % (s, float(st["fabric_left_angle_deg"])))
     ax_e.set_title("silo: void ratio across")
-    ax_r.set_title("silo: rotation across")
+    ax_r.set_title("silo: rotation across at the zones' height")
     ax_e.set_xlabel("across (m)")
     ax_e.set_ylabel("void ratio e")
     ax_e.grid(alpha=0.3)
@@ -113,7 +132,7 @@ def make(input_path, out_dir, args):
     ax_r.set_ylabel("mean |rotation| (rad)")
     ax_r.grid(alpha=0.3)
     ax_r.legend(fontsize=7)
-    ax_p.set_title("silo: left half contact normals (0 deg = wall normal)", fontsize=9)
+    ax_p.set_title("silo: left half contact normals (0 deg = wall normal)", fontsize=9, pad=18)
     ax_p.legend(fontsize=7, loc="lower left", bbox_to_anchor=(0.8, -0.1))
     written.append(figutil.save(fig, out_dir, "silo_fabric.png"))
     return written

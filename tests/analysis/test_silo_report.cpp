@@ -314,3 +314,31 @@ TEST(SiloReport, FlowPatternFromTheVelocityField) {
   EXPECT_EQ(run([](double, double) { return 0.0; }).flow, FlowPattern::Rest);
   EXPECT_STREQ(flow_pattern_name(FlowPattern::Mixed), "mixed");
 }
+
+// Hand-set: the reference frame holds the grains 0.3r higher in the left half and 0 elsewhere,
+// the rotation about the depth axis (up × across = z × x = y) is
+// 0.2 rad in the box at the left wall and −0.1 rad elsewhere: the boxes' means are these.
+TEST(SiloReport, LayerDisplacementAndRotationSinceTheReference) {
+  const double r = 0.001;
+  Frame now = cubic_silo(r), before = cubic_silo(r);
+  for (std::size_t i = 0; i < now.particles.size(); ++i) {
+    const double x = now.particles[i].position.x();
+    if (x < 10 * r) before.particles[i].position.z() += 0.3 * r;
+    now.particles[i].rotation = Eigen::Vector3d(0.5, x < 2 * r ? 0.2 : -0.1, 0.7);
+  }
+  SiloReportOptions o;
+  o.bin = 5 * r;
+  o.layer_fractions = {0.5};
+  o.layer_bin = 2 * r;
+  o.layer_band = 4 * r;
+  const auto rep = silo_report(now, o, &before);
+  ASSERT_EQ(rep.layers.size(), 1u);
+  const auto& L = rep.layers[0];
+  ASSERT_EQ(L.displacement_down.size(), 10u);
+  for (std::size_t b = 0; b < 10; ++b) {
+    EXPECT_NEAR(L.displacement_down[b], b < 5 ? 0.3 * r : 0.0, 1e-15) << b;
+    EXPECT_NEAR(L.rotation[b], b == 0 ? 0.2 : 0.1, 1e-15) << b;
+  }
+  const auto alone = silo_report(now, o);
+  EXPECT_TRUE(std::isnan(alone.layers[0].displacement_down[0]));
+}
