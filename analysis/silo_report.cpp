@@ -1,6 +1,7 @@
 #include "silo_report.hpp"
 
 #include "contact_rose.hpp"
+#include "love_weber_stress.hpp"
 #include "shear_zone.hpp"
 #include "sphere_box_volume.hpp"
 
@@ -340,6 +341,36 @@ SiloFrameReport silo_report(const Frame& f, const SiloReportOptions& o, const Fr
       pr.sigma11_right[b] += s11;
       pr.sigma21_right[b] += s21;
       pr.contacts_right[b] += 1;
+    }
+  }
+  if (o.rev_width > 0) {
+    // Love–Weber stress in near-wall cells, in the (across, depth, up) frame.
+    const auto [xl, xr] = wall_bases(f, across, role);
+    Eigen::Matrix3d R;
+    R.row(0) = across.transpose();
+    R.row(1) = depth_axis.transpose();
+    R.row(2) = up.transpose();
+    ContactBranches cb = contact_branches(f);
+    for (ContactBranch& b : cb.branches) {
+      b.start = R * b.start;
+      b.branch = R * b.branch;
+      b.force = R * b.force;
+    }
+    const double dlo = o.depth > 0 ? 0.5 * (lo + hi) - 0.5 * depth : lo;
+    const double dhi = o.depth > 0 ? 0.5 * (lo + hi) + 0.5 * depth : hi;
+    for (auto* v :
+         {&pr.lw_sigma11_left, &pr.lw_sigma21_left, &pr.lw_sigma11_right, &pr.lw_sigma21_right})
+      v->assign(bins, 0.0);
+    for (std::size_t b = 0; b < bins; ++b) {
+      const double z0 = bottom + static_cast<double>(b) * o.bin, z1 = z0 + o.bin;
+      const Eigen::Matrix3d sl =
+          love_weber_stress(cb.branches, {xl, dlo, z0}, {xl + o.rev_width, dhi, z1});
+      const Eigen::Matrix3d sr =
+          love_weber_stress(cb.branches, {xr - o.rev_width, dlo, z0}, {xr, dhi, z1});
+      pr.lw_sigma11_left[b] = sl(0, 0);
+      pr.lw_sigma21_left[b] = 0.5 * (sl(0, 2) + sl(2, 0));
+      pr.lw_sigma11_right[b] = sr(0, 0);
+      pr.lw_sigma21_right[b] = -0.5 * (sr(0, 2) + sr(2, 0));
     }
   }
   if (o.zone_bin > 0) wall_zones(f, o, up, across, bottom, top, role, r);

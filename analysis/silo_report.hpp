@@ -16,6 +16,12 @@
 //    point (bins of `bin` m from the bottom's top up), σ11 = Σ(−F·b̂)/(bin·depth),
 //    σ21 = Σ(−F·up)/(bin·depth), depth the extent of the particles along up × across (their
 //    centres ± radii) unless given.
+//  * The same profiles from the Love–Weber stress (seed 004 eq 4.1; love_weber_stress.hpp) in
+//    near-wall cells: boxes `rev_width` wide from each wall's base plane, one per profile bin,
+//    through the particles' depth, in the (across, depth, up) frame. σ11 is the across–across
+//    component (compression positive, as the wall's), σ21 the symmetric across–up part with the
+//    wall's sign (the material dragging the wall down positive: +σ on the left, −σ on the
+//    right). A row of grains in equilibrium between the walls gives the wall's σ11 exactly.
 //  * Wall shear zones at a height (§5.3.1, Table 5.4; the procedure of §4.2.3): the particles'
 //    rotation about the depth axis (cumulative, from the snapshot) averaged in bins across the
 //    silo (`zone_bin` wide) within a horizontal band (`zone_band` thick) centred at `zone_height`
@@ -70,6 +76,7 @@ struct SiloReportOptions {
   double layer_bin = 0;                 // m, > 0 with layer_fractions
   double layer_band = 0;                // m, > 0 with layer_fractions
   int fabric_bins = 0;                  // rose bins over 360°; 0: no contact-orientation fabric
+  double rev_width = 0;                 // m; 0: no Love–Weber near-wall cells
   int flow_bands = 0;                   // 0: no flow pattern
   double flow_wall_width = 0;           // m, > 0 with flow_bands
   double flow_threshold = 0.1;          // of the fastest column's downward velocity
@@ -92,6 +99,10 @@ struct SiloProfile {
   std::vector<double> height;  // bin centres above the bottom, m
   std::vector<double> sigma11_left, sigma21_left, sigma11_right, sigma21_right;  // Pa
   std::vector<double> contacts_left, contacts_right;
+  // Love–Weber stress in the near-wall cells (with rev_width > 0), Pa: σ11 the horizontal
+  // normal stress, σ21 the symmetric part of the across–up shear, signed as the wall's (the
+  // material dragging the wall down positive).
+  std::vector<double> lw_sigma11_left, lw_sigma21_left, lw_sigma11_right, lw_sigma21_right;
 };
 
 struct SiloFrameReport {

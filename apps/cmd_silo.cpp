@@ -36,6 +36,7 @@ struct SiloArgs {
   double layer_bin_d50 = 2.0, layer_band_d50 = 5.0;
   int rose_bins = 36;
   double phi_i = 35.0, en_k = 0.63;
+  double rev_width_d50 = 2.0;
   int flow_bands = 10;
   double flow_wall_d50 = 3.0, flow_threshold = 0.1;
 };
@@ -98,6 +99,9 @@ void run_silo(const SiloArgs& a) {
   if (!(a.phi_i > 0 && a.phi_i < 90))
     throw InputError(a.input, "--phi-i: not in (0, 90) deg", value_str(a.phi_i));
   require_positive(a.input, "--en-k", a.en_k);
+  if (!(a.rev_width_d50 >= 0) || !std::isfinite(a.rev_width_d50))
+    throw InputError(a.input, "--rev-width-d50: negative", value_str(a.rev_width_d50));
+  o.rev_width = a.rev_width_d50 * d50;
   if (a.flow_bands < 0 || a.flow_bands > 10000)
     throw InputError(a.input, "--flow-bands: not in [0, 10000]", std::to_string(a.flow_bands));
   o.flow_bands = a.flow_bands;
@@ -176,7 +180,7 @@ void run_silo(const SiloArgs& a) {
   h.group("/series");
   for (const auto& [name, v] : series) h.write(std::string("/series/") + name, v);
   h.group("/profiles");
-  std::vector<double> st, ph, s11l, s21l, s11r, s21r;
+  std::vector<double> st, ph, s11l, s21l, s11r, s21r, l11l, l21l, l11r, l21r;
   for (std::size_t i = 0; i < states.size(); ++i) {
     const auto& [name, k] = states[i];
     const auto& r = reports[k];
@@ -189,6 +193,10 @@ void run_silo(const SiloArgs& a) {
     h.write(g + "/sigma21_left_Pa", r.profile.sigma21_left);
     h.write(g + "/sigma11_right_Pa", r.profile.sigma11_right);
     h.write(g + "/sigma21_right_Pa", r.profile.sigma21_right);
+    h.write(g + "/lw_sigma11_left_Pa", r.profile.lw_sigma11_left);
+    h.write(g + "/lw_sigma21_left_Pa", r.profile.lw_sigma21_left);
+    h.write(g + "/lw_sigma11_right_Pa", r.profile.lw_sigma11_right);
+    h.write(g + "/lw_sigma21_right_Pa", r.profile.lw_sigma21_right);
     h.attr("zone_height_m", r.zone_height, g);
     h.attr("zone_left_m", r.zone_left, g);
     h.attr("zone_right_m", r.zone_right, g);
@@ -239,6 +247,11 @@ void run_silo(const SiloArgs& a) {
       s21l.push_back(r.profile.sigma21_left[b]);
       s11r.push_back(r.profile.sigma11_right[b]);
       s21r.push_back(r.profile.sigma21_right[b]);
+      const bool lw = !r.profile.lw_sigma11_left.empty();
+      l11l.push_back(lw ? r.profile.lw_sigma11_left[b] : NAN);
+      l21l.push_back(lw ? r.profile.lw_sigma21_left[b] : NAN);
+      l11r.push_back(lw ? r.profile.lw_sigma11_right[b] : NAN);
+      l21r.push_back(lw ? r.profile.lw_sigma21_right[b] : NAN);
     }
     std::printf(
         "%-8s frame %ld (t = %.4g s): P/G %.3f, T/G %.3f / %.3f, N/G %.3f / %.3f (left / right), "
@@ -264,6 +277,22 @@ void run_silo(const SiloArgs& a) {
       std::printf("         void ratio at %.3g m: %.3f next to the walls, %.3f in the middle\n",
                   L.height, e_wall, e_mid);
     }
+    if (!r.profile.lw_sigma11_left.empty()) {
+      // Mean over the bins of both walls: the wall-binned stresses against Love–Weber's.
+      double w11 = 0, l11 = 0, w21 = 0, l21 = 0;
+      const auto& q = r.profile;
+      for (std::size_t b = 0; b < q.height.size(); ++b) {
+        w11 += 0.5 * (q.sigma11_left[b] + q.sigma11_right[b]);
+        l11 += 0.5 * (q.lw_sigma11_left[b] + q.lw_sigma11_right[b]);
+        w21 += 0.5 * (q.sigma21_left[b] + q.sigma21_right[b]);
+        l21 += 0.5 * (q.lw_sigma21_left[b] + q.lw_sigma21_right[b]);
+      }
+      const double nb = static_cast<double>(q.height.size());
+      std::printf(
+          "         wall stresses, mean over the height: sigma11 %.4g Pa (walls) / %.4g Pa "
+          "(Love-Weber, near-wall cells), sigma21 %.4g / %.4g Pa\n",
+          w11 / nb, l11 / nb, w21 / nb, l21 / nb);
+    }
     if (o.flow_bands > 0)
       std::printf(
           "         flow: %s (the walls move from %.3g / %.3g m up; fastest column "
@@ -287,7 +316,11 @@ void run_silo(const SiloArgs& a) {
                                      {"sigma11_left_Pa", 1, s11l},
                                      {"sigma21_left_Pa", 1, s21l},
                                      {"sigma11_right_Pa", 1, s11r},
-                                     {"sigma21_right_Pa", 1, s21r}});
+                                     {"sigma21_right_Pa", 1, s21r},
+                                     {"lw_sigma11_left_Pa", 1, l11l},
+                                     {"lw_sigma21_left_Pa", 1, l21l},
+                                     {"lw_sigma11_right_Pa", 1, l11r},
+                                     {"lw_sigma21_right_Pa", 1, l21r}});
 }
 
 }  // namespace
@@ -330,6 +363,8 @@ void register_analyze_silo(CLI::App& app) {
                 "thickness of the void-ratio layers, d50 (default 5)");
   s->add_option("--rose-bins", a->rose_bins,
                 "bins of the left half's contact rose over 360 deg (default 36)");
+  s->add_option("--rev-width-d50", a->rev_width_d50,
+                "width of the near-wall Love-Weber cells, d50 (default 2; 0: none)");
   s->add_option("--flow-bands", a->flow_bands,
                 "bands of the fill for the flow pattern (default 10; 0: none)");
   s->add_option("--flow-wall-d50", a->flow_wall_d50,

@@ -2,7 +2,8 @@
 silo_forces.png   P/G, T/G, N/G per side wall and phi_w against time (Figs 5.5-5.7), with the
                   slice method's P/G at the three states (Eq 5.1-5.2, EN 1991-4);
 silo_profiles.png wall stresses sigma11 and sigma21 against the height at the initial, maximum
-                  and residual states (Figs 5.8-5.11);
+                  and residual states (Figs 5.8-5.11), from the wall contacts (thick) and from
+                  the Love-Weber stress in near-wall cells (thin);
 silo_fabric.png   top: the last state's downward displacement, rotation and void ratio across
                   the width at the layers' heights (Figs 5.15-5.17); bottom, per state: the void
                   ratio across, the rotation profile the wall shear zones are read from
@@ -73,6 +74,11 @@ def make(input_path, out_dir, args):
             axes[0].plot(st["sigma11_%s_Pa" % side], h, style, color=COLOURS[s],
                          label="%s, %s wall" % (s, side))
             axes[1].plot(st["sigma21_%s_Pa" % side], h, style, color=COLOURS[s])
+            if len(st.get("lw_sigma11_%s_Pa" % side, [])):  # (Love-Weber, near-wall cells)
+                axes[0].plot(st["lw_sigma11_%s_Pa" % side], h, style, color=COLOURS[s],
+                             lw=0.6, alpha=0.6, label="%s, %s, Love-Weber" % (s, side))
+                axes[1].plot(st["lw_sigma21_%s_Pa" % side], h, style, color=COLOURS[s],
+                             lw=0.6, alpha=0.6)
     axes[0].set_title("silo: sigma11")
     axes[1].set_title("silo: sigma21")
     axes[0].set_xlabel("horizontal wall stress sigma11 (Pa)")

@@ -342,3 +342,51 @@ TEST(SiloReport, LayerDisplacementAndRotationSinceTheReference) {
   const auto alone = silo_report(now, o);
   EXPECT_TRUE(std::isnan(alone.layers[0].displacement_down[0]));
 }
+
+// Exact answer: a row of five grains in equilibrium between the side walls, each contact
+// pushing with Fn along x: in the near-wall cells (2r wide, the bin's height, the row's depth)
+// the Love–Weber stress is the wall's σ11 = Fn / (bin·depth) on both sides, with no shear.
+TEST(SiloReport, LoveWeberNearWallCellsEqualTheWallStressOfARowInEquilibrium) {
+  const double r = 0.001, Fn = 0.3;
+  Frame f;
+  f.walls = {wall(100, WallKind::Plane, {0, 0, 0}, {1, 0, 0}, {-Fn, 0, 0}),
+             wall(101, WallKind::Plane, {10 * r, 0, 0}, {-1, 0, 0}, {Fn, 0, 0}),
+             wall(102, WallKind::Plane, {0, 0, 0}, {0, 0, 1}, {0, 0, 0})};
+  for (int i = 0; i < 5; ++i) {
+    Particle p;
+    p.id = i;
+    p.position = Eigen::Vector3d((2 * i + 1) * r, 0, 3 * r);
+    p.radius = r;
+    p.mass = 1e-5;
+    f.particles.push_back(p);
+  }
+  auto contact = [](std::int64_t a, std::int64_t b, Eigen::Vector3d point, Eigen::Vector3d n,
+                    Eigen::Vector3d force) {
+    Contact c;
+    c.id1 = a;
+    c.id2 = b;
+    c.point = point;
+    c.normal = n;
+    c.normal_force = force;
+    return c;
+  };
+  f.contacts.push_back(contact(100, 0, {0, 0, 3 * r}, {1, 0, 0}, {Fn, 0, 0}));
+  for (int i = 0; i < 4; ++i)
+    f.contacts.push_back(contact(i, i + 1, {(2 * i + 2) * r, 0, 3 * r}, {1, 0, 0}, {Fn, 0, 0}));
+  f.contacts.push_back(contact(101, 4, {10 * r, 0, 3 * r}, {-1, 0, 0}, {-Fn, 0, 0}));
+  SiloReportOptions o;
+  o.bin = 4 * r;
+  o.rev_width = 2 * r;
+  const auto rep = silo_report(f, o);
+  ASSERT_EQ(rep.profile.height.size(), 1u);
+  const double s11 = Fn / (4 * r * 2 * r);
+  EXPECT_NEAR(rep.profile.sigma11_left[0], s11, 1e-9 * s11);
+  EXPECT_NEAR(rep.profile.sigma11_right[0], s11, 1e-9 * s11);
+  EXPECT_NEAR(rep.profile.lw_sigma11_left[0], s11, 1e-9 * s11);
+  EXPECT_NEAR(rep.profile.lw_sigma11_right[0], s11, 1e-9 * s11);
+  EXPECT_NEAR(rep.profile.lw_sigma21_left[0], 0.0, 1e-9 * s11);
+  EXPECT_NEAR(rep.profile.lw_sigma21_right[0], 0.0, 1e-9 * s11);
+  // A cell twice as wide holds one more half branch per side: the same stress.
+  o.rev_width = 4 * r;
+  EXPECT_NEAR(silo_report(f, o).profile.lw_sigma11_left[0], s11, 1e-9 * s11);
+}
