@@ -204,13 +204,15 @@ Frame cubic_silo(double r) {
   return f;
 }
 
-Contact between(std::int64_t a, std::int64_t b, Eigen::Vector3d point, Eigen::Vector3d n) {
+/// A compressive contact of id1 on id2 at `point`: normal n (normalised), force fn·n.
+Contact between(std::int64_t a, std::int64_t b, Eigen::Vector3d point, Eigen::Vector3d n,
+                double fn = 0.1) {
   Contact c;
   c.id1 = a;
   c.id2 = b;
   c.point = point;
   c.normal = n.normalized();
-  c.normal_force = 0.1 * c.normal;
+  c.normal_force = fn * c.normal;
   return c;
 }
 
@@ -360,20 +362,10 @@ TEST(SiloReport, LoveWeberNearWallCellsEqualTheWallStressOfARowInEquilibrium) {
     p.mass = 1e-5;
     f.particles.push_back(p);
   }
-  auto contact = [](std::int64_t a, std::int64_t b, Eigen::Vector3d point, Eigen::Vector3d n,
-                    Eigen::Vector3d force) {
-    Contact c;
-    c.id1 = a;
-    c.id2 = b;
-    c.point = point;
-    c.normal = n;
-    c.normal_force = force;
-    return c;
-  };
-  f.contacts.push_back(contact(100, 0, {0, 0, 3 * r}, {1, 0, 0}, {Fn, 0, 0}));
+  f.contacts.push_back(between(100, 0, {0, 0, 3 * r}, {1, 0, 0}, Fn));
   for (int i = 0; i < 4; ++i)
-    f.contacts.push_back(contact(i, i + 1, {(2 * i + 2) * r, 0, 3 * r}, {1, 0, 0}, {Fn, 0, 0}));
-  f.contacts.push_back(contact(101, 4, {10 * r, 0, 3 * r}, {-1, 0, 0}, {-Fn, 0, 0}));
+    f.contacts.push_back(between(i, i + 1, {(2 * i + 2) * r, 0, 3 * r}, {1, 0, 0}, Fn));
+  f.contacts.push_back(between(101, 4, {10 * r, 0, 3 * r}, {-1, 0, 0}, Fn));
   SiloReportOptions o;
   o.bin = 4 * r;
   o.rev_width = 2 * r;
