@@ -27,6 +27,10 @@ FIGURES = {
     "granoscope-hhd": ["fig_hhd"],
     "granoscope-vortices": ["fig_vortices"],
 }
+# figure modules made only when asked for with --type
+ON_REQUEST = {
+    "granoscope-trajectory": ["fig_layers"],
+}
 
 
 def main(argv):
@@ -53,7 +57,7 @@ def main(argv):
     modules = FIGURES[fmt]
     if args.type:
         name = "fig_" + args.type
-        if name not in modules:
+        if name not in modules + ON_REQUEST.get(fmt, []):
             print(f"error: {args.input}: figure type not available for {fmt} ({args.type})",
                   file=sys.stderr)
             return 2

@@ -1078,3 +1078,46 @@ TEST_F(Figures, SiloReportForcesVoidRatioAndRose) {
   for (const double v : e) EXPECT_NEAR(v, 6 / M_PI - 1, 1e-6);
   EXPECT_GE(fab.axes("silo: left half contact normals (0 deg = wall normal)"), 0);
 }
+
+// `figures RUN.h5 --type layers` (on request only): the front view of the reference frame and
+// of later frames, every grain drawn at its (x, z); a frame the run does not have is an error.
+TEST_F(Figures, LayersOnRequest) {
+  gs::Trajectory t;
+  for (int k = 0; k < 4; ++k) {
+    gs::Frame f;
+    f.time = 0.5 * k;
+    for (int i = 0; i < 20; ++i) {
+      gs::Particle q;
+      q.id = i;
+      q.radius = 1e-3;
+      q.position = Eigen::Vector3d(0.003 * (i % 5), 0, 0.002 * i - 1e-4 * k * (i % 5));
+      f.particles.push_back(q);
+    }
+    t.frames.push_back(f);
+  }
+  gs::write_hdf5_trajectory(dir / "run.h5", t);
+  const CliRun r = run("figures " + p("run.h5") + " -o " + p("f") + " --type layers --frame 1");
+  ASSERT_EQ(r.rc, 0) << r.err;
+  EXPECT_EQ(pngs(dir / "f"), std::vector<std::string>{"run_layers_000001.png"});
+  const Plotted pl = read_plotted(dir / "f" / "run_layers_000001.png");
+  for (const int k : {1, 2, 3}) {
+    const int a = pl.axes("layers: frame " + std::to_string(k) + ", t = " +
+                          (k == 1   ? "0.5"
+                           : k == 2 ? "1"
+                                    : "1.5") +
+                          " s");
+    ASSERT_GE(a, 0) << k;
+    std::vector<double> xz;
+    for (const auto& q : t.frames[static_cast<std::size_t>(k)].particles) {
+      xz.push_back(q.position.x());
+      xz.push_back(q.position.z());
+    }
+    expect_same(pl.nums("coll_offsets", a, 0), xz, "offsets");
+  }
+  const CliRun def = run("figures " + p("run.h5") + " -o " + p("g"));
+  ASSERT_EQ(def.rc, 0) << def.err;
+  for (const auto& png : pngs(dir / "g")) EXPECT_EQ(png.find("layers"), std::string::npos);
+  const CliRun bad = run("figures " + p("run.h5") + " -o " + p("h") + " --type layers --frame 9");
+  EXPECT_EQ(bad.rc, 2);
+  EXPECT_NE(bad.err.find("no such frame (9 of 4)"), std::string::npos) << bad.err;
+}
