@@ -28,10 +28,9 @@ std::pair<double, double> wall_bases(const Frame& f, const Eigen::Vector3d& acro
 }
 
 void wall_zones(const Frame& f, const SiloReportOptions& o, const Eigen::Vector3d& up,
-                const Eigen::Vector3d& across, double bottom, double top,
-                const std::unordered_map<std::int64_t, int>& role, SiloFrameReport& r) {
+                const Eigen::Vector3d& across, double bottom, double top, double x0, double x1,
+                SiloFrameReport& r) {
   if (!(o.zone_band > 0)) throw std::invalid_argument("zone band must be positive");
-  const auto [x0, x1] = wall_bases(f, across, role);
   if (!(x1 > x0)) return;
   r.zone_height = o.zone_height > 0 ? o.zone_height : 0.5 * (top - bottom);
   const double z = bottom + r.zone_height;
@@ -343,9 +342,12 @@ SiloFrameReport silo_report(const Frame& f, const SiloReportOptions& o, const Fr
       pr.contacts_right[b] += 1;
     }
   }
+  // The side walls' base planes across, and the depth the stresses and boxes span.
+  const auto [x0, x1] = wall_bases(f, across, role);
+  const double dlo = o.depth > 0 ? 0.5 * (lo + hi) - 0.5 * depth : lo;
+  const double dhi = o.depth > 0 ? 0.5 * (lo + hi) + 0.5 * depth : hi;
   if (o.rev_width > 0) {
     // Love–Weber stress in near-wall cells, in the (across, depth, up) frame.
-    const auto [xl, xr] = wall_bases(f, across, role);
     Eigen::Matrix3d R;
     R.row(0) = across.transpose();
     R.row(1) = depth_axis.transpose();
@@ -356,30 +358,26 @@ SiloFrameReport silo_report(const Frame& f, const SiloReportOptions& o, const Fr
       b.branch = R * b.branch;
       b.force = R * b.force;
     }
-    const double dlo = o.depth > 0 ? 0.5 * (lo + hi) - 0.5 * depth : lo;
-    const double dhi = o.depth > 0 ? 0.5 * (lo + hi) + 0.5 * depth : hi;
     for (auto* v :
          {&pr.lw_sigma11_left, &pr.lw_sigma21_left, &pr.lw_sigma11_right, &pr.lw_sigma21_right})
       v->assign(bins, 0.0);
     for (std::size_t b = 0; b < bins; ++b) {
       const double z0 = bottom + static_cast<double>(b) * o.bin, z1 = z0 + o.bin;
       const Eigen::Matrix3d sl =
-          love_weber_stress(cb.branches, {xl, dlo, z0}, {xl + o.rev_width, dhi, z1});
+          love_weber_stress(cb.branches, {x0, dlo, z0}, {x0 + o.rev_width, dhi, z1});
       const Eigen::Matrix3d sr =
-          love_weber_stress(cb.branches, {xr - o.rev_width, dlo, z0}, {xr, dhi, z1});
+          love_weber_stress(cb.branches, {x1 - o.rev_width, dlo, z0}, {x1, dhi, z1});
       pr.lw_sigma11_left[b] = sl(0, 0);
       pr.lw_sigma21_left[b] = 0.5 * (sl(0, 2) + sl(2, 0));
       pr.lw_sigma11_right[b] = sr(0, 0);
       pr.lw_sigma21_right[b] = -0.5 * (sr(0, 2) + sr(2, 0));
     }
   }
-  if (o.zone_bin > 0) wall_zones(f, o, up, across, bottom, top, role, r);
+  if (o.zone_bin > 0) wall_zones(f, o, up, across, bottom, top, x0, x1, r);
   r.fill_height = top - bottom;
-  const auto [x0, x1] = wall_bases(f, across, role);
   r.width = x1 > x0 ? x1 - x0 : 0.0;
   if (!o.layer_fractions.empty())
-    void_ratio_layers(f, o, up, across, bottom, o.depth > 0 ? 0.5 * (lo + hi) - 0.5 * depth : lo,
-                      o.depth > 0 ? 0.5 * (lo + hi) + 0.5 * depth : hi, x0, x1, reference, r);
+    void_ratio_layers(f, o, up, across, bottom, dlo, dhi, x0, x1, reference, r);
   if (o.fabric_bins > 0) left_fabric(f, o, up, across, bottom, x0, x1, role, r);
   if (o.flow_bands > 0) flow_pattern(f, o, up, across, bottom, x0, x1, r);
   const bool loaded = std::abs(r.T_left) + std::abs(r.N_left) + std::abs(r.T_right) +
