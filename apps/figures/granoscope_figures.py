@@ -29,7 +29,7 @@ FIGURES = {
 }
 # figure modules made only when asked for with --type
 ON_REQUEST = {
-    "granoscope-trajectory": ["fig_layers"],
+    "granoscope-trajectory": ["fig_layers", "fig_rotation"],
 }
 
 

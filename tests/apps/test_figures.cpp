@@ -1121,3 +1121,57 @@ TEST_F(Figures, LayersOnRequest) {
   EXPECT_EQ(bad.rc, 2);
   EXPECT_NE(bad.err.find("no such frame (9 of 4)"), std::string::npos) << bad.err;
 }
+
+// `figures RUN.h5 --type rotation` (on request only): each grain coloured by its rotation about
+// +y since the reference frame, the scale symmetric at the 98th percentile of |rotation|; a grain
+// the reference frame does not hold is masked (grey).
+TEST_F(Figures, RotationMapOnRequest) {
+  gs::Trajectory t;
+  for (int k = 0; k < 4; ++k) {
+    gs::Frame f;
+    f.time = 0.5 * k;
+    for (int i = 0; i < 20; ++i) {
+      if (k == 0 && i == 19) continue;  // grain 19 enters after the reference frame
+      gs::Particle q;
+      q.id = i;
+      q.radius = 1e-3;
+      q.position = Eigen::Vector3d(0.003 * (i % 5), 0, 0.002 * i);
+      q.rotation = Eigen::Vector3d(0.3, 0.1 * i * k - 0.05 * i * i * k, -0.2);
+      f.particles.push_back(q);
+    }
+    t.frames.push_back(f);
+  }
+  gs::write_hdf5_trajectory(dir / "run.h5", t);
+  const CliRun r = run("figures " + p("run.h5") + " -o " + p("f") + " --type rotation");
+  ASSERT_EQ(r.rc, 0) << r.err;
+  EXPECT_EQ(pngs(dir / "f"), std::vector<std::string>{"run_rotation_000000.png"});
+  const Plotted pl = read_plotted(dir / "f" / "run_rotation_000000.png");
+  std::vector<double> all;
+  for (const int k : {1, 2, 3}) {
+    const int a = pl.axes("rotation: frame " + std::to_string(k) + ", t = " +
+                          (k == 1   ? "0.5"
+                           : k == 2 ? "1"
+                                    : "1.5") +
+                          " s");
+    ASSERT_GE(a, 0) << k;
+    const auto w = pl.nums("coll_array", a, 0);
+    ASSERT_EQ(w.size(), 20u);
+    for (int i = 0; i < 19; ++i) {
+      const double expected = (0.1 * i - 0.05 * i * i) * k;  // rotation_y(k) - rotation_y(0)
+      EXPECT_NEAR(w[static_cast<std::size_t>(i)], expected, 1e-12) << k << " " << i;
+      all.push_back(std::abs(expected));
+    }
+    EXPECT_TRUE(std::isnan(w[19])) << "a grain missing from the reference frame is masked";
+  }
+  std::sort(all.begin(), all.end());  // numpy's percentile: linear between the order statistics
+  const double pos = 0.98 * static_cast<double>(all.size() - 1);
+  const auto lo = static_cast<std::size_t>(pos);
+  const double top = all[lo] + (pos - static_cast<double>(lo)) * (all[lo + 1] - all[lo]);
+  const auto clim = pl.nums("coll_clim", pl.axes("rotation: frame 3, t = 1.5 s"), 0);
+  ASSERT_EQ(clim.size(), 2u);
+  EXPECT_NEAR(clim[0], -top, 1e-12);
+  EXPECT_NEAR(clim[1], top, 1e-12);
+  const CliRun bad = run("figures " + p("run.h5") + " -o " + p("h") + " --type rotation --frame 4");
+  EXPECT_EQ(bad.rc, 2);
+  EXPECT_NE(bad.err.find("no such frame (4 of 4)"), std::string::npos) << bad.err;
+}
