@@ -191,11 +191,13 @@ std::int64_t as_int(const Index& index, const std::string& key, const fs::path& 
   }
 }
 
-std::string history_header(const solver::Simulation& sim) {
+std::string history_header(const solver::Simulation& sim,
+                           const std::vector<std::int64_t>& track_ids) {
   std::string h =
       "step,time_s,contacts,kinetic_J,unbalanced_force,inertial_number,elastic_J,"
       "friction_dissipation_J,rolling_dissipation_J,damping_dissipation_J,gravity_work_J,"
       "wall_work_J,external_work_J,energy_residual_J";
+  if (sim.config().law == solver::ContactLaw::HertzMindlin) h += ",viscous_dissipation_J";
   for (std::size_t k = 0; k < sim.walls().size(); ++k) {
     const auto& w = sim.walls()[k];
     if (w.spec.shape == solver::WallShape::Facets) continue;  // (per mesh group, below)
@@ -219,10 +221,13 @@ std::string history_header(const solver::Simulation& sim) {
     for (const char* c : ij) h += std::string(",cell_stress_") + c + "_Pa";
     for (const char* c : ij) h += std::string(",cell_h") + c + "_m";
   }
+  for (const auto id : track_ids)  // [output] track_ids: those particles' state
+    for (const char* c : {"_x_m", "_y_m", "_z_m", "_vx_m_s", "_vy_m_s", "_vz_m_s"})
+      h += ",p" + std::to_string(id) + c;
   return h;
 }
 
-std::string history_row(solver::Simulation& sim) {
+std::string history_row(solver::Simulation& sim, const std::vector<std::int64_t>& track_ids) {
   const auto& e = sim.energy();
   char buf[640];
   std::snprintf(buf, sizeof buf,
@@ -233,6 +238,10 @@ std::string history_row(solver::Simulation& sim) {
                 e.rolling_dissipation, e.damping_dissipation, e.gravity_work, e.wall_work,
                 e.external_work, e.residual());
   std::string row = buf;
+  if (sim.config().law == solver::ContactLaw::HertzMindlin) {
+    std::snprintf(buf, sizeof buf, ",%.17g", e.viscous_dissipation);
+    row += buf;
+  }
   for (const auto& w : sim.walls()) {
     if (w.spec.shape == solver::WallShape::Facets) continue;
     std::snprintf(buf, sizeof buf, ",%.17g,%.17g,%.17g,%.17g,%.17g,%.17g", w.force.x(), w.force.y(),
@@ -263,6 +272,17 @@ std::string history_row(solver::Simulation& sim) {
           std::snprintf(buf, sizeof buf, ",%.17g", m(i, j));
           row += buf;
         }
+  const auto& p = sim.particles();
+  for (const auto id : track_ids) {
+    const auto it = std::find(p.id.begin(), p.id.end(), id);
+    const auto i = static_cast<std::size_t>(it - p.id.begin());
+    const bool here = it != p.id.end() && !p.removed[i];  // (gone through an outlet: nan)
+    const Eigen::Vector3d x = here ? p.pos[i] : Eigen::Vector3d::Constant(NAN);
+    const Eigen::Vector3d v = here ? p.vel[i] : Eigen::Vector3d::Constant(NAN);
+    std::snprintf(buf, sizeof buf, ",%.17g,%.17g,%.17g,%.17g,%.17g,%.17g", x.x(), x.y(), x.z(),
+                  v.x(), v.y(), v.z());
+    row += buf;
+  }
   return row;
 }
 
@@ -470,10 +490,10 @@ Results run(const Args& a, int sweep_point = -1) {
       }
       copy.commit();
     }
-    history.create(history_header(sim));
+    history.create(history_header(sim, scene.output.track_ids));
     programmes[0]->start(sim);
     open_curve(0);
-    history.append(history_row(sim));
+    history.append(history_row(sim, scene.output.track_ids));
     curve_row();
     if (programmes[0]->name() != "preparation") {
       last_frame = programmes[0]->frame_index(sim);
@@ -541,7 +561,7 @@ Results run(const Args& a, int sweep_point = -1) {
       const std::int64_t s = sim.step_count();
       if (s % scene.output.history_every == 0) {
         sim.check_energy();
-        history.append(history_row(sim));
+        history.append(history_row(sim, scene.output.track_ids));
       }
       if (s % scene.output.curve_every == 0) curve_row();
       if (programmes[k]->name() != "preparation") {
@@ -580,7 +600,7 @@ Results run(const Args& a, int sweep_point = -1) {
   if (tty) std::fprintf(stderr, "\n");
   // Final rows and frame, unless the last step already wrote them.
   const std::int64_t s = sim.step_count();
-  if (s % scene.output.history_every != 0) history.append(history_row(sim));
+  if (s % scene.output.history_every != 0) history.append(history_row(sim, scene.output.track_ids));
   if (programmes[k]->name() != "preparation" && last_frame_step != s) write_frame();
   history.finish();
   curve.finish();

@@ -1,6 +1,8 @@
 #include "packing_csv.hpp"
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 
@@ -22,6 +24,12 @@ Frame read_packing_csv(const std::filesystem::path& path) {
   const auto col = text::column_indices(header, {need.begin(), need.end()});
   for (std::size_t k = 0; k < need.size(); ++k)
     if (col[k] == header.size()) throw InputError(name, "missing column in header", need[k]);
+  // Optional velocities (all three or none).
+  const std::array<const char*, 3> vel{"vx", "vy", "vz"};
+  const auto vcol = text::column_indices(header, {vel.begin(), vel.end()});
+  const std::size_t nv = static_cast<std::size_t>(
+      std::count_if(vcol.begin(), vcol.end(), [&](std::size_t c) { return c < header.size(); }));
+  if (nv != 0 && nv != 3) throw InputError(name, "velocity columns: give vx, vy and vz, or none");
   Frame f;
   for (++li; li < lines.size(); ++li) {
     const auto l = text::trim(lines[li]);
@@ -37,6 +45,12 @@ Frame read_packing_csv(const std::filesystem::path& path) {
     for (int d = 0; d < 3; ++d)
       p.position[d] = text::to_double(fields[col[1 + d]], name, li + 1, need[1 + d]);
     p.radius = text::to_double(fields[col[4]], name, li + 1, "r");
+    for (std::size_t d = 0; nv == 3 && d < 3; ++d) {
+      p.velocity[static_cast<int>(d)] = text::to_double(fields[vcol[d]], name, li + 1, vel[d]);
+      if (!std::isfinite(p.velocity[static_cast<int>(d)]))
+        throw InputError(name, "line " + std::to_string(li + 1) + ": " + vel[d] + " not finite",
+                         std::string(fields[vcol[d]]));
+    }
     f.particles.push_back(p);
   }
   if (f.particles.empty()) throw InputError(name, "no particles");

@@ -1,4 +1,5 @@
-// Packing CSV: header `id,x,y,z,r` (any column order, extra columns ignored), metres.
+// Packing CSV: header `id,x,y,z,r` (any column order, extra columns ignored), metres;
+// optional velocities `vx,vy,vz` (m/s).
 #pragma once
 
 #include <filesystem>

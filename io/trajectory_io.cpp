@@ -6,6 +6,7 @@
 #include "errors.hpp"
 #include "hdf5_trajectory.hpp"
 #include "packing_csv.hpp"
+#include "particle_text.hpp"
 #include "vtk_io.hpp"
 
 namespace gs {
@@ -24,6 +25,8 @@ std::string format_name(SnapshotFormat f) {
       return "packing CSV";
     case SnapshotFormat::LiggghtsDump:
       return "LIGGGHTS/LAMMPS dump";
+    case SnapshotFormat::ParticleText:
+      return "DEM8 particle text";
   }
   return "unknown";
 }
@@ -48,6 +51,7 @@ SnapshotFormat detect_format(const std::filesystem::path& path) {
   head.resize(static_cast<std::size_t>(in.gcount()));
   if (head.rfind("ITEM: TIMESTEP", 0) == 0) return SnapshotFormat::LiggghtsDump;
   if (head.rfind("# vtk DataFile", 0) == 0) return SnapshotFormat::YadeLegacyVtk;
+  if (is_particle_text(path)) return SnapshotFormat::ParticleText;
   const std::string e = lower_ext(path);
   if (e == ".h5" || e == ".hdf5") throw InputError(name, "not an HDF5 file (bad signature)");
   if (e == ".vtu") return SnapshotFormat::Vtu;
@@ -97,6 +101,8 @@ Trajectory read_any(const std::filesystem::path& path, const ImportOptions& opt)
                     "imported from YADE VTKExporter " + name);
     case SnapshotFormat::PackingCsv:
       return single(read_packing_csv(path), "packing CSV " + name);
+    case SnapshotFormat::ParticleText:
+      return single(read_particle_text(path, opt.max_particles), "DEM8 particle text " + name);
     case SnapshotFormat::LiggghtsDump: {
       LiggghtsImportOptions lo = opt.liggghts;
       if (opt.contacts) lo.pairs = opt.contacts;

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <filesystem>
+#include <limits>
 #include <optional>
 #include <string>
 
@@ -11,12 +12,13 @@
 
 namespace gs {
 
-enum class SnapshotFormat { Hdf5, Vtu, Pvd, YadeLegacyVtk, PackingCsv, LiggghtsDump };
+enum class SnapshotFormat { Hdf5, Vtu, Pvd, YadeLegacyVtk, PackingCsv, LiggghtsDump, ParticleText };
 
 std::string format_name(SnapshotFormat f);
 
-/// By content where it is unambiguous (HDF5 signature, "ITEM: TIMESTEP", "# vtk DataFile"),
-/// else by extension (.h5 .hdf5 .vtu .pvd .vtk .csv). Throws InputError when unknown.
+/// By content where it is unambiguous (HDF5 signature, "ITEM: TIMESTEP", "# vtk DataFile", a
+/// first line starting "Radius": DEM8 particle text), else by extension (.h5 .hdf5 .vtu .pvd
+/// .vtk .csv). Throws InputError when unknown.
 SnapshotFormat detect_format(const std::filesystem::path& path);
 /// By extension only, for outputs: .h5/.hdf5, .vtu, .pvd, .csv.
 SnapshotFormat output_format(const std::filesystem::path& path);
@@ -26,6 +28,8 @@ struct ImportOptions {
   /// dump). Default: the sibling found by naming convention, if any.
   std::optional<std::filesystem::path> contacts;
   LiggghtsImportOptions liggghts;
+  /// DEM8 particle text only: read at most this many particles (particle_text.hpp).
+  std::size_t max_particles = std::numeric_limits<std::size_t>::max();
 };
 
 Trajectory read_snapshots(const std::filesystem::path& path, const ImportOptions& options = {});

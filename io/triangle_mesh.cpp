@@ -403,6 +403,45 @@ TriangleMesh read_obj(const std::filesystem::path& path) {
   return out;
 }
 
+TriangleMesh read_triangle_text(const std::filesystem::path& path) {
+  const std::string name = path.string();
+  const std::string text = text::read_text_file(path);
+  const auto lines = text::split_lines(text);
+  MeshBuilder mb;
+  static const char* field[9] = {"vertex1_X", "vertex1_Y", "vertex1_Z", "vertex2_X", "vertex2_Y",
+                                 "vertex2_Z", "vertex3_X", "vertex3_Y", "vertex3_Z"};
+  bool header = false;
+  for (std::size_t li = 0; li < lines.size(); ++li) {
+    const std::size_t ln = li + 1;
+    const auto tok = text::split_ws(lines[li]);
+    if (tok.empty() || tok[0].front() == '#') continue;
+    if (!header) {  // the first non-blank line names the nine columns
+      if (tok.size() != 9 || tok[0].substr(0, 9) != "vertex1_X")
+        throw InputError(name,
+                         line_prefix(ln) + "expected the header vertex1_X[m] ... vertex3_Z[m]",
+                         std::string(tok[0].substr(0, 40)));
+      header = true;
+      continue;
+    }
+    if (tok.size() != 9)
+      throw InputError(name, line_prefix(ln) + "expected 9 numbers",
+                       std::to_string(tok.size()) + " given");
+    std::array<Eigen::Vector3d, 3> c;
+    for (int k = 0; k < 9; ++k) {
+      const double v = text::to_double(tok[static_cast<std::size_t>(k)], name, ln, field[k]);
+      if (!std::isfinite(v))
+        throw InputError(name, line_prefix(ln) + "vertex coordinate is not finite", value_str(v));
+      c[static_cast<std::size_t>(k / 3)][k % 3] = v;
+    }
+    const std::size_t t = mb.triangle_count();
+    if (degenerate_triangle(c[0], c[1], c[2]))
+      throw InputError(name, line_prefix(ln) + zero_area_what(t), corners_str(c[0], c[1], c[2]));
+    mb.triangle(mb.vertex(c[0]), mb.vertex(c[1]), mb.vertex(c[2]));
+  }
+  if (mb.triangle_count() == 0) throw InputError(name, "no triangles");
+  return mb.take();
+}
+
 TriangleMesh read_mesh(const std::filesystem::path& path, double scale) {
   if (!(std::isfinite(scale) && scale > 0))
     throw std::invalid_argument("read_mesh: scale must be finite and > 0 (" + value_str(scale) +
@@ -413,8 +452,10 @@ TriangleMesh read_mesh(const std::filesystem::path& path, double scale) {
     m = read_stl(path);
   } else if (ext == ".obj") {
     m = read_obj(path);
+  } else if (ext == ".txt") {
+    m = read_triangle_text(path);
   } else {
-    throw InputError(path.string(), "unknown mesh format (expected .stl or .obj)",
+    throw InputError(path.string(), "unknown mesh format (expected .stl, .obj or .txt)",
                      ext.empty() ? std::string("no extension") : ext);
   }
   if (scale != 1.0) {

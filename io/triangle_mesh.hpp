@@ -52,7 +52,14 @@ TriangleMesh read_stl(const std::filesystem::path& path);
 /// default group is "mesh"); every other statement is ignored. Vertices are kept as listed.
 TriangleMesh read_obj(const std::filesystem::path& path);
 
-/// read_stl or read_obj by extension (.stl, .obj, any case), every coordinate multiplied by
+/// The DEM8 benchmark's wall files (../shared/dem8, MercuryDPM's OSBenchmark inputs): a header
+/// `vertex1_X[m] vertex1_Y[m] ... vertex3_Z[m]`, then one triangle per line, nine numbers
+/// separated by blanks (CRLF ends allowed); `#` lines are skipped. Identical vertices merged as
+/// in read_stl; one group "mesh".
+TriangleMesh read_triangle_text(const std::filesystem::path& path);
+
+/// read_stl, read_obj or read_triangle_text by extension (.stl, .obj, .txt, any case), every
+/// coordinate multiplied by
 /// `scale` (e.g. 1e-3 for a mesh drawn in millimetres); the scaled mesh is validated again.
 /// Throws std::invalid_argument for a scale that is not finite and > 0.
 TriangleMesh read_mesh(const std::filesystem::path& path, double scale = 1.0);

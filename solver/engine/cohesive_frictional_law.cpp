@@ -38,7 +38,6 @@ template <bool kTwist, bool kPeriodic>
     batch.v[f + 1][j] = x.y;
     batch.v[f + 2][j] = x.z;
   };
-  double* const pen_ = batch[Batch::PEN];
   const double* const r1_ = batch[Batch::R1];
   const double* const r2_ = batch[Batch::R2];
   const double* const ratchet_ = batch[Batch::RATCHET];
@@ -53,28 +52,11 @@ template <bool kTwist, bool kPeriodic>
   double* const fn_ = batch[Batch::FN];
   double* const fr_ = batch[Batch::FRICTION_DISSIPATION];
   double* const ro_ = batch[Batch::ROLLING_DISSIPATION];
-  const double* const geom_ = batch[Batch::GEOM];
-  double* const touch_ = batch[Batch::TOUCH];
   for (int j = 0; j < count; ++j) {
     const double r1 = r1_[j], r2 = r2_[j];
-    // Sphere pairs: sphere_sphere_geometry's operations, lane by lane (a lane that is not a
-    // sphere pair computes them on whatever X1, X2 hold and selects its own fields instead).
-    const bool geom = geom_[j] != 0;
-    const V3 x1 = in3(Batch::X1X, j), x2 = in3(Batch::X2X, j);
-    const V3 branch = x2 - x1;
-    const double dist = std::sqrt(squared_norm(branch));
-    const V3 n_s = branch / dist;
-    const double pen_s = r1 + r2 - dist;
-    const V3 pt_s = x1 + (r1 - 0.5 * pen_s) * n_s;
-    const V3 n = select(geom, n_s, in3(Batch::NX, j));
-    const double pen = geom ? pen_s : pen_[j];
-    const V3 pt = select(geom, pt_s, in3(Batch::PTX, j));
-    const V3 c1 = select(geom, pt_s - x1, in3(Batch::C1X, j));
-    const V3 c2 = select(geom, pt_s - x2, in3(Batch::C2X, j));
-    touch_[j] = ((!geom) | ((dist > 0) & !(pen_s < 0))) ? 1.0 : 0.0;
-    out3(Batch::NX, j, n);
-    pen_[j] = pen;
-    out3(Batch::PTX, j, pt);
+    const LaneGeometry g = lane_geometry(batch, j);
+    const V3 n = g.n, c1 = g.c1, c2 = g.c2;
+    const double pen = g.pen;
     const V3 w1 = in3(Batch::W1X, j), w2 = in3(Batch::W2X, j);
     const V3 v1 = in3(Batch::V1X, j), v2 = in3(Batch::V2X, j);
     const double kn = kn_[j], ks = ks_[j], kr = kr_[j];

@@ -2,6 +2,8 @@
 // (seed 000 eq 1-7; seed 004 eqs 3.1-3.18). docs/physics.md lists each convention.
 #pragma once
 
+#include <cmath>
+
 #include "dem_types.hpp"
 #include "scalar_vec3.hpp"
 
@@ -81,6 +83,44 @@ struct ContactBatch {
   alignas(64) double v[kFields][kLanes];
   double* operator[](Field f) { return v[f]; }
 };
+
+/// The geometry of lane j (what both contact laws start from): on GEOM lanes (sphere pairs)
+/// sphere_sphere_geometry's operations, lane by lane, written back to NX, PEN, PTX and TOUCH (a
+/// lane that is not a sphere pair computes them on whatever X1, X2 hold and selects its own
+/// fields instead, with TOUCH = 1).
+struct LaneGeometry {
+  V3 n, pt, c1, c2;  // unit normal, contact point, arms from the centres of body 1 and 2
+  double pen = 0;    // penetration, m
+};
+
+[[gnu::always_inline]] inline LaneGeometry lane_geometry(ContactBatch& b, int j) {
+  using F = ContactBatch::Field;
+  auto in3 = [&](F f) { return V3{b.v[f][j], b.v[f + 1][j], b.v[f + 2][j]}; };
+  auto out3 = [&](F f, const V3& x) {
+    b.v[f][j] = x.x;
+    b.v[f + 1][j] = x.y;
+    b.v[f + 2][j] = x.z;
+  };
+  const double r1 = b.v[F::R1][j], r2 = b.v[F::R2][j];
+  const bool geom = b.v[F::GEOM][j] != 0;
+  const V3 x1 = in3(F::X1X), x2 = in3(F::X2X);
+  const V3 branch = x2 - x1;
+  const double dist = std::sqrt(squared_norm(branch));
+  const V3 n_s = branch / dist;
+  const double pen_s = r1 + r2 - dist;
+  const V3 pt_s = x1 + (r1 - 0.5 * pen_s) * n_s;
+  LaneGeometry g;
+  g.n = select(geom, n_s, in3(F::NX));
+  g.pen = geom ? pen_s : b.v[F::PEN][j];
+  g.pt = select(geom, pt_s, in3(F::PTX));
+  g.c1 = select(geom, pt_s - x1, in3(F::C1X));
+  g.c2 = select(geom, pt_s - x2, in3(F::C2X));
+  b.v[F::TOUCH][j] = ((!geom) | ((dist > 0) & !(pen_s < 0))) ? 1.0 : 0.0;
+  out3(F::NX, g.n);
+  b.v[F::PEN][j] = g.pen;
+  out3(F::PTX, g.pt);
+  return g;
+}
 
 /// One step of the law on lanes [0, count) of the batch (seed 000 eq 1-7): rotation of the
 /// stored shear force and moments into the current tangent plane, elastic increments, Coulomb

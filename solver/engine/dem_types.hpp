@@ -23,6 +23,15 @@ struct Material {
   double rolling_beta = 0;     // β, Kr = β·Ks·Ra·Rb (0 disables contact moments)
   double rolling_eta = 0;      // η, |M| ≤ η·R_roll·|Fn| (negative: no limit)
   RollingRadius rolling_radius = RollingRadius::Min;
+  // Hertz–Mindlin law only (young_ec is then the material's Young's modulus E):
+  double poisson = 0;      // ν
+  double restitution = 1;  // en of a pair of these grains (and of a grain on a wall)
+};
+
+/// The contact law of a scene.
+enum class ContactLaw {
+  CohesiveFrictional,  // YADE CohFrictMat, linear (default)
+  HertzMindlin,        // YADE MindlinPhys (hertz_mindlin_law.hpp)
 };
 
 /// Facets: triangles of a mesh wall (one triangle per wall in YADE's layout, or the triangles
@@ -59,6 +68,7 @@ struct WallSpec {
   Eigen::Vector3d rotation_center = Eigen::Vector3d::Zero();  // facets only
   int body = -1;  // walls with the same body ≥ 0 form one rigid mesh (servo on their sum)
   double off_at_s = HUGE_VAL;  // switched off once the time reaches this (an outlet opening)
+  int material = 0;            // index into the scene's materials (Hertz–Mindlin law)
 };
 
 /// Per-particle state, structure of arrays (index = particle index, not id).
@@ -73,6 +83,7 @@ struct ParticleState {
   std::vector<std::int32_t> clump;  // index of the clump the particle is a member of; -1: none
   std::vector<std::uint8_t>
       removed;  // 1: left through an outlet (frozen, in no contact, not output)
+  std::vector<std::uint8_t> material;  // index into the scene's materials (0: `material`)
 
   std::size_t size() const { return pos.size(); }
 };

@@ -14,6 +14,7 @@
 #include "atomic_file.hpp"
 #include "contact_geometry.hpp"
 #include "errors.hpp"
+#include "hertz_mindlin_law.hpp"
 #include "newton_integrator.hpp"
 
 namespace gs::solver {
@@ -48,6 +49,17 @@ Simulation::Simulation(SimulationConfig config, const std::vector<Particle>& par
   p_.external_force.assign(n, Eigen::Vector3d::Zero());
   p_.clump.assign(n, -1);
   p_.removed.assign(n, 0);
+  p_.material.assign(n, 0);
+  const std::size_t n_materials = 1 + cfg_.more_materials.size();
+  if (n_materials > 256) throw std::invalid_argument("more than 256 materials");
+  for (const auto& m : cfg_.more_materials)
+    if (!(m.density > 0) || !(m.young_ec > 0))
+      throw std::invalid_argument("material density and Ec must be positive");
+  for (const auto* t : {&cfg_.pair_restitution, &cfg_.pair_friction_deg})
+    if (!t->empty() && t->size() != n_materials * n_materials)
+      throw std::invalid_argument("material-pair table of the wrong size");
+  if (n_materials > 1 && cfg_.law != ContactLaw::HertzMindlin)
+    throw std::invalid_argument("several materials need the Hertz-Mindlin law");
   std::int64_t max_id = -1;
   double rmin = std::numeric_limits<double>::infinity();
   for (std::size_t i = 0; i < n; ++i) {
@@ -56,9 +68,14 @@ Simulation::Simulation(SimulationConfig config, const std::vector<Particle>& par
     p_.id[i] = q.id;
     p_.radius[i] = q.radius;
     // As YADE's utils.sphere: V = 4/3·π·r³, m = V·ρ, I = (2/5·V·r²)·ρ.
+    if (q.material_id < 0 || static_cast<std::size_t>(q.material_id) >= n_materials)
+      throw std::invalid_argument("particle " + std::to_string(q.id) + ": no material " +
+                                  std::to_string(q.material_id));
+    p_.material[i] = static_cast<std::uint8_t>(q.material_id);
+    const double density = material_at(q.material_id).density;
     const double volume = (4.0 / 3.0) * M_PI * std::pow(q.radius, 3);
-    p_.mass[i] = volume * cfg_.material.density;
-    p_.inertia[i] = (2.0 / 5.0) * volume * std::pow(q.radius, 2) * cfg_.material.density;
+    p_.mass[i] = volume * density;
+    p_.inertia[i] = (2.0 / 5.0) * volume * std::pow(q.radius, 2) * density;
     p_.pos[i] = q.position;
     p_.vel[i] = q.velocity;
     p_.angvel[i] = q.angular_velocity;
@@ -69,6 +86,9 @@ Simulation::Simulation(SimulationConfig config, const std::vector<Particle>& par
   }
   wall_id_base_ = max_id + 1;
   for (auto& spec : walls) {
+    if (spec.material < 0 || static_cast<std::size_t>(spec.material) >= n_materials)
+      throw std::invalid_argument("wall '" + spec.name + "': no material " +
+                                  std::to_string(spec.material));
     if (spec.shape == WallShape::Facets && spec.facets.empty())
       throw std::invalid_argument("facet wall '" + spec.name + "' has no triangles");
     WallState w;
@@ -411,16 +431,35 @@ void Simulation::attach_histories(const std::vector<ContactHistory>& old,
     const WallSpec* ws = pr.second >= kWallBase ? &walls_[pr.second - kWallBase].spec : nullptr;
     if (kept && reuse) {
       params_[k] = (*old_params)[o];
+      if (cfg_.law == ContactLaw::HertzMindlin) continue;  // (set_friction_deg: linear law only)
       params_[k].tan_friction =
           ws && ws->friction_deg >= 0 ? std::tan(ws->friction_deg * M_PI / 180.0) : tan_material;
       continue;
     }
     const double ra = p_.radius[pr.first];
     const double rb = pr.second >= kWallBase ? ra : p_.radius[pr.second];
-    if (ws && ws->shape == WallShape::Facets && !ws->plane_radii)  // YADE: the facet is 2R, first
+    const bool facet2r = ws && ws->shape == WallShape::Facets && !ws->plane_radii;
+    if (cfg_.law == ContactLaw::HertzMindlin) {
+      // Walls flat (radius 1e5 m, YADE's hertzian facets) or YADE's default radii (a box R, a
+      // facet 2R); m* of the dynamic bodies; the pair's restitution and friction. (E*, G*, R*
+      // and m* are symmetric to the bit, so the order of the two bodies does not matter.)
+      const int ia = p_.material[pr.first], ib = ws ? ws->material : p_.material[pr.second];
+      const Material &A = material_at(ia), &B = material_at(ib);
+      const double r_wall = cfg_.hertz_flat_walls ? 1e5 : facet2r ? 2 * ra : ra;
+      const double ma = p_.fixed[pr.first] ? 0.0 : p_.mass[pr.first];
+      const double mb = ws || p_.fixed[pr.second] ? 0.0 : p_.mass[pr.second];
+      const std::size_t nm = 1 + cfg_.more_materials.size();
+      const std::size_t cell = static_cast<std::size_t>(ia) * nm + static_cast<std::size_t>(ib);
+      const double en = cfg_.pair_restitution.empty() ? A.restitution : cfg_.pair_restitution[cell];
+      double phi = cfg_.pair_friction_deg.empty() ? -1 : cfg_.pair_friction_deg[cell];
+      if (phi < 0) phi = std::min(A.friction_deg, B.friction_deg);
+      params_[k] = hertz_mindlin_params({A.young_ec, A.poisson}, {B.young_ec, B.poisson}, ra,
+                                        ws ? r_wall : rb, ma, mb, en, std::tan(phi * M_PI / 180.0));
+    } else if (facet2r) {  // YADE: the facet is 2R, first
       params_[k] = contact_params(cfg_.material, 2 * ra, ra, cfg_.twist_beta, cfg_.twist_eta);
-    else
+    } else {
       params_[k] = contact_params(cfg_.material, ra, rb, cfg_.twist_beta, cfg_.twist_eta);
+    }
     if (disk_thickness_ > 0 && !ws) {  // disks: a line contact of Ec per unit thickness
       params_[k].kn = mat.young_ec * disk_thickness_;
       params_[k].ks = mat.stiffness_ratio * params_[k].kn;
@@ -527,10 +566,16 @@ std::pair<double, std::size_t> Simulation::wall_stiffness(std::size_t w) const {
 }
 
 void Simulation::set_friction_deg(double friction_deg) {
+  // Every contact takes it now, sphere pairs and the pairs of walls without a friction angle of
+  // their own: what a pair's friction is does not depend on when the neighbour list was last
+  // built (a resumed run builds it afresh), so a run resumes bit for bit.
   cfg_.material.friction_deg = friction_deg;
   const double t = std::tan(friction_deg * M_PI / 180.0);
-  for (std::size_t k = 0; k < params_.size(); ++k)
-    if (nl_.pairs[k].second < kWallBase) params_[k].tan_friction = t;
+  for (std::size_t k = 0; k < params_.size(); ++k) {
+    const std::uint32_t b = nl_.pairs[k].second;
+    if (b < kWallBase || !(walls_[b - kWallBase].spec.friction_deg >= 0))
+      params_[k].tan_friction = t;
+  }
 }
 
 void Simulation::set_wall_active(std::size_t w, bool active) {
@@ -712,6 +757,7 @@ void Simulation::accumulate_walls() {
   B.v[F::KN][j] = p.kn;
   B.v[F::KS][j] = p.ks;
   B.v[F::KR][j] = p.kr;
+  if (cfg_.law == ContactLaw::HertzMindlin) B.v[F::KTW][j] = p.ktw;  // (βs)
   if (twist) {
     B.v[F::KTW][j] = p.ktw;
     B.v[F::MAX_TWIST][j] = p.max_twist;
@@ -858,6 +904,13 @@ int Simulation::fill_batch(std::size_t& i, std::size_t end, ContactBatch& batch,
   return true;
 }
 
+void Simulation::run_law(ContactBatch& batch, int count, double dt) const {
+  if (cfg_.law == ContactLaw::HertzMindlin)
+    hertz_mindlin_batch(batch, count, dt, periodic_);
+  else
+    cohesive_frictional_batch(batch, count, dt, cfg_.twist_beta > 0, periodic_);
+}
+
 void Simulation::step() {
   if (periodic_) cell_.integrate(cfg_.dt);  // (YADE: Scene::moveToNextTimeStep, before engines)
   if (walls_dirty_) classify_walls();
@@ -911,7 +964,7 @@ void Simulation::step() {
       for (std::size_t i = 0; i < nv;) {
         const int m = indexed ? fill_batch<true>(i, nv, batch, lane_pair)
                               : fill_batch<false>(i, nv, batch, lane_pair);
-        cohesive_frictional_batch(batch, m, dt, cfg_.twist_beta > 0, periodic_);
+        run_law(batch, m, dt);
         for (int j = 0; j < m; ++j) {
           const std::uint32_t kk = lane_pair[j];
           ContactLoads L;
@@ -954,7 +1007,7 @@ void Simulation::step() {
       for (std::size_t i = nv * t / nt; i < k_end;) {
         const int m = indexed ? fill_batch<true>(i, k_end, batch, lane_pair)
                               : fill_batch<false>(i, k_end, batch, lane_pair);
-        cohesive_frictional_batch(batch, m, dt, cfg_.twist_beta > 0, periodic_);
+        run_law(batch, m, dt);
         for (int j = 0; j < m; ++j) {
           const std::uint32_t kk = lane_pair[j];
           ContactLoads& L = loads_[kk];
@@ -1041,9 +1094,11 @@ void Simulation::step() {
       chunk_sums_[kSums * c + 4] = sums.damping;
     }
   }
+  const bool hertz = cfg_.law == ContactLaw::HertzMindlin;
   for (std::size_t c = 0; c < chunks; ++c) {
     ledger_.friction_dissipation += chunk_sums_[kSums * c];
-    ledger_.rolling_dissipation += chunk_sums_[kSums * c + 1];
+    (hertz ? ledger_.viscous_dissipation : ledger_.rolling_dissipation) +=
+        chunk_sums_[kSums * c + 1];  // (the Hertz-Mindlin law has no contact moments)
     ledger_.gravity_work += chunk_sums_[kSums * c + 2] * dt;
     ledger_.external_work += chunk_sums_[kSums * c + 3] * dt;
     ledger_.damping_dissipation += chunk_sums_[kSums * c + 4];
@@ -1227,6 +1282,12 @@ const EnergyLedger& Simulation::energy() {
     const auto& h = hist_[k];
     if (!h.real) continue;
     const auto& p = params_[k];
+    if (cfg_.law == ContactLaw::HertzMindlin) {  // (kn, ks hold kno, kso: Fn = kno·δ^1.5)
+      ledger_.elastic_normal += 0.4 * p.kn * std::pow(h.overlap, 2.5);
+      const double ks = p.ks * std::sqrt(h.overlap);
+      if (ks > 0) ledger_.elastic_shear += 0.5 * h.shear_force.squaredNorm() / ks;
+      continue;
+    }
     ledger_.elastic_normal += 0.5 * h.fn * h.fn / p.kn;
     if (p.ks > 0) ledger_.elastic_shear += 0.5 * h.shear_force.squaredNorm() / p.ks;
     if (p.kr > 0) ledger_.elastic_rolling += 0.5 * h.bending.squaredNorm() / p.kr;
@@ -1244,7 +1305,9 @@ const EnergyLedger& Simulation::energy() {
         BodyMotion m1, m2;
         if (!pair_geometry(k, g, m1, m2)) continue;
         if (g.penetration > 0)
-          ledger_.initial += 0.5 * params_[k].kn * g.penetration * g.penetration;
+          ledger_.initial += cfg_.law == ContactLaw::HertzMindlin
+                                 ? 0.4 * params_[k].kn * std::pow(g.penetration, 2.5)
+                                 : 0.5 * params_[k].kn * g.penetration * g.penetration;
       }
     }
   }
@@ -1287,6 +1350,7 @@ Frame Simulation::frame() const {
     q.orientation = p_.ori[i];
     q.rotation = p_.rot[i];
     q.mass = p_.mass[i];
+    q.material_id = p_.material[i];
     q.clump_id = p_.clump[i] >= 0 ? clumps_[static_cast<std::size_t>(p_.clump[i])].id : -1;
   }
   for (const auto& h : hist_) {

@@ -40,6 +40,16 @@ struct CellServo {
 
 struct SimulationConfig {
   Material material;
+  ContactLaw law = ContactLaw::CohesiveFrictional;
+  // Hertz–Mindlin law only: further materials (index 1, 2, ...; 0 is `material`), and the
+  // material-pair table, (1 + more_materials)² entries, symmetric: the restitution of each pair
+  // (empty: one material, its own), and its friction angle (negative or empty: the smaller of the
+  // two materials' angles, as YADE's default).
+  std::vector<Material> more_materials;
+  std::vector<double> pair_restitution, pair_friction_deg;
+  // Walls under the Hertz–Mindlin law: flat (the wall's radius 1e5 m, R* = R to 1e-8, YADE's
+  // Ig2_Facet_Sphere_ScGeom(hertzian=True)), or YADE's default radii (box R, facet 2R).
+  bool hertz_flat_walls = true;
   double dt = 0;  // s
   double damping = 0;
   Eigen::Vector3d gravity = Eigen::Vector3d::Zero();
@@ -56,12 +66,14 @@ struct SimulationConfig {
 struct EnergyLedger {
   double kinetic = 0, elastic_normal = 0, elastic_shear = 0, elastic_rolling = 0;
   double friction_dissipation = 0, rolling_dissipation = 0, damping_dissipation = 0;
+  double viscous_dissipation = 0;  // the Hertz–Mindlin law's viscous contact forces
   double gravity_work = 0, wall_work = 0, external_work = 0;
   double outflow = 0;  // kinetic energy of the particles removed through an outlet
   double initial = 0;  // kinetic + elastic at the start
   double stored() const { return kinetic + elastic_normal + elastic_shear + elastic_rolling; }
   double dissipated() const {
-    return friction_dissipation + rolling_dissipation + damping_dissipation + outflow;
+    return friction_dissipation + rolling_dissipation + damping_dissipation + viscous_dissipation +
+           outflow;
   }
   /// stored + dissipated − (initial + work in): zero for an exact integration.
   double residual() const {
@@ -132,8 +144,9 @@ class Simulation {
   /// Sum of the normal stiffnesses Kn (N/m) of the real contacts on wall w, and their count:
   /// what a stiffness-based servo needs (YADE TriaxialStressController).
   std::pair<double, std::size_t> wall_stiffness(std::size_t w) const;
-  /// Changes the inter-particle friction angle of every existing and future sphere–sphere
-  /// contact (YADE's setContactFriction); walls keep their own friction.
+  /// Changes the friction angle of every existing and future contact, as YADE's
+  /// setContactFriction does for sphere pairs, and at once for the contacts of walls that have
+  /// no friction angle of their own (spec.friction_deg < 0; the others keep theirs).
   void set_friction_deg(double friction_deg);
   void set_damping(double damping) { cfg_.damping = damping; }
   void set_gravity(const Eigen::Vector3d& g) { cfg_.gravity = g; }
@@ -219,6 +232,12 @@ class Simulation {
   /// geometry of a wall pair (a sphere pair's the batch computes); false when a wall pair does
   /// not touch (its history is then marked not real).
   bool prepare_pair(std::size_t k, ContactBatch& batch, int j);
+  /// Material i of the scene (0: cfg_.material).
+  const Material& material_at(int i) const {
+    return i == 0 ? cfg_.material : cfg_.more_materials[static_cast<std::size_t>(i - 1)];
+  }
+  /// The scene's contact law on lanes [0, count) of a prepared batch.
+  void run_law(ContactBatch& batch, int count, double dt) const;
   /// Fills a batch with the next touching pairs from k (advanced) up to end; returns the
   /// number of lanes, lane_pair[j] the pair of lane j.
   /// With kIndexed, positions i in [i, end) of pass_pairs_ instead of pairs themselves.

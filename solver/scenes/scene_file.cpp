@@ -12,6 +12,7 @@
 
 #include "clump_shapes.hpp"
 #include "errors.hpp"
+#include "hertz_mindlin_law.hpp"
 #include "mesh_walls.hpp"
 #include "text_parse.hpp"
 #include "trajectory_io.hpp"
@@ -606,6 +607,141 @@ void read_clumps(const Reader& r, const toml::table& root, const std::filesystem
     for (const auto i : c.members) s.particles[i].clump_id = c.id;
 }
 
+// The materials after [material] ([[materials]], Hertz–Mindlin law only) and the material-pair
+// table ([[material_pairs]]): the restitution of every pair that can meet, and a friction angle
+// where it is not the smaller of the two materials' (YADE's default).
+void read_materials(const Reader& r, const toml::table& root, bool hertz, Scene& s) {
+  const auto* mat = r.table("material", true);
+  s.material_names = {r.string(mat, "material", "name", false, "default")};
+  s.material_radius_range = {{-1.0, -1.0}};
+  const auto* ms = root["materials"].as_array();
+  const auto* ps = root["material_pairs"].as_array();
+  if (!ms) {
+    if (ps) r.fail("[[material_pairs]]", "needs [[materials]]");
+    return;
+  }
+  if (!hertz) r.fail("[[materials]]", "several materials need material.law = \"hertz_mindlin\"");
+  for (std::size_t i = 0; i < ms->size(); ++i) {
+    const auto* t = (*ms)[i].as_table();
+    const std::string sec = "materials[" + std::to_string(i) + "]";
+    if (!t) r.fail(sec, "expected a table");
+    r.only(t, sec,
+           {"name", "young_Pa", "poisson", "restitution", "friction_deg", "density_kg_m3",
+            "radius_range_m"});
+    Material m;
+    const std::string name = r.string(t, sec, "name", true, "");
+    if (std::find(s.material_names.begin(), s.material_names.end(), name) != s.material_names.end())
+      r.fail(sec + ".name", "used twice", name);
+    m.young_ec = r.positive(t, sec, "young_Pa", true, 0);
+    m.poisson = r.number(t, sec, "poisson", true, 0);
+    if (!(m.poisson > -1 && m.poisson <= 0.5))
+      r.fail(sec + ".poisson", "outside (-1, 0.5]", value_str(m.poisson));
+    m.restitution = r.number(t, sec, "restitution", false, NAN);
+    if (!std::isnan(m.restitution) && !(m.restitution > 0 && m.restitution <= 1))
+      r.fail(sec + ".restitution", "outside (0, 1]", value_str(m.restitution));
+    m.friction_deg = r.number(t, sec, "friction_deg", true, 0);
+    if (m.friction_deg < 0 || m.friction_deg >= 90)
+      r.fail(sec + ".friction_deg", "outside [0, 90)", value_str(m.friction_deg));
+    m.density = r.positive(t, sec, "density_kg_m3", true, 0);
+    std::array<double, 2> range{-1.0, -1.0};
+    if (t->contains("radius_range_m")) {
+      const auto* a = (*t)["radius_range_m"].as_array();
+      const auto lo = a && a->size() == 2 ? (*a)[0].value<double>() : std::nullopt;
+      const auto hi = a && a->size() == 2 ? (*a)[1].value<double>() : std::nullopt;
+      if (!lo || !hi || !(*lo > 0) || !(*hi >= *lo))
+        r.fail(sec + ".radius_range_m", "expected [lo, hi] with 0 < lo <= hi");
+      range = {*lo, *hi};
+    }
+    s.material_names.push_back(name);
+    s.material_radius_range.push_back(range);
+    s.config.more_materials.push_back(m);
+  }
+  const std::size_t n = s.material_names.size();
+  auto at = [&](int i) -> const Material& {
+    return i == 0 ? s.config.material : s.config.more_materials[static_cast<std::size_t>(i - 1)];
+  };
+  std::vector<double> en(n * n, NAN), phi(n * n, -1.0);
+  for (std::size_t i = 0; i < n; ++i) en[i * n + i] = at(static_cast<int>(i)).restitution;
+  for (std::size_t k = 0; ps && k < ps->size(); ++k) {
+    const auto* t = (*ps)[k].as_table();
+    const std::string sec = "material_pairs[" + std::to_string(k) + "]";
+    if (!t) r.fail(sec, "expected a table");
+    r.only(t, sec, {"materials", "restitution", "friction_deg"});
+    const auto* a = (*t)["materials"].as_array();
+    std::array<std::size_t, 2> ij{};
+    for (std::size_t q = 0; q < 2; ++q) {
+      const auto name = a && a->size() == 2 ? (*a)[q].value<std::string>() : std::nullopt;
+      if (!name) r.fail(sec + ".materials", "expected two material names");
+      const auto it = std::find(s.material_names.begin(), s.material_names.end(), *name);
+      if (it == s.material_names.end()) r.fail(sec + ".materials", "unknown material", *name);
+      ij[q] = static_cast<std::size_t>(it - s.material_names.begin());
+    }
+    const double e = r.number(t, sec, "restitution", true, 0);
+    if (!(e > 0 && e <= 1)) r.fail(sec + ".restitution", "outside (0, 1]", value_str(e));
+    const double f = r.number(t, sec, "friction_deg", false, -1);
+    if (t->contains("friction_deg") && (f < 0 || f >= 90))
+      r.fail(sec + ".friction_deg", "outside [0, 90)", value_str(f));
+    en[ij[0] * n + ij[1]] = en[ij[1] * n + ij[0]] = e;
+    phi[ij[0] * n + ij[1]] = phi[ij[1] * n + ij[0]] = f;
+  }
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t j = i; j < n; ++j)
+      if (std::isnan(en[i * n + j]))
+        r.fail("[[material_pairs]]", "no restitution for a pair of materials",
+               s.material_names[i] + "/" + s.material_names[j]);
+  s.config.pair_restitution = en;
+  s.config.pair_friction_deg = phi;
+}
+
+/// The material a wall or mesh names (`material = "steel"`; default the first).
+int material_index(const Reader& r, const Scene& s, const toml::table* t, const std::string& sec) {
+  if (!t->contains("material")) return 0;
+  const std::string name = r.string(t, sec, "material", true, "");
+  const auto it = std::find(s.material_names.begin(), s.material_names.end(), name);
+  if (it == s.material_names.end()) r.fail(sec + ".material", "unknown material", name);
+  return static_cast<int>(it - s.material_names.begin());
+}
+
+/// [[particles]]: single particles added to the packing (e.g. the DEM8 impactor): position,
+/// radius, velocity, material; ids after the packing's.
+void read_extra_particles(const Reader& r, const toml::table& root, Scene& s) {
+  const auto* ps = root["particles"].as_array();
+  if (!ps) return;
+  std::int64_t next = 0;
+  for (const auto& p : s.particles) next = std::max(next, p.id + 1);
+  for (std::size_t i = 0; i < ps->size(); ++i) {
+    const auto* t = (*ps)[i].as_table();
+    const std::string sec = "particles[" + std::to_string(i) + "]";
+    if (!t) r.fail(sec, "expected a table");
+    r.only(t, sec, {"position_m", "radius_m", "velocity_m_s", "material"});
+    Particle q;
+    q.id = next++;
+    q.position = r.vec3(t, sec, "position_m", true, {});
+    q.radius = r.positive(t, sec, "radius_m", true, 0);
+    q.velocity = r.vec3(t, sec, "velocity_m_s", false, Eigen::Vector3d::Zero());
+    q.material_id = material_index(r, s, t, sec);
+    s.particles.push_back(q);
+  }
+}
+
+/// A particle of material 0 (the default: none named, none in the packing) takes the first
+/// material whose radius range holds its radius.
+void assign_materials_by_radius(const Reader& r, Scene& s) {
+  const std::size_t n = s.material_names.size();
+  for (auto& p : s.particles) {
+    for (std::size_t i = 1; p.material_id == 0 && i < n; ++i) {
+      const auto& rr = s.material_radius_range[i];
+      if (rr[0] > 0 && p.radius >= rr[0] && p.radius <= rr[1]) {
+        p.material_id = static_cast<std::int32_t>(i);
+        break;
+      }
+    }
+    if (p.material_id < 0 || static_cast<std::size_t>(p.material_id) >= n)
+      r.fail("scene.packing", "particle " + std::to_string(p.id) + " has no such material",
+             std::to_string(p.material_id));
+  }
+}
+
 /// [fill]: layers of a grading inserted into a region (layered_filling.hpp). The particles are
 /// appended to the scene's (ids after every particle and clump), waiting for insertion; the
 /// first layer is placed here already, so that a region too small for it is an error now.
@@ -804,6 +940,9 @@ Scene load_scene(const std::filesystem::path& path, int sweep_point) {
   for (const auto& [k, v] : root) {
     static const char* sections[] = {"scene",
                                      "material",
+                                     "materials",
+                                     "material_pairs",
+                                     "particles",
                                      "solver",
                                      "output",
                                      "walls",
@@ -826,7 +965,7 @@ Scene load_scene(const std::filesystem::path& path, int sweep_point) {
       r.fail("[" + std::string(k.str()) + "]", "unknown section");
   }
   const auto* scene = r.table("scene", true);
-  r.only(scene, "scene", {"name", "packing", "test", "wall_friction_deg"});
+  r.only(scene, "scene", {"name", "packing", "packing_rows", "test", "wall_friction_deg"});
   s.name = r.string(scene, "scene", "name", true, "");
   s.test = r.string(scene, "scene", "test", false, "");
   if (!s.test.empty() && s.test != "triaxial" && s.test != "plane_strain" &&
@@ -846,7 +985,11 @@ Scene load_scene(const std::filesystem::path& path, int sweep_point) {
     std::error_code missing;
     if (!std::filesystem::exists(packing_path, missing))
       r.fail("scene.packing", "no such file", packing_path.string());
-    const Trajectory t = read_snapshots(packing_path);
+    ImportOptions io;
+    if (scene->contains("packing_rows"))
+      io.max_particles =
+          static_cast<std::size_t>(r.integer(scene, "scene", "packing_rows", true, 0, 1));
+    const Trajectory t = read_snapshots(packing_path, io);
     if (t.frames.empty() || t.frames.back().particles.empty())
       throw InputError(packing_path.string(), "packing holds no particles");
     s.particles = t.frames.back().particles;
@@ -860,12 +1003,37 @@ Scene load_scene(const std::filesystem::path& path, int sweep_point) {
   s.wall_friction_deg = r.number(scene, "scene", "wall_friction_deg", false, 0.0);
 
   const auto* mat = r.table("material", true);
-  r.only(mat, "material",
-         {"young_Pa", "stiffness_ratio", "friction_deg", "density_kg_m3", "rolling_stiffness",
-          "rolling_limit", "rolling_limit_radius", "twisting_stiffness", "twisting_limit"});
+  const std::string law = r.string(mat, "material", "law", false, "cohesive_frictional");
+  const bool hertz = law == "hertz_mindlin";
+  if (!hertz && law != "cohesive_frictional")
+    r.fail("material.law", "expected \"cohesive_frictional\" or \"hertz_mindlin\"", law);
+  const bool several = root.contains("materials");
+  if (hertz)  // (YADE's FrictMat with MindlinPhys: no stiffness ratio, no contact moments)
+    r.only(mat, "material",
+           {"law", "name", "young_Pa", "poisson", "restitution", "friction_deg", "density_kg_m3",
+            "wall_radius"});
+  else
+    r.only(
+        mat, "material",
+        {"law", "young_Pa", "stiffness_ratio", "friction_deg", "density_kg_m3", "rolling_stiffness",
+         "rolling_limit", "rolling_limit_radius", "twisting_stiffness", "twisting_limit"});
   auto& m = s.config.material;
+  s.config.law = hertz ? ContactLaw::HertzMindlin : ContactLaw::CohesiveFrictional;
   m.young_ec = r.positive(mat, "material", "young_Pa", true, 0);
-  m.stiffness_ratio = r.number(mat, "material", "stiffness_ratio", true, 0);
+  if (hertz) {
+    m.poisson = r.number(mat, "material", "poisson", true, 0);
+    if (!(m.poisson > -1 && m.poisson <= 0.5))
+      r.fail("material.poisson", "outside (-1, 0.5]", value_str(m.poisson));
+    m.restitution = r.number(mat, "material", "restitution", !several, NAN);
+    if (!std::isnan(m.restitution) && !(m.restitution > 0 && m.restitution <= 1))
+      r.fail("material.restitution", "outside (0, 1]", value_str(m.restitution));
+    const std::string wr = r.string(mat, "material", "wall_radius", false, "flat");
+    if (wr != "flat" && wr != "yade")
+      r.fail("material.wall_radius", "expected \"flat\" or \"yade\"", wr);
+    s.config.hertz_flat_walls = wr == "flat";
+  } else {
+    m.stiffness_ratio = r.number(mat, "material", "stiffness_ratio", true, 0);
+  }
   if (m.stiffness_ratio < 0)
     r.fail("material.stiffness_ratio", "must not be negative", value_str(m.stiffness_ratio));
   m.friction_deg = r.number(mat, "material", "friction_deg", true, 0);
@@ -883,6 +1051,8 @@ Scene load_scene(const std::filesystem::path& path, int sweep_point) {
     r.fail("material.rolling_limit_radius", "expected \"min\" or \"mean\"", rr);
   s.config.twist_beta = r.number(mat, "material", "twisting_stiffness", false, 0);
   s.config.twist_eta = r.number(mat, "material", "twisting_limit", false, -1);
+  read_materials(r, root, hertz, s);
+  read_extra_particles(r, root, s);
 
   const auto* sol = r.table("solver", true);
   r.only(sol, "solver",
@@ -1003,7 +1173,7 @@ Scene load_scene(const std::filesystem::path& path, int sweep_point) {
   const auto* out = r.table("output", false);
   r.only(out, "output",
          {"trajectory", "every", "contacts", "history", "history_every", "checkpoint_every",
-          "curve", "curve_every", "specimen", "preparation", "facet_forces"});
+          "curve", "curve_every", "specimen", "preparation", "facet_forces", "track_ids"});
   s.output.trajectory = r.string(out, "output", "trajectory", false, s.output.trajectory);
   s.output.every = r.integer(out, "output", "every", false, s.output.every, 1);
   s.output.contacts = out && out->contains("contacts") ? (*out)["contacts"].value_or(true) : true;
@@ -1017,6 +1187,15 @@ Scene load_scene(const std::filesystem::path& path, int sweep_point) {
   s.output.specimen = r.string(out, "output", "specimen", false, s.output.specimen);
   s.output.preparation = r.string(out, "output", "preparation", false, s.output.preparation);
   check_output_names(r, s);
+  if (out && out->contains("track_ids")) {
+    const auto* a = (*out)["track_ids"].as_array();
+    if (!a) r.fail("output.track_ids", "expected an array of particle ids");
+    for (std::size_t i = 0; i < a->size(); ++i) {
+      const auto id = (*a)[i].value<std::int64_t>();
+      if (!id) r.fail("output.track_ids", "expected an array of particle ids");
+      s.output.track_ids.push_back(*id);
+    }
+  }
   if (out && out->contains("facet_forces")) {
     const auto* v = (*out)["facet_forces"].as_boolean();
     if (!v) r.fail("output.facet_forces", "expected true or false");
@@ -1038,7 +1217,7 @@ Scene load_scene(const std::filesystem::path& path, int sweep_point) {
       if (!w) r.fail(sec, "expected a table");
       r.only(w, sec,
              {"name", "shape", "center_m", "half_extents_m", "point_m", "normal",
-              "angular_velocity_rad_s", "velocity_m_s", "servo", "friction_deg"});
+              "angular_velocity_rad_s", "velocity_m_s", "servo", "friction_deg", "material"});
       WallSpec spec;
       spec.name = r.string(w, sec, "name", false, "wall" + std::to_string(i));
       const std::string shape = r.string(w, sec, "shape", true, "");
@@ -1061,6 +1240,7 @@ Scene load_scene(const std::filesystem::path& path, int sweep_point) {
       }
       spec.velocity = r.vec3(w, sec, "velocity_m_s", false, Eigen::Vector3d::Zero());
       spec.friction_deg = r.number(w, sec, "friction_deg", false, -1);
+      spec.material = material_index(r, s, w, sec);
       if (const auto* servo = (*w)["servo"].as_table()) {
         const std::string ss = sec + ".servo";
         r.only(servo, ss, {"stress_Pa", "area_m2", "gain_m_s_per_Pa", "max_velocity_m_s", "axis"});
@@ -1080,10 +1260,10 @@ Scene load_scene(const std::filesystem::path& path, int sweep_point) {
       const auto* m = (*meshes)[i].as_table();
       const std::string sec = "mesh[" + std::to_string(i) + "]";
       if (!m) r.fail(sec, "expected a table");
-      r.only(
-          m, sec,
-          {"file", "scale", "contact", "velocity_m_s", "friction_deg", "name",
-           "angular_velocity_rad_s", "rotation_center_m", "servo", "off_at_s", "off_after_fill"});
+      r.only(m, sec,
+             {"file", "scale", "contact", "velocity_m_s", "friction_deg", "name",
+              "angular_velocity_rad_s", "rotation_center_m", "servo", "off_at_s", "off_after_fill",
+              "material"});
       const std::string file_name = r.string(m, sec, "file", true, "");
       const auto mesh_path = path.parent_path() / file_name;
       std::error_code missing;
@@ -1136,6 +1316,7 @@ Scene load_scene(const std::filesystem::path& path, int sweep_point) {
         off_after_fill = v->get();
       }
       const int body = static_cast<int>(i);
+      const int mesh_material = material_index(r, s, m, sec);
       try {
         for (auto& w :
              mesh_walls(tri, contact == "yade" ? MeshContact::YadeParity : MeshContact::Merged,
@@ -1146,6 +1327,7 @@ Scene load_scene(const std::filesystem::path& path, int sweep_point) {
           w.body = body;
           w.mesh = name.empty() ? mesh_path.stem().string() : name;
           w.off_at_s = off_at;
+          w.material = mesh_material;
           w.servo_stress_Pa = servo.servo_stress_Pa;
           w.servo_area_m2 = servo.servo_area_m2;
           w.servo_gain = servo.servo_gain;
@@ -1241,6 +1423,27 @@ Scene load_scene(const std::filesystem::path& path, int sweep_point) {
     if (s.specimen) all.push_back(0.5 * s.specimen->sizes.dmin_m);
     s.dt_pwave = pwave_timestep(all, s.config.material.density, s.config.material.young_ec);
     if (auto_dt_safety > 0) s.config.dt = auto_dt_safety * s.dt_pwave;
+    assign_materials_by_radius(r, s);
+    for (const auto id : s.output.track_ids)
+      if (std::none_of(s.particles.begin(), s.particles.end(),
+                       [&](const Particle& p) { return p.id == id; }))
+        r.fail("output.track_ids", "no particle with this id", std::to_string(id));
+    const auto& m = s.config.material;
+    if (s.config.law == ContactLaw::HertzMindlin && (!s.clumps.empty() || s.clump_replace))
+      r.fail("material.law", "the Hertz-Mindlin law does not take clumps yet", "hertz_mindlin");
+    if (s.config.law == ContactLaw::HertzMindlin && !all.empty()) {
+      double dt_r = rayleigh_timestep(all, m.density, m.young_ec, m.poisson);
+      for (const auto& p : s.particles) {
+        const Material& pm =
+            p.material_id <= 0
+                ? m
+                : s.config.more_materials[static_cast<std::size_t>(p.material_id - 1)];
+        dt_r = std::min(dt_r, rayleigh_timestep({p.radius}, pm.density, pm.young_ec, pm.poisson));
+      }
+      if (s.config.dt > dt_r)
+        r.fail("solver.dt_s", "above the Hertz critical (Rayleigh) step " + value_str(dt_r) + " s",
+               value_str(s.config.dt));
+    }
   }
   if (!s.open_after_fill.empty() && !s.fill)
     r.fail("[[mesh]].off_after_fill", "there is no [fill] section");

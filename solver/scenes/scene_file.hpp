@@ -2,6 +2,7 @@
 // output cadence of one `granoscope simulate` run.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <string>
@@ -40,7 +41,8 @@ struct OutputSpec {
   std::int64_t curve_every = 200;
   std::string specimen = "specimen.h5";  // the prepared specimen (one frame)
   std::string preparation = "preparation.csv";
-  bool facet_forces = false;  // per-triangle forces of the mesh walls in the history
+  bool facet_forces = false;            // per-triangle forces of the mesh walls in the history
+  std::vector<std::int64_t> track_ids;  // particles whose position and velocity the history holds
 };
 
 /// [specimen]: a seeded random specimen generated instead of reading a packing.
@@ -66,6 +68,10 @@ struct SweepInfo {
 
 struct Scene {
   std::string name;
+  // Materials by index (0: [material], then [[materials]] in order) and, where given, the radius
+  // range [lo, hi] (m) of the particles that are of that material.
+  std::vector<std::string> material_names;
+  std::vector<std::array<double, 2>> material_radius_range;
   std::optional<SweepInfo> sweep;
   std::filesystem::path file;
   SimulationConfig config;

@@ -38,9 +38,12 @@ std::string scene(const std::string& surface, const std::string& extra = "") {
 }  // namespace
 
 // Seed 004 §4.3.3: on the nearly flat surface "the entire sand mass behaved like a rigid body"
-// and φs is the surface's friction. With every surface contact sliding, the surface's own
-// T/P is tan 18° to rounding, and the frame's μeff = T/P is that too once the block slides
-// steadily (no gravity: the platen's force is the surface's).
+// and φs is the surface's friction. Coulomb bounds every contact's shear force by tan 18° times
+// its normal force, so the surface's own T/P can never exceed tan 18° (to the curve's 9
+// printed digits); with the block sliding, all but a few grains touching the surface slide, and
+// T/P is within 1e-4 of the bound (the grains that roll or rest carry less); the frame's
+// μeff = T/P is that too once the block slides steadily (no gravity: the platen's force is the
+// surface's).
 TEST(InterfaceShear, FlatSurfaceSlidesAtItsFriction) {
   gs::test::ScratchDir dir("is_flat");
   std::ofstream(dir / "is.toml") << scene("surface = \"flat\"\n", "max_displacement_m = 0.001\n");
@@ -52,7 +55,8 @@ TEST(InterfaceShear, FlatSurfaceSlidesAtItsFriction) {
   const double mu = std::tan(18.0 * M_PI / 180.0);
   const std::size_t last = c.rows.size() - 1;
   EXPECT_NEAR(c.num(last, "u_m"), 0.001, 1e-6);
-  EXPECT_NEAR(c.num(last, "surface_mu"), mu, 1e-6 * mu);
+  EXPECT_LE(c.num(last, "surface_mu"), mu * (1 + 1e-8));
+  EXPECT_GT(c.num(last, "surface_mu"), mu * (1 - 1e-4));
   EXPECT_NEAR(c.num(last, "sigma_n_Pa"), 1e5, 0.01e5);
   // The surface carries what the platen pushes: P_surface = P_platen (no gravity) to 1 %.
   EXPECT_NEAR(c.num(last, "surface_P_N"), c.num(last, "P_N"), 0.01 * c.num(last, "P_N"));
@@ -126,13 +130,15 @@ TEST(InterfaceShear, SweepWritesOneRunPerValueAndTheirTable) {
   EXPECT_EQ(gs::test::slurp(dir / "out" / "sweep.csv"), before);
 }
 
-// Killed while shearing (the preparation ends near step 60 000), resumed: the curve, the history
-// and the results are the uninterrupted run's.
+// Killed while preparing (step 20 000: after the preparation has lowered the friction, which
+// the walls' contacts follow at once, not at the next neighbour-list build) and while shearing
+// (the preparation ends near step 60 000), resumed: the curve, the history and the results are
+// the uninterrupted run's.
 TEST(InterfaceShear, ResumeIsBitForBit) {
   gs::test::ScratchDir dir("is_resume");
   std::ofstream(dir / "is.toml") << scene(
       "surface = \"saw_tooth\"\nroughness = 0.5\nd50_m = 0.001\n", "max_displacement_m = 0.0008\n");
-  gs::test::expect_resume_bit_for_bit(dir.path, (dir / "is.toml").string(), {70000},
+  gs::test::expect_resume_bit_for_bit(dir.path, (dir / "is.toml").string(), {20000, 70000},
                                       {"history.csv", "curve.csv", "results.csv"}, "trajectory.h5");
 }
 

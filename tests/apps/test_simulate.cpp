@@ -899,3 +899,40 @@ TEST(Simulate, ProgressLinesInALogAndTheShippedOedometerPacking) {
   EXPECT_EQ(oed.rc, 0) << oed.err;
   EXPECT_EQ(gs::TrajectoryReader(dir / "oed" / "oedometer_yade.h5").particle_count(0), 883u);
 }
+
+// [output] track_ids: the history holds those particles' position and velocity, the same
+// numbers the trajectory's frames hold at the same steps; a Hertz–Mindlin run adds its viscous
+// dissipation column; an id that no particle has is one line naming the key.
+TEST(Simulate, TrackedParticlesInTheHistory) {
+  gs::test::ScratchDir dir("track");
+  std::filesystem::copy_file(kData / "yade_hertz" / "packing.csv", dir / "packing.csv");
+  std::string text = slurp(kData / "yade_hertz" / "scene.toml");
+  text.replace(text.find("steps = 5000"), 12, "steps = 3000");
+  text.replace(text.find("every = 2500"), 12, "every = 1000\ntrack_ids = [7, 200]");
+  text.replace(text.find("history_every = 500"), 19, "history_every = 1000");
+  write_text(dir / "t.toml", text);
+  const auto r = gs::test::run_cli(
+      "simulate " + (dir / "t.toml").string() + " -q -o " + (dir / "out").string(), dir.path);
+  ASSERT_EQ(r.rc, 0) << r.err;
+  const auto traj = gs::read_hdf5_trajectory(dir / "out" / "trajectory.h5");
+  const gs::Frame& last = traj.frames.back();
+  ASSERT_EQ(last.step, 3000);
+  for (const long id : {7L, 200L}) {
+    const auto it = std::find_if(last.particles.begin(), last.particles.end(),
+                                 [&](const gs::Particle& p) { return p.id == id; });
+    ASSERT_NE(it, last.particles.end());
+    const std::string p = "p" + std::to_string(id);
+    const auto h = dir / "out" / "history.csv";
+    EXPECT_EQ(last_history_value(h, p + "_x_m"), it->position.x());
+    EXPECT_EQ(last_history_value(h, p + "_z_m"), it->position.z());
+    EXPECT_EQ(last_history_value(h, p + "_vz_m_s"), it->velocity.z());
+  }
+  EXPECT_GT(last_history_value(dir / "out" / "history.csv", "viscous_dissipation_J"), 0.0);
+  text.replace(text.find("track_ids = [7, 200]"), 20, "track_ids = [7, 240]");
+  write_text(dir / "bad.toml", text);
+  std::string err;
+  EXPECT_EQ(run("simulate " + (dir / "bad.toml").string() + " -q -o " + (dir / "o").string(), &err),
+            2);
+  EXPECT_NE(err.find("output.track_ids: no particle with this id (240)"), std::string::npos) << err;
+  EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
+}

@@ -1,6 +1,9 @@
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <algorithm>
+#include <filesystem>
 #include <fstream>
 #include <map>
 #include <sstream>
@@ -142,6 +145,68 @@ TEST(Importers, PackingCsvFixture) {
   ASSERT_EQ(f.particles.size(), 8u);
   EXPECT_EQ(f.particles[7].radius, 0.0015);
   EXPECT_NEAR((f.domain.hi - Eigen::Vector3d(0.0045, 0.0045, 0.005)).norm(), 0.0, 1e-15);
+}
+
+// A packing CSV may carry velocities (vx, vy, vz: all three or none).
+TEST(Importers, PackingCsvVelocities) {
+  const auto dir = std::filesystem::temp_directory_path() / ("gs_pv_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "a.csv")
+      << "id,x,y,z,r,vz,vx,vy\n0,0,0,0,0.001,-5,1,2.5\n1,0.01,0,0,0.001,0,0,0\n";
+  const Frame f = read_snapshots(dir / "a.csv").frames.at(0);
+  EXPECT_EQ(f.particles[0].velocity, Eigen::Vector3d(1, 2.5, -5));
+  EXPECT_EQ(f.particles[1].velocity, Eigen::Vector3d::Zero());
+  std::ofstream(dir / "b.csv") << "id,x,y,z,r,vx\n0,0,0,0,0.001,1\n";
+  try {
+    (void)read_snapshots(dir / "b.csv");
+    ADD_FAILURE() << "accepted vx alone";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("give vx, vy and vz, or none"), std::string::npos);
+  }
+  std::filesystem::remove_all(dir);
+}
+
+// DEM8 particle text (Radius[m] PosX[m] PosY[m] PosZ[m], whitespace, CRLF): detected by content,
+// ids in file order; `max_particles` stops before a trailing row that is not a particle, which
+// is otherwise refused with its line.
+TEST(Importers, Dem8ParticleText) {
+  const auto dir = std::filesystem::temp_directory_path() / ("gs_pt_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const std::string text =
+      "Radius[m]\tPosX[m] PosY[m] PosZ[m]\r\n 0.001 0.1 0.2 0.3\r\n 0.002\t-0.1 0 1e-3\r\n"
+      " 5 0.01 0.01 0 0 0.06\r\n\r\n";
+  std::ofstream(dir / "bed.txt") << text;
+  ImportOptions o;
+  o.max_particles = 2;
+  const Frame f = read_snapshots(dir / "bed.txt", o).frames.at(0);
+  ASSERT_EQ(f.particles.size(), 2u);
+  EXPECT_EQ(f.particles[1].id, 1);
+  EXPECT_EQ(f.particles[1].radius, 0.002);
+  EXPECT_EQ(f.particles[1].position, Eigen::Vector3d(-0.1, 0, 1e-3));
+  EXPECT_EQ(f.particles[0].position, Eigen::Vector3d(0.1, 0.2, 0.3));
+  try {
+    (void)read_snapshots(dir / "bed.txt");
+    ADD_FAILURE() << "accepted the 6-field row";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()),
+              (dir / "bed.txt").string() + ": line 4: expected 4 fields (6)");
+  }
+  std::ofstream(dir / "nohead.txt") << "Radius[m] PosX[m] PosY[m]\n0.001 0 0\n";
+  try {
+    (void)read_snapshots(dir / "nohead.txt");
+    ADD_FAILURE() << "accepted a header without PosZ";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("missing column in header (PosZ)"), std::string::npos);
+  }
+  const auto shared = std::filesystem::path(GS_SOURCE_DIR) / ".." / "shared" / "dem8";
+  if (std::filesystem::exists(shared / "case3_penetration" / "25KParticles.txt")) {
+    o.max_particles = 25000;
+    const Frame bed =
+        read_snapshots(shared / "case3_penetration" / "25KParticles.txt", o).frames.at(0);
+    EXPECT_EQ(bed.particles.size(), 25000u);
+    for (const auto& p : bed.particles) EXPECT_EQ(p.radius, 0.001);
+  }
+  std::filesystem::remove_all(dir);
 }
 
 TEST(TextParse, StrictNumbers) {

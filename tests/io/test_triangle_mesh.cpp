@@ -198,6 +198,52 @@ TEST(TriangleMesh, ObjCubeAndScale) {
   EXPECT_EQ(read_mesh(dir / "CUBE.STL").triangles.size(), 12u);
 }
 
+// The DEM8 wall format (header of nine column names, nine numbers per triangle line, CRLF):
+// the same cube, one group "mesh"; read_mesh picks it by the .txt extension. Bad input: a
+// missing header, a short row, a zero-area triangle, each one line naming file and line.
+TEST(TriangleMesh, TriangleTextCubeAndErrors) {
+  ScratchDir dir("tmesh_txt");
+  std::ostringstream o;
+  o << "vertex1_X[m]\tvertex1_Y[m]\tvertex1_Z[m]\tvertex2_X[m]\tvertex2_Y[m]\tvertex2_Z[m]\t"
+       "vertex3_X[m]\tvertex3_Y[m]\tvertex3_Z[m]\r\n";
+  o.precision(17);
+  for (const auto& t : cube_triangles()) {
+    for (int k = 0; k < 3; ++k) o << t[k].x() << " " << t[k].y() << "\t" << t[k].z() << " ";
+    o << "\r\n";
+  }
+  write_file(dir / "cube.txt", o.str());
+  expect_unit_cube(read_triangle_text(dir / "cube.txt"), false);
+  const TriangleMesh twice = read_mesh(dir / "cube.txt", 2.0);
+  EXPECT_EQ(twice.vertices[twice.triangles[3][1]], cube_triangles()[3][1] * 2.0);
+  const std::string h =
+      "vertex1_X[m] vertex1_Y[m] vertex1_Z[m] vertex2_X[m] vertex2_Y[m] vertex2_Z[m] "
+      "vertex3_X[m] vertex3_Y[m] vertex3_Z[m]\n";
+  auto err = [&](const std::string& name, const std::string& text) {
+    write_file(dir / name, text);
+    return error_of([&] { (void)read_triangle_text(dir / name); });
+  };
+  const std::string f = (dir / "a.txt").string();
+  EXPECT_EQ(err("a.txt", "0 0 0 1 0 0 0 1 0\n"),
+            f + ": line 1: expected the header vertex1_X[m] ... vertex3_Z[m] (0)");
+  EXPECT_EQ(err("a.txt", h + "0 0 0 1 0 0 0 1\n"), f + ": line 2: expected 9 numbers (8 given)");
+  EXPECT_EQ(err("a.txt", h + "0 0 0 1 0 0 1 0 0\n"),
+            f + ": line 2: triangle 0 has zero area (0 0 0 | 1 0 0 | 1 0 0)");
+  EXPECT_EQ(err("a.txt", h), f + ": no triangles");
+  EXPECT_EQ(err("a.txt", h + "0 0 0 1 0 0 0 x 0\n").substr(0, f.size() + 8), f + ": line 2");
+}
+
+// The DEM8 benchmark's wall files (../shared/dem8; skipped without them): the triangle counts
+// their README gives, finite, no zero-area triangle (the reader would refuse one).
+TEST(TriangleMesh, Dem8WallFiles) {
+  const fs::path d = fs::path(GS_SOURCE_DIR) / ".." / "shared" / "dem8";
+  if (!fs::exists(d / "case3_penetration" / "walls.txt"))
+    GTEST_SKIP() << "DEM8 inputs absent: " << d.string();
+  EXPECT_EQ(read_mesh(d / "case3_penetration" / "walls.txt").triangles.size(), 56u);
+  EXPECT_EQ(read_mesh(d / "case2_drum" / "walls.txt").triangles.size(), 1200u);
+  EXPECT_EQ(read_mesh(d / "case1_silo" / "walls_large_orifice.txt").triangles.size(), 7632u);
+  EXPECT_EQ(read_mesh(d / "case1_silo" / "walls_small_orifice.txt").triangles.size(), 8636u);
+}
+
 // write_stl_ascii then read_stl: every corner bit-identical (17 significant digits), groups and
 // their order kept, the written facet normals equal triangle_normal to the bit, and no temporary
 // file left beside the output.
@@ -389,7 +435,7 @@ TEST(TriangleMesh, BadInputErrors) {
     const fs::path p = dir / "cube.ply";
     write_file(p, "ply\n");
     EXPECT_EQ(error_of([&] { (void)read_mesh(p); }),
-              p.string() + ": unknown mesh format (expected .stl or .obj) (.ply)");
+              p.string() + ": unknown mesh format (expected .stl, .obj or .txt) (.ply)");
     const fs::path missing = dir / "missing.stl";
     EXPECT_EQ(error_of([&] { (void)read_mesh(missing); }), missing.string() + ": no such file");
   }
