@@ -24,7 +24,8 @@ def _ids(path, i):
         return f["particles/id"][b:int(end[i][0])]
 
 
-def make(path, out_dir, args):
+def reference_frame(path, args):
+    """(frames in the trajectory, the reference frame: --frame, default the first)."""
     with h5py.File(path, "r", swmr=True) as f:
         n = len(f["frames/end"])
     if n == 0:
@@ -32,6 +33,11 @@ def make(path, out_dir, args):
     ref = args.frame if args.frame >= 0 else 0
     if ref >= n:
         raise ValueError(f"no such frame ({ref} of {n})")
+    return n, ref
+
+
+def make(path, out_dir, args):
+    n, ref = reference_frame(path, args)
     _, t0, pos0, _ = load_frame(path, ref)
     if len(pos0) == 0:
         raise ValueError(f"frame {ref} has no particles")

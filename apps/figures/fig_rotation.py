@@ -15,6 +15,7 @@ from matplotlib.collections import EllipseCollection
 
 import figutil
 from figutil import plt
+from fig_layers import reference_frame
 from fig_positions import load_frame
 
 
@@ -29,13 +30,7 @@ def _ids_rotation(path, i):
 
 
 def make(path, out_dir, args):
-    with h5py.File(path, "r", swmr=True) as f:
-        n = len(f["frames/end"])
-    if n == 0:
-        raise ValueError("trajectory holds no frame")
-    ref = args.frame if args.frame >= 0 else 0
-    if ref >= n:
-        raise ValueError(f"no such frame ({ref} of {n})")
+    n, ref = reference_frame(path, args)
     t0 = load_frame(path, ref)[1]
     ids0, rot0 = _ids_rotation(path, ref)
     start = {int(k): float(r) for k, r in zip(ids0, rot0)}

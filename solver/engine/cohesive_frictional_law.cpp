@@ -30,14 +30,8 @@ inline double zero_max(double x) {
 
 template <bool kTwist, bool kPeriodic>
 [[gnu::always_inline]] inline void law_lanes(ContactBatch& batch, int count, double dt) {
-  auto in3 = [&](Batch::Field f, int j) {
-    return V3{batch.v[f][j], batch.v[f + 1][j], batch.v[f + 2][j]};
-  };
-  auto out3 = [&](Batch::Field f, int j, V3 x) {
-    batch.v[f][j] = x.x;
-    batch.v[f + 1][j] = x.y;
-    batch.v[f + 2][j] = x.z;
-  };
+  auto in3 = [&](Batch::Field f, int j) { return batch.get3(f, j); };
+  auto out3 = [&](Batch::Field f, int j, const V3& x) { batch.set3(f, j, x); };
   const double* const r1_ = batch[Batch::R1];
   const double* const r2_ = batch[Batch::R2];
   const double* const ratchet_ = batch[Batch::RATCHET];

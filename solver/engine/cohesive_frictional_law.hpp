@@ -82,6 +82,13 @@ struct ContactBatch {
 
   alignas(64) double v[kFields][kLanes];
   double* operator[](Field f) { return v[f]; }
+  /// The 3-vector whose x component is field f, in lane j (y and z follow it).
+  V3 get3(Field f, int j) const { return {v[f][j], v[f + 1][j], v[f + 2][j]}; }
+  void set3(Field f, int j, const V3& x) {
+    v[f][j] = x.x;
+    v[f + 1][j] = x.y;
+    v[f + 2][j] = x.z;
+  }
 };
 
 /// The geometry of lane j (what both contact laws start from): on GEOM lanes (sphere pairs)
@@ -95,12 +102,8 @@ struct LaneGeometry {
 
 [[gnu::always_inline]] inline LaneGeometry lane_geometry(ContactBatch& b, int j) {
   using F = ContactBatch::Field;
-  auto in3 = [&](F f) { return V3{b.v[f][j], b.v[f + 1][j], b.v[f + 2][j]}; };
-  auto out3 = [&](F f, const V3& x) {
-    b.v[f][j] = x.x;
-    b.v[f + 1][j] = x.y;
-    b.v[f + 2][j] = x.z;
-  };
+  auto in3 = [&](F f) { return b.get3(f, j); };
+  auto out3 = [&](F f, const V3& x) { b.set3(f, j, x); };
   const double r1 = b.v[F::R1][j], r2 = b.v[F::R2][j];
   const bool geom = b.v[F::GEOM][j] != 0;
   const V3 x1 = in3(F::X1X), x2 = in3(F::X2X);

@@ -53,14 +53,8 @@ using Batch = ContactBatch;
 
 template <bool kPeriodic>
 [[gnu::always_inline]] inline void hm_lanes(ContactBatch& batch, int count, double dt) {
-  auto in3 = [&](Batch::Field f, int j) {
-    return V3{batch.v[f][j], batch.v[f + 1][j], batch.v[f + 2][j]};
-  };
-  auto out3 = [&](Batch::Field f, int j, V3 x) {
-    batch.v[f][j] = x.x;
-    batch.v[f + 1][j] = x.y;
-    batch.v[f + 2][j] = x.z;
-  };
+  auto in3 = [&](Batch::Field f, int j) { return batch.get3(f, j); };
+  auto out3 = [&](Batch::Field f, int j, const V3& x) { batch.set3(f, j, x); };
   for (int j = 0; j < count; ++j) {
     const double r1 = batch.v[Batch::R1][j], r2 = batch.v[Batch::R2][j];
     const LaneGeometry g = lane_geometry(batch, j);

@@ -1,0 +1,47 @@
+#!/usr/bin/env bash
+# DEM8 Case 3 (penetration, 25 000 M1 grains + the steel ball, 56-triangle steel box,
+# Hertz-Mindlin, dt 0.5 us; docs/dem8.md) against YADE 2023.02a -j1 running the same case
+# (yade_dem8_impact.py: the benchmark script's engines and materials, the ball placed as in
+# data/scenes/dem8_impact_laptop.toml) for the same STEPS steps (default 4000: the ball's first
+# 2 ms in the bed), in the same script. Particle-steps count the 25 001 spheres. granoscope runs
+# the laptop scene with contact = "yade" (one wall per triangle, as YADE's facets), 1 and 2
+# threads. The ball's height at the end is printed beside each (the same run: they agree to um).
+#   bench/solver/run_dem8_bench.sh [BUILD_DIR]   (needs yade and ../shared/dem8)
+set -euo pipefail
+here=$(cd "$(dirname "$0")" && pwd)
+root=$(cd "$here/../.." && pwd)
+build=${1:-$root/build}
+gs=$build/bin/granoscope
+py=/usr/bin/python3
+d8=$(cd "$root/../shared/dem8" 2>/dev/null && pwd) || { echo "needs ../shared/dem8"; exit 1; }
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+[ -x "$gs" ] || { echo "build first (scripts/build)"; exit 1; }
+steps=${STEPS:-4000}
+sed -e "s#\"../../../shared/dem8/#\"$d8/#" -e 's/^contact = "merged".*/contact = "yade"/' \
+  -e "s/^steps = .*/steps = $steps/" -e "s/^checkpoint_every = .*/checkpoint_every = 100000000/" \
+  -e "s/^every = .*/every = 100000000/" "$root/data/scenes/dem8_impact_laptop.toml" > "$work/impact.toml"
+for t in 1 2; do
+  "$gs" simulate "$work/impact.toml" --threads $t -q -o "$work/run$t" > "$work/gs$t.txt"
+done
+yade -n -x -j1 "$here/yade_dem8_impact.py" "$d8/case3_penetration/25KParticles.txt" \
+  "$d8/case3_penetration/walls.txt" 25000 -0.0455 5.202875166674672 "$($py -c "print($steps*5e-7)")" \
+  "$work/yade_ball.csv" > "$work/yade.txt" 2>&1
+"$py" - "$work" "$steps" <<'PY'
+import csv, re, sys
+work, steps = sys.argv[1], int(sys.argv[2])
+n = 25001
+yt = float(re.search(r"wall time ([0-9.]+)", open(work + "/yade.txt").read()).group(1))
+yz = float(list(csv.DictReader(open(work + "/yade_ball.csv")))[-1]["z_m"])
+rows = [("YADE 2023.02a -j1", yt, yz)]
+for t in (1, 2):
+    out = open("%s/gs%d.txt" % (work, t)).read()
+    s = float(re.search(r"steps of \d+ particles in ([0-9.]+) s", out).group(1))
+    z = float(list(csv.DictReader(open("%s/run%d/history.csv" % (work, t))))[-1]["p25000_z_m"])
+    rows.append(("granoscope, %d thread%s" % (t, "s" if t > 1 else ""), s, z))
+print("DEM8 Case 3, 25 000 grains + ball, %d steps of 0.5 us:" % steps)
+print("  %-26s %8s %16s %7s %14s" % ("run", "time s", "particle-steps/s", "ratio", "ball z (m)"))
+base = n * steps / rows[0][1]
+for name, t, z in rows:
+    print("  %-26s %8.2f %16.3g %6.1fx %14.7f" % (name, t, n * steps / t, n * steps / t / base, z))
+PY
