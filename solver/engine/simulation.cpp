@@ -1066,9 +1066,16 @@ void Simulation::step() {
         const Eigen::Matrix3d r = 0.5 * (field_.d_vel_grad - field_.d_vel_grad.transpose());
         field_.d_spin = Eigen::Vector3d(-r(1, 2), r(0, 2), -r(0, 1));
       }
-      // (a wall not in moving_walls_ has a zero velocity: its term is ±0)
-      for (const std::uint32_t w : moving_walls_)
-        ledger_.wall_work += -walls_[w].force.dot(walls_[w].vel) * dt;
+      // (a wall not in moving_walls_ has a zero velocity: its term is ±0). The power a wall
+      // gives the particles: −(F·v + T·ω), F and T the loads on it, T about its position, v that
+      // position's velocity (a mesh turns about its rotation centre); ω = 0 adds an exact 0.
+      for (const std::uint32_t w : moving_walls_) {
+        const WallState& ws = walls_[w];
+        const Eigen::Vector3d& om = ws.spec.angular_velocity;
+        Eigen::Vector3d v = ws.vel;
+        if (ws.spec.shape == WallShape::Facets) v += om.cross(ws.pos - ws.rot_center);
+        ledger_.wall_work += -(ws.force.dot(v) + ws.torque.dot(om)) * dt;
+      }
     }  // (implicit barrier: servo velocities and the work terms use this step's loads)
 
     // Integration, with the work of gravity and of applied loads over this step (velocities of
