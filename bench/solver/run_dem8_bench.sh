@@ -5,8 +5,10 @@
 # data/scenes/dem8_impact_laptop.toml) for the same STEPS steps (default 4000: the ball's first
 # 2 ms in the bed), in the same script. Particle-steps count the 25 001 spheres. granoscope runs
 # the laptop scene with contact = "yade" (one wall per triangle, as YADE's facets), 1 and 2
-# threads. The ball's height at the end is printed beside each (the same run: they agree to um).
-#   bench/solver/run_dem8_bench.sh [BUILD_DIR]   (needs yade and ../shared/dem8)
+# threads, and LIGGGHTS 3.8 (liggghts_dem8_impact.py: `gran model hertz`, the same materials,
+# the box as an STL; its Hertz damping is its own) when installed. The ball's height at the end
+# is printed beside each (the same run: YADE and granoscope agree to um).
+#   bench/solver/run_dem8_bench.sh [BUILD_DIR]   (needs yade, optionally liggghts, and ../shared/dem8)
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
 root=$(cd "$here/../.." && pwd)
@@ -24,6 +26,11 @@ sed -e "s#\"../../../shared/dem8/#\"$d8/#" -e 's/^contact = "merged".*/contact =
 for t in 1 2; do
   "$gs" simulate "$work/impact.toml" --threads $t -q -o "$work/run$t" > "$work/gs$t.txt"
 done
+if command -v liggghts > /dev/null; then
+  "$py" "$here/liggghts_dem8_impact.py" "$d8/case3_penetration/25KParticles.txt" \
+    "$d8/case3_penetration/walls.txt" 25000 -0.0455 5.202875166674672 "$steps" 1000 "$work/lig"
+  (cd "$work/lig" && liggghts -in in.impact > log.txt 2>&1)
+fi
 yade -n -x -j1 "$here/yade_dem8_impact.py" "$d8/case3_penetration/25KParticles.txt" \
   "$d8/case3_penetration/walls.txt" 25000 -0.0455 5.202875166674672 "$($py -c "print($steps*5e-7)")" \
   "$work/yade_ball.csv" > "$work/yade.txt" 2>&1
@@ -34,6 +41,12 @@ n = 25001
 yt = float(re.search(r"wall time ([0-9.]+)", open(work + "/yade.txt").read()).group(1))
 yz = float(list(csv.DictReader(open(work + "/yade_ball.csv")))[-1]["z_m"])
 rows = [("YADE 2023.02a -j1", yt, yz)]
+import os
+if os.path.exists(work + "/lig/log.txt"):
+    log = open(work + "/lig/log.txt").read()
+    lt = float(re.findall(r"Loop time of ([0-9.e+-]+) on 1 procs for %d steps" % steps, log)[-1])
+    lz = float(re.findall(r"^\s+%d\s+\d+\s+\S+\s+(\S+)\s*$" % (steps + 1), log, re.M)[-1])
+    rows.append(("LIGGGHTS 3.8, 1 process", lt, lz))
 for t in (1, 2):
     out = open("%s/gs%d.txt" % (work, t)).read()
     s = float(re.search(r"steps of \d+ particles in ([0-9.]+) s", out).group(1))

@@ -59,6 +59,5 @@ record()
 O.engines = O.engines + [PyRunner(iterPeriod=100, command="record()")]
 t0 = time.time()
 O.run(int(round(t_end / O.dt)), True)
-if O.iter % 100:
-    record()  # (the recorder ran before the last step: record the end)
+record()  # the end (the recorder runs before each hundredth step, so it last saw step N - 100)
 print("steps", O.iter, "particles", len(rows) + 1, "wall time", time.time() - t0)
