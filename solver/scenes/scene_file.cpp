@@ -1432,13 +1432,19 @@ Scene load_scene(const std::filesystem::path& path, int sweep_point) {
     if (s.config.law == ContactLaw::HertzMindlin && (!s.clumps.empty() || s.clump_replace))
       r.fail("material.law", "the Hertz-Mindlin law does not take clumps yet", "hertz_mindlin");
     if (s.config.law == ContactLaw::HertzMindlin && !all.empty()) {
-      double dt_r = rayleigh_timestep(all, m.density, m.young_ec, m.poisson);
+      // Each material's Rayleigh step from its own smallest sphere (YADE's RayleighWaveTimeStep
+      // takes each body's own material); a generated specimen is of the scene's material.
+      std::vector<double> rmin(1 + s.config.more_materials.size(), HUGE_VAL);
       for (const auto& p : s.particles) {
-        const Material& pm =
-            p.material_id <= 0
-                ? m
-                : s.config.more_materials[static_cast<std::size_t>(p.material_id - 1)];
-        dt_r = std::min(dt_r, rayleigh_timestep({p.radius}, pm.density, pm.young_ec, pm.poisson));
+        auto& x = rmin[static_cast<std::size_t>(std::max(p.material_id, 0))];
+        x = std::min(x, p.radius);
+      }
+      if (s.specimen) rmin[0] = std::min(rmin[0], 0.5 * s.specimen->sizes.dmin_m);
+      double dt_r = HUGE_VAL;
+      for (std::size_t i = 0; i < rmin.size(); ++i) {
+        if (rmin[i] == HUGE_VAL) continue;
+        const Material& pm = i == 0 ? m : s.config.more_materials[i - 1];
+        dt_r = std::min(dt_r, rayleigh_timestep({rmin[i]}, pm.density, pm.young_ec, pm.poisson));
       }
       if (s.config.dt > dt_r)
         r.fail("solver.dt_s", "above the Hertz critical (Rayleigh) step " + value_str(dt_r) + " s",

@@ -201,6 +201,51 @@ TEST(HertzMindlin, SceneRejectsBadParameters) {
   std::filesystem::remove_all(dir);
 }
 
+// The Hertz step limit is each material's own Rayleigh step at its own smallest sphere: a stiff
+// default material that only the walls use does not limit the grains' step (it did: the check
+// took the default material for every radius), and the soft grains' step is the exact bound.
+TEST(HertzMindlin, RayleighStepPerMaterial) {
+  const auto dir =
+      std::filesystem::temp_directory_path() / ("gs_hertz_dt_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  std::filesystem::copy_file(kData / "yade_hertz" / "packing.csv", dir / "packing.csv",
+                             std::filesystem::copy_options::overwrite_existing);
+  std::string s = text::read_text_file(kData / "yade_hertz" / "scene.toml");
+  auto replace = [&](const std::string& from, const std::string& to) {
+    const auto at = s.find(from);
+    ASSERT_NE(at, std::string::npos) << from;
+    s.replace(at, from.size(), to);
+  };
+  // The default material becomes steel (walls); the grains are a soft material by radius.
+  replace("young_Pa = 5.0e7", "young_Pa = 2.1e11");
+  replace("density_kg_m3 = 2600.0", "density_kg_m3 = 7800.0");
+  replace("[solver]",
+          "[[materials]]\nname = \"grain\"\nyoung_Pa = 5.0e7\n"
+          "poisson = 0.3\nrestitution = 0.6\nfriction_deg = 20.0\ndensity_kg_m3 = 2600.0\n"
+          "radius_range_m = [0.001, 0.0014]\n[[material_pairs]]\n"
+          "materials = [\"default\", \"grain\"]\nrestitution = 0.5\n[solver]");
+  const double rmin = 0.0010006965527670014;  // the packing's smallest sphere
+  const double grain = rayleigh_timestep({rmin}, 2600, 5e7, 0.3);
+  const double steel = rayleigh_timestep({rmin}, 7800, 2.1e11, 0.3);
+  ASSERT_LT(steel, 7.8936472294602601e-06);  // the old check refused the scene's step
+  std::ofstream(dir / "scene.toml") << s;
+  const Scene ok = load_scene(dir / "scene.toml");
+  EXPECT_EQ(ok.config.dt, 7.8936472294602601e-06);
+  replace("dt_s = 7.8936472294602601e-06", "dt_s = 4e-5");
+  ASSERT_GT(4e-5, grain);
+  std::ofstream(dir / "scene.toml") << s;
+  try {
+    (void)load_scene(dir / "scene.toml");
+    ADD_FAILURE() << "accepted dt = 4e-5 above the grains' Rayleigh step " << grain;
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("solver.dt_s: above the Hertz critical (Rayleigh) step " +
+                                         value_str(grain) + " s (4.0000000000000003e-05)"),
+              std::string::npos)
+        << e.what();
+  }
+  std::filesystem::remove_all(dir);
+}
+
 // Several materials: the particles of the radius range are "heavy" (density, restitution and
 // friction from the tables), the walls name theirs; a pair's friction defaults to the smaller
 // angle; the trajectory records each particle's material.
