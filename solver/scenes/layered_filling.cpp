@@ -1,6 +1,7 @@
 #include "layered_filling.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <random>
 #include <unordered_map>
@@ -38,7 +39,7 @@ FillParticles fill_particles(const FillSpec& spec, std::int64_t first_id) {
 std::vector<Eigen::Vector3d> place_in_region(const Simulation& sim,
                                              const std::vector<double>& radii,
                                              const Eigen::Vector3d& lo, const Eigen::Vector3d& hi,
-                                             std::uint64_t seed, int max_attempts) {
+                                             std::uint64_t seed, int max_attempts, bool lattice) {
   std::vector<Eigen::Vector3d> out;
   if (radii.empty()) return out;
   const ParticleState& p = sim.particles();
@@ -107,27 +108,68 @@ std::vector<Eigen::Vector3d> place_in_region(const Simulation& sim,
     return true;
   };
   std::mt19937_64 rng(seed);
+  auto free_of_particles = [&](const Eigen::Vector3d& x, double r) {
+    for (int dz = -1; dz <= 1; ++dz)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) {
+          const auto it = grid.find(key(x, dx, dy, dz));
+          if (it == grid.end()) continue;
+          for (const auto j : it->second) {
+            const double s = r + radius[j];
+            if ((centre[j] - x).squaredNorm() < s * s) return false;
+          }
+        }
+    return true;
+  };
+  if (lattice) {
+    // Sites of a simple cubic lattice, spacing a = 1.05 · 2 r_max, ordered from the bottom up
+    // (along gravity; x then y within a level when gravity is along z).
+    const double rl = *std::max_element(radii.begin(), radii.end());
+    const double a = 1.05 * 2 * rl, jitter = 0.01 * 2 * rl;
+    std::array<std::int64_t, 3> n{};
+    for (int k = 0; k < 3; ++k) {
+      const double span = hi[k] - lo[k] - 2 * rl;
+      if (span < 0) return out;
+      n[static_cast<std::size_t>(k)] = static_cast<std::int64_t>(std::floor(span / a)) + 1;
+    }
+    const Eigen::Vector3d g = sim.config().gravity;
+    int up = 2;  // the axis most along gravity is the slowest index, walked against gravity
+    for (int k = 0; k < 3; ++k)
+      if (std::abs(g[k]) > std::abs(g[up])) up = k;
+    const int u = (up + 1) % 3, v = (up + 2) % 3;
+    const auto nu = static_cast<std::size_t>(up), nuu = static_cast<std::size_t>(u),
+               nvv = static_cast<std::size_t>(v);
+    const std::int64_t sites = n[nu] * n[nuu] * n[nvv];
+    std::int64_t next = 0;
+    for (const double r : radii) {
+      bool placed = false;
+      while (!placed && next < sites) {
+        const std::int64_t s = next++;
+        std::int64_t level = s / (n[nuu] * n[nvv]);
+        if (g[up] > 0) level = n[nu] - 1 - level;  // gravity along +axis: fill from the top
+        const std::int64_t iv = (s / n[nuu]) % n[nvv], iu = s % n[nuu];
+        Eigen::Vector3d x;
+        x[up] = lo[up] + rl + static_cast<double>(level) * a;
+        x[u] = lo[u] + rl + static_cast<double>(iu) * a;
+        x[v] = lo[v] + rl + static_cast<double>(iv) * a;
+        for (int k = 0; k < 3; ++k)
+          x[k] = std::clamp(x[k] + jitter * (2 * uniform01(rng) - 1), lo[k] + r, hi[k] - r);
+        if (!free_of_particles(x, r) || !clear_of_walls(x, r)) continue;
+        add(x, r);
+        out.push_back(x);
+        placed = true;
+      }
+      if (!placed) break;
+    }
+    return out;
+  }
   for (const double r : radii) {
     if (((hi - lo).array() < 2 * r).any()) return out;
     bool placed = false;
     for (int attempt = 0; attempt < max_attempts && !placed; ++attempt) {
       Eigen::Vector3d x;
       for (int k = 0; k < 3; ++k) x[k] = lo[k] + r + uniform01(rng) * (hi[k] - lo[k] - 2 * r);
-      bool free = true;
-      for (int dz = -1; dz <= 1 && free; ++dz)
-        for (int dy = -1; dy <= 1 && free; ++dy)
-          for (int dx = -1; dx <= 1 && free; ++dx) {
-            const auto it = grid.find(key(x, dx, dy, dz));
-            if (it == grid.end()) continue;
-            for (const auto j : it->second) {
-              const double s = r + radius[j];
-              if ((centre[j] - x).squaredNorm() < s * s) {
-                free = false;
-                break;
-              }
-            }
-          }
-      if (!free || !clear_of_walls(x, r)) continue;
+      if (!free_of_particles(x, r) || !clear_of_walls(x, r)) continue;
       add(x, r);
       out.push_back(x);
       placed = true;
@@ -169,9 +211,9 @@ void LayeredFilling::insert_layer(Simulation& sim) {
   std::vector<double> radii;
   for (const auto k : layer) radii.push_back(sim.particles().radius[first_ + k]);
   // One seed per layer: the placement depends only on the state (bit-exact resume).
-  const auto x =
-      place_in_region(sim, radii, spec_.region_lo_m, spec_.region_hi_m,
-                      spec_.seed + 0x9e3779b97f4a7c15ull * (inserted_ + 1), spec_.max_attempts);
+  const auto x = place_in_region(sim, radii, spec_.region_lo_m, spec_.region_hi_m,
+                                 spec_.seed + 0x9e3779b97f4a7c15ull * (inserted_ + 1),
+                                 spec_.max_attempts, spec_.lattice);
   if (x.size() < layer.size())
     throw FillError("fill: layer " + std::to_string(inserted_ + 1) + " of " +
                     std::to_string(layers_.size()) + ": the region took " +
@@ -192,6 +234,8 @@ void LayeredFilling::start(Simulation& sim) {
   done_ = false;
   material_friction_deg_ = sim.config().material.friction_deg;
   if (spec_.friction_deg >= 0) sim.set_friction_deg(spec_.friction_deg);
+  solver_damping_ = sim.config().damping;
+  if (spec_.damping >= 0) sim.set_damping(spec_.damping);
   insert_layer(sim);
 }
 
@@ -221,6 +265,7 @@ void LayeredFilling::control(Simulation& sim) {
   }
   for (const std::size_t w : open_walls_) sim.set_wall_active(w, false);
   if (spec_.friction_deg >= 0) sim.set_friction_deg(material_friction_deg_);
+  if (spec_.damping >= 0) sim.set_damping(solver_damping_);
   done_ = true;
 }
 
@@ -246,6 +291,7 @@ std::string LayeredFilling::save_state() const {
   st.set("last_insert_step", last_insert_step_);
   st.set("done", static_cast<std::int64_t>(done_));
   st.set("material_friction_deg", material_friction_deg_);
+  st.set("solver_damping", solver_damping_);
   st.set("moved", static_cast<std::int64_t>(moved_));
   return st.text();
 }
@@ -257,6 +303,7 @@ void LayeredFilling::load_state(const std::string& state) {
   done_ = st.integer("done") != 0;
   material_friction_deg_ = st.has("material_friction_deg") ? st.number("material_friction_deg")
                                                            : -1.0;  // (older checkpoints)
+  solver_damping_ = st.has("solver_damping") ? st.number("solver_damping") : 0.0;
   moved_ = st.has("moved") ? st.integer("moved") != 0 : true;
 }
 

@@ -752,7 +752,8 @@ void read_fill(const Reader& r, Scene& s) {
     r.fail("[fill]", "a laboratory test makes its own specimen; remove [fill]");
   r.only(t, "fill",
          {"region_lo_m", "region_hi_m", "layers", "count", "dmin_m", "dmax_m", "distribution",
-          "seed", "kinetic_ratio", "min_steps", "max_steps", "max_attempts", "friction_deg"});
+          "seed", "kinetic_ratio", "min_steps", "max_steps", "max_attempts", "friction_deg",
+          "damping", "placement"});
   FillSpec f;
   f.region_lo_m = r.vec3(t, "fill", "region_lo_m", true, {});
   f.region_hi_m = r.vec3(t, "fill", "region_hi_m", true, {});
@@ -778,6 +779,13 @@ void read_fill(const Reader& r, Scene& s) {
   f.friction_deg = r.number(t, "fill", "friction_deg", false, -1);
   if (!(f.friction_deg < 90))
     r.fail("fill.friction_deg", "must be below 90", value_str(f.friction_deg));
+  f.damping = r.number(t, "fill", "damping", false, -1);
+  if (t->contains("damping") && !(f.damping >= 0 && f.damping < 1))
+    r.fail("fill.damping", "outside [0, 1)", value_str(f.damping));
+  const std::string placement = r.string(t, "fill", "placement", false, "random");
+  if (placement != "random" && placement != "lattice")
+    r.fail("fill.placement", "expected \"random\" or \"lattice\"", placement);
+  f.lattice = placement == "lattice";
   if (!(s.config.gravity.norm() > 0)) r.fail("solver.gravity_m_s2", "[fill] needs gravity");
   std::int64_t next_id = 0;
   for (const auto& p : s.particles) next_id = std::max(next_id, p.id + 1);
@@ -794,7 +802,7 @@ void read_fill(const Reader& r, Scene& s) {
     std::vector<double> radii;
     for (const auto k : fp.layers[0]) radii.push_back(fp.particles[k].radius);
     const auto placed = place_in_region(probe, radii, f.region_lo_m, f.region_hi_m,
-                                        f.seed + 0x9e3779b97f4a7c15ull, f.max_attempts);
+                                        f.seed + 0x9e3779b97f4a7c15ull, f.max_attempts, f.lattice);
     if (placed.size() < radii.size())
       r.fail("fill.region_hi_m",
              "the region takes " + std::to_string(placed.size()) + " of the " +
@@ -1217,7 +1225,8 @@ Scene load_scene(const std::filesystem::path& path, int sweep_point) {
       if (!w) r.fail(sec, "expected a table");
       r.only(w, sec,
              {"name", "shape", "center_m", "half_extents_m", "point_m", "normal",
-              "angular_velocity_rad_s", "velocity_m_s", "servo", "friction_deg", "material"});
+              "angular_velocity_rad_s", "velocity_m_s", "servo", "friction_deg", "material",
+              "off_at_s", "off_after_fill"});
       WallSpec spec;
       spec.name = r.string(w, sec, "name", false, "wall" + std::to_string(i));
       const std::string shape = r.string(w, sec, "shape", true, "");
@@ -1249,6 +1258,15 @@ Scene load_scene(const std::filesystem::path& path, int sweep_point) {
         spec.servo_gain = r.positive(servo, ss, "gain_m_s_per_Pa", true, 0);
         spec.servo_max_velocity = r.positive(servo, ss, "max_velocity_m_s", true, 0);
         if (spec.shape == WallShape::Box) spec.normal = r.vec3(servo, ss, "axis", true, {});
+      }
+      // Switched off at a time or when the [fill] has settled (a lid under an outlet).
+      spec.off_at_s = r.number(w, sec, "off_at_s", false, HUGE_VAL);
+      if (!(spec.off_at_s >= 0))
+        r.fail(sec + ".off_at_s", "must be >= 0", value_str(spec.off_at_s));
+      if (w->contains("off_after_fill")) {
+        const auto* v = (*w)["off_after_fill"].as_boolean();
+        if (!v) r.fail(sec + ".off_after_fill", "expected true or false");
+        if (v->get()) s.open_after_fill.push_back(s.walls.size());
       }
       s.walls.push_back(spec);
     }
@@ -1451,8 +1469,7 @@ Scene load_scene(const std::filesystem::path& path, int sweep_point) {
                value_str(s.config.dt));
     }
   }
-  if (!s.open_after_fill.empty() && !s.fill)
-    r.fail("[[mesh]].off_after_fill", "there is no [fill] section");
+  if (!s.open_after_fill.empty() && !s.fill) r.fail("off_after_fill", "there is no [fill] section");
   // (The particles of a [fill] are placed later, layer by layer.)
   check_distinct_centres(
       r, {s.particles.begin(), s.particles.begin() + (s.fill ? s.fill_first : s.particles.size())});

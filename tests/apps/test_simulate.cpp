@@ -539,6 +539,65 @@ keep_hi_m = [1.0, 1.0, 1.0]
               1e-12 * mass);
 }
 
+// A lattice-placed fill held by a lid that is a plain box wall, switched off when the fill has
+// settled: every sphere was inserted at once (one layer, the first frame holds all 60) and all
+// of them leave through the outlet under the lid.
+TEST(Simulate, LatticeFillUnderALidWallThenDischarge) {
+  gs::test::ScratchDir dir("sim_fill_lid");
+  std::string walls;
+  for (const char* w : {"point_m = [0.0, 0.0, 0.0]\nnormal = [1.0, 0.0, 0.0]",
+                        "point_m = [0.01, 0.0, 0.0]\nnormal = [-1.0, 0.0, 0.0]",
+                        "point_m = [0.0, 0.0, 0.0]\nnormal = [0.0, 1.0, 0.0]",
+                        "point_m = [0.0, 0.01, 0.0]\nnormal = [0.0, -1.0, 0.0]"})
+    walls += std::string("[[walls]]\nshape = \"plane\"\n") + w + "\n";
+  write_text(dir / "scene.toml", R"([scene]
+name = "lid"
+[material]
+young_Pa = 1.0e6
+stiffness_ratio = 0.3
+friction_deg = 25.0
+density_kg_m3 = 2550.0
+[solver]
+dt_s = 1.0e-5
+damping = 0.0
+gravity_m_s2 = [0.0, 0.0, -9.81]
+steps = 20000
+[output]
+trajectory = "lid.h5"
+every = 1000
+history_every = 1000
+checkpoint_every = 100000
+[[walls]]
+name = "lid"
+shape = "box"
+center_m = [0.005, 0.005, -0.001]
+half_extents_m = [0.006, 0.006, 0.001]
+off_after_fill = true
+[fill]
+region_lo_m = [0.0, 0.0, 0.002]
+region_hi_m = [0.01, 0.01, 0.012]
+layers = 1
+count = 60
+dmin_m = 0.0015
+dmax_m = 0.0015
+placement = "lattice"
+damping = 0.3
+[outlet]
+keep_lo_m = [-1.0, -1.0, -0.02]
+keep_hi_m = [1.0, 1.0, 1.0]
+)" + walls);
+  std::string err;
+  ASSERT_EQ(
+      run("simulate " + (dir / "scene.toml").string() + " -q -o " + (dir / "out").string(), &err),
+      0)
+      << err;
+  const auto t = gs::read_hdf5_trajectory(dir / "out" / "lid.h5");
+  ASSERT_GE(t.frames.size(), 3u);
+  EXPECT_EQ(t.frames.front().particles.size(), 60u);
+  EXPECT_EQ(t.frames.back().particles.size(), 0u);
+  EXPECT_EQ(last_history_value(dir / "out" / "history.csv", "removed"), 60.0);
+}
+
 // A [fill] whose region cannot take a layer: one line saying how many fitted, exit 2.
 TEST(Simulate, FillRegionTooSmallSaysHowManyFitted) {
   gs::test::ScratchDir dir("sim_fill_bad");
@@ -558,7 +617,16 @@ TEST(Simulate, FillRegionTooSmallSaysHowManyFitted) {
        "dmin_m = 0.001\ndmax_m = 0.001\n",
        "fill.region_hi_m: must exceed region_lo_m"},
       {fill + "count = 4\n[[mesh]]\nfile = \"floor.stl\"\noff_after_fill = 1\n",
-       "mesh[0].off_after_fill: expected true or false"}};
+       "mesh[0].off_after_fill: expected true or false"},
+      {fill + "count = 4\nplacement = \"grid\"\n",
+       "fill.placement: expected \"random\" or \"lattice\" (grid)"},
+      {fill + "count = 4\ndamping = 1.0\n", "fill.damping: outside [0, 1) (1)"},
+      {fill + "count = 4\n[[walls]]\nshape = \"plane\"\npoint_m = [0.0, 0.0, 0.0]\n"
+              "normal = [0.0, 0.0, 1.0]\noff_after_fill = \"yes\"\n",
+       "walls[0].off_after_fill: expected true or false"},
+      {fill + "count = 4\n[[walls]]\nshape = \"plane\"\npoint_m = [0.0, 0.0, 0.0]\n"
+              "normal = [0.0, 0.0, 1.0]\noff_at_s = -0.5\n",
+       "walls[0].off_at_s: must be >= 0 (-0.5)"}};
   expect_one_line_errors(dir.path, base, cases);
 }
 
@@ -642,7 +710,7 @@ TEST(Simulate, BadMeshMotionNamesTheKey) {
        "0.1, axis = [0.0, 0.0, 0.0] }\n",
        "mesh[0].servo.axis: must not be zero"},
       {"angular_velocity_rad_s = [0.0, 1.0]\n", "mesh[0].angular_velocity_rad_s"},
-      {"off_after_fill = true\n", "[[mesh]].off_after_fill: there is no [fill] section"},
+      {"off_after_fill = true\n", ": off_after_fill: there is no [fill] section"},
       {"[output]\nfacet_forces = \"yes\"\n", "output.facet_forces: expected true or false"}};
   expect_one_line_errors(dir.path, base, cases);
 }

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <map>
 
 #include "layered_filling.hpp"
 #include "mesh_walls.hpp"
@@ -227,4 +228,76 @@ TEST(LayeredFilling, PlacementKeepsClearOfMeshFacets) {
   EXPECT_GT(above, 20);
   EXPECT_LT(above, 180);
   EXPECT_GE(closest, 0.5e-3);
+}
+
+// Lattice placement: sites of spacing 1.05·d from the bottom up, each jittered by at most
+// ±1 % of d per axis. A 10 mm cube takes floor((10 − 1)/1.05) + 1 = 9 sites per axis (729);
+// 200 spheres fill the two lowest levels (81 each) and 38 of the third; none overlaps another
+// (the closest pair is at least 0.05·d − 2·0.01·d apart); 800 asked for, 729 fit.
+TEST(LayeredFilling, LatticePlacementFillsFromTheBottomUp) {
+  solver::Simulation sim(config(), {}, {});
+  const double r = 0.5e-3, d = 2 * r, a = 1.05 * d;
+  const Eigen::Vector3d lo(0, 0, 0.01), hi(0.01, 0.01, 0.02);
+  const auto x = solver::place_in_region(sim, std::vector<double>(200, r), lo, hi, 3, 1, true);
+  ASSERT_EQ(x.size(), 200u);
+  std::map<long, int> per_level;
+  double closest = HUGE_VAL;
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    const double level = (x[i].z() - lo.z() - r) / a;
+    EXPECT_NEAR(level, std::round(level), 0.01 * d / a + 1e-12) << i;
+    ++per_level[std::lround(level)];
+    EXPECT_TRUE((x[i].array() >= (lo.array() + r)).all() &&
+                (x[i].array() <= (hi.array() - r)).all())
+        << i;
+    for (std::size_t j = 0; j < i; ++j) closest = std::min(closest, (x[i] - x[j]).norm() - d);
+  }
+  EXPECT_EQ(per_level, (std::map<long, int>{{0, 81}, {1, 81}, {2, 38}}));
+  EXPECT_GE(closest, 0.05 * d - 2 * 0.01 * d - 1e-15);
+  EXPECT_LE(closest, 0.05 * d + 2 * 0.01 * d);
+  EXPECT_EQ(solver::place_in_region(sim, std::vector<double>(800, r), lo, hi, 3, 1, true).size(),
+            729u);
+  // Sites taken by particles already in the scene, or cut by a wall, are skipped.
+  solver::Simulation walled(config(), {}, {plane({0, 0, 0.0105}, {0, 0, 1})});
+  const auto y = solver::place_in_region(walled, std::vector<double>(800, r), lo, hi, 3, 1, true);
+  EXPECT_EQ(y.size(), 648u);  // the lowest level (centres at 0.0105 ± jitter) is in the wall
+  for (const auto& yi : y) EXPECT_GE(yi.z() - 0.0105, r);
+}
+
+// [fill] damping: the filling runs with its own global damping, and the solver's comes back
+// when the filling ends, also in a run resumed from a checkpoint taken while filling.
+TEST(LayeredFilling, FillDampingEndsWithTheFilling) {
+  FillSpec f = spec();
+  f.layers = 1;
+  f.count = 80;
+  f.damping = 0.6;
+  const auto fp = solver::fill_particles(f, 0);
+  solver::Simulation a(config(), fp.particles, box());  // solver damping 0.3
+  solver::LayeredFilling fa(f, 0, fp.layers, 1000);
+  fa.start(a);
+  EXPECT_EQ(a.config().damping, 0.6);
+  for (int s = 0; s < 3000; ++s) {
+    fa.control(a);
+    a.step();
+  }
+  ASSERT_FALSE(fa.finished(a));
+  const auto ck = std::filesystem::temp_directory_path() / "gs_fill_damping_ck.bin";
+  a.save_checkpoint(ck, fa.save_state());
+  auto c = config();
+  c.damping = 0.0;
+  solver::Simulation b(c, fp.particles, box());
+  solver::LayeredFilling fb(f, 0, fp.layers, 1000);
+  fb.load_state(b.load_checkpoint(ck));
+  std::filesystem::remove(ck);
+  EXPECT_EQ(b.config().damping, 0.6);  // the checkpoint's, while filling
+  for (auto* run : {&a, &b}) {
+    auto& fill = run == &a ? fa : fb;
+    while (!fill.finished(*run)) {
+      fill.control(*run);
+      if (fill.finished(*run)) break;
+      run->step();
+      ASSERT_LT(run->step_count(), 300000);
+    }
+    EXPECT_EQ(run->config().damping, 0.3);  // the scene's solver damping, back
+  }
+  EXPECT_EQ(a.step_count(), b.step_count());
 }
