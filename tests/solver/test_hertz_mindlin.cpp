@@ -316,6 +316,53 @@ TEST(HertzMindlin, Dem8ImpactScenes) {
   }
 }
 
+// The shipped DEM8 Case 1 scenes: the benchmark's silo meshes (7 632 and 8 636 triangles), M1 or
+// M2 grains of 4 mm poured from a lattice onto a lid under the orifice that opens when they are
+// at rest, removal below the orifice plane, the benchmark's dt and pair table.
+TEST(HertzMindlin, Dem8SiloScenes) {
+  const auto scenes = std::filesystem::path(GS_SOURCE_DIR) / "data" / "scenes";
+  if (!std::filesystem::exists(std::filesystem::path(GS_SOURCE_DIR) / ".." / "shared" / "dem8"))
+    GTEST_SKIP() << "../shared/dem8 absent";
+  struct Case {
+    const char* file;
+    bool small, m2;
+    std::int64_t count;
+    int layers;
+  };
+  for (const Case c : {Case{"dem8_silo_laptop.toml", false, false, 30000, 1},
+                       Case{"dem8_silo_small_laptop.toml", true, false, 30000, 1},
+                       Case{"dem8_silo.toml", false, false, 100000, 2},
+                       Case{"dem8_silo_small.toml", true, false, 100000, 2},
+                       Case{"dem8_silo_M2.toml", false, true, 100000, 2},
+                       Case{"dem8_silo_small_M2.toml", true, true, 100000, 2}}) {
+    SCOPED_TRACE(c.file);
+    const Scene s = load_scene(scenes / c.file);
+    ASSERT_TRUE(s.fill.has_value());
+    EXPECT_EQ(s.fill->count, c.count);
+    EXPECT_EQ(s.fill->layers, c.layers);
+    EXPECT_TRUE(s.fill->lattice);
+    EXPECT_EQ(s.fill->sizes.dmin_m, 0.004);
+    EXPECT_EQ(s.fill->sizes.dmax_m, 0.004);
+    EXPECT_EQ(s.particles.size(), static_cast<std::size_t>(c.count));
+    EXPECT_EQ(s.material_names, (std::vector<std::string>{c.m2 ? "M2" : "M1", "steel"}));
+    EXPECT_EQ(s.config.pair_restitution, (std::vector<double>{c.m2 ? 0.4 : 0.5, 0.4, 0.4, 0.4}));
+    EXPECT_EQ(s.config.dt, c.m2 ? 2e-6 : 1.5e-6);
+    EXPECT_EQ(s.config.damping, 0.0);
+    const double orifice = c.small ? -0.0593008 : -0.0554222;
+    ASSERT_TRUE(s.outlet.has_value());
+    EXPECT_EQ(s.outlet->first.z(), orifice);
+    ASSERT_EQ(s.open_after_fill, (std::vector<std::size_t>{0}));
+    EXPECT_EQ(s.walls[0].name, "lid");
+    EXPECT_NEAR(s.walls[0].center.z() + s.walls[0].half_extents.z(), orifice, 1e-15);
+    std::size_t triangles = 0;
+    for (std::size_t w = 1; w < s.walls.size(); ++w) {
+      EXPECT_EQ(s.walls[w].material, 1);
+      triangles += s.walls[w].facets.size();
+    }
+    EXPECT_EQ(triangles, c.small ? 8636u : 7632u);
+  }
+}
+
 // The shipped DEM8 Case 2 scene: 30 000 M1 grains (1 mm) and 8 000 M2 (2 mm) by radius, the
 // 1 200-triangle drum of steel turning at 2 rad/s about +y through the origin, the pair table of
 // the benchmark's YADE script.
