@@ -147,18 +147,59 @@ void NeighborList::build(const ParticleState& p, const std::vector<WallState>& w
   while (first < n && gone(first)) ++first;
   if (first == n) return;  // every particle has left
   Eigen::Vector3d lo = p.pos[first], hi = p.pos[first];
+  radius_scratch_.clear();
   for (std::size_t i = first; i < n; ++i) {
     if (gone(i)) continue;
     rmax = std::max(rmax, p.radius[i]);
     lo = lo.cwiseMin(p.pos[i]);
     hi = hi.cwiseMax(p.pos[i]);
+    radius_scratch_.push_back(p.radius[i]);
   }
-  const double cell = 2 * rmax + skin;
+  // Mixed sizes: particles larger than twice the 99th percentile of the radii, if they are at
+  // most 1 % of all, stay out of the grid (`big_`), whose cells are sized for the others.
+  big_.clear();
+  is_big_.assign(n, 0);
+  double rgrid = rmax;
+  const std::size_t active = radius_scratch_.size();
+  if (active >= 200) {
+    const std::size_t q = (active - 1) * 99 / 100;
+    std::nth_element(radius_scratch_.begin(), radius_scratch_.begin() + static_cast<long>(q),
+                     radius_scratch_.end());
+    const double limit = 2 * radius_scratch_[q];
+    if (rmax > limit) {
+      double rest = 0;
+      for (std::size_t i = first; i < n; ++i) {
+        if (gone(i)) continue;
+        if (p.radius[i] > limit) {
+          big_.push_back(static_cast<std::uint32_t>(i));
+          is_big_[i] = 1;
+        } else {
+          rest = std::max(rest, p.radius[i]);
+        }
+      }
+      if (big_.size() <= active / 100) {
+        rgrid = rest;
+      } else {
+        big_.clear();
+        is_big_.assign(n, 0);
+      }
+    }
+  }
+  double cell = 2 * rgrid + skin;
   const bool clumped = p.clump.size() == n;
   Eigen::Array3i dims;
-  for (int k = 0; k < 3; ++k)
-    dims[k] =
-        std::max(1, std::min(1 << 10, static_cast<int>(std::floor((hi[k] - lo[k]) / cell)) + 1));
+  auto size_grid = [&] {
+    for (int k = 0; k < 3; ++k)
+      dims[k] =
+          std::max(1, std::min(1 << 10, static_cast<int>(std::floor((hi[k] - lo[k]) / cell)) + 1));
+  };
+  size_grid();
+  // (Cells for small particles spread thin: no more than a few cells per particle.)
+  while (!big_.empty() && static_cast<double>(dims[0]) * dims[1] * dims[2] >
+                              4.0 * static_cast<double>(active) + 4096) {
+    cell *= 1.25;
+    size_grid();
+  }
   const std::size_t ncells = static_cast<std::size_t>(dims[0]) * dims[1] * dims[2];
   auto cell_of = [&](const Eigen::Vector3d& x) {
     Eigen::Array3i c;
@@ -176,13 +217,13 @@ void NeighborList::build(const ParticleState& p, const std::vector<WallState>& w
     if (gone(i)) continue;
     const auto c = cell_of(p.pos[i]);
     cell_of_particle_[i] = index_of(c[0], c[1], c[2]);
-    ++cell_start_[cell_of_particle_[i] + 1];
+    if (!is_big_[i]) ++cell_start_[cell_of_particle_[i] + 1];
   }
   for (std::size_t c = 0; c < ncells; ++c) cell_start_[c + 1] += cell_start_[c];
   cell_fill_.assign(cell_start_.begin(), cell_start_.end() - 1);
   slots_.resize(cell_start_[ncells]);
   for (std::size_t i = 0; i < n; ++i) {
-    if (gone(i)) continue;
+    if (gone(i) || is_big_[i]) continue;
     const Eigen::Vector3d& x = p.pos[i];
     slots_[cell_fill_[cell_of_particle_[i]]++] = {
         x[0], x[1], x[2], p.radius[i], static_cast<std::uint32_t>(i), clumped ? p.clump[i] : -1};
@@ -201,8 +242,38 @@ void NeighborList::build(const ParticleState& p, const std::vector<WallState>& w
         if (dx * dx + dy * dy + dz * dz < reach * reach * (1 + 1e-12))
           found_.emplace_back(std::min(a.index, b.index), std::max(a.index, b.index));
       });
+  // The large particles: with each other, and with the slots of the cells their reach covers.
+  auto same_clump = [&](std::uint32_t a, std::uint32_t b) {
+    return clumped && p.clump[a] >= 0 && p.clump[a] == p.clump[b];
+  };
+  for (std::size_t k = 0; k < big_.size(); ++k) {
+    const std::uint32_t a = big_[k];
+    const Eigen::Vector3d& xa = p.pos[a];
+    for (std::size_t l = k + 1; l < big_.size(); ++l) {
+      const std::uint32_t b = big_[l];
+      const double reach = p.radius[a] + p.radius[b] + skin;
+      if (!same_clump(a, b) && (p.pos[b] - xa).squaredNorm() < reach * reach * (1 + 1e-12))
+        found_.emplace_back(std::min(a, b), std::max(a, b));
+    }
+    const Eigen::Vector3d span = Eigen::Vector3d::Constant(p.radius[a] + rgrid + skin);
+    const auto c0 = cell_of(xa - span), c1 = cell_of(xa + span);
+    for (int z = c0[2]; z <= c1[2]; ++z)
+      for (int y = c0[1]; y <= c1[1]; ++y)
+        for (int x = c0[0]; x <= c1[0]; ++x) {
+          const std::uint32_t ci = index_of(x, y, z);
+          for (std::uint32_t t = cell_start_[ci]; t < cell_start_[ci + 1]; ++t) {
+            const Slot& b = slots_[t];
+            if (same_clump(a, b.index)) continue;
+            const double reach = p.radius[a] + b.r + skin;
+            const double dx = b.x - xa[0], dy = b.y - xa[1], dz = b.z - xa[2];
+            if (dx * dx + dy * dy + dz * dz < reach * reach * (1 + 1e-12))
+              found_.emplace_back(std::min(a, b.index), std::max(a, b.index));
+          }
+        }
+  }
   // Facets are binned, each on its own, into the cells their bounding box (grown by the
-  // largest reach) covers, in (wall, facet) order within a cell; other walls are checked by all.
+  // largest reach of the grid's particles) covers, in (wall, facet) order within a cell; other
+  // walls are checked by all.
   plain_walls_.clear();
   facet_cell_.clear();
   facet_entries_.clear();
@@ -221,7 +292,7 @@ void NeighborList::build(const ParticleState& p, const std::vector<WallState>& w
         lo_f = lo_f.cwiseMin(x);
         hi_f = hi_f.cwiseMax(x);
       }
-      const Eigen::Vector3d grow = Eigen::Vector3d::Constant(rmax + skin);
+      const Eigen::Vector3d grow = Eigen::Vector3d::Constant(rgrid + skin);
       const auto c0 = cell_of(lo_f - grow), c1 = cell_of(hi_f + grow);
       for (int z = c0[2]; z <= c1[2]; ++z)
         for (int y = c0[1]; y <= c1[1]; ++y)
@@ -243,8 +314,30 @@ void NeighborList::build(const ParticleState& p, const std::vector<WallState>& w
     if (gone(i)) continue;
     const std::uint32_t own = cell_of_particle_[i];
     const double reach = p.radius[i] + skin;
+    if (is_big_[i]) {
+      // A large particle: the facets of every cell its reach covers, each wall paired once.
+      walls_seen_.clear();
+      const Eigen::Vector3d span = Eigen::Vector3d::Constant(reach);
+      const auto c0 = cell_of(p.pos[i] - span), c1 = cell_of(p.pos[i] + span);
+      for (int z = c0[2]; z <= c1[2]; ++z)
+        for (int y = c0[1]; y <= c1[1]; ++y)
+          for (int x = c0[0]; x <= c1[0]; ++x) {
+            const std::uint32_t ci = index_of(x, y, z);
+            for (std::uint32_t e = facet_start_[ci]; e < facet_start_[ci + 1]; ++e) {
+              const FacetEntry fe = facet_sorted_[e];
+              if (std::find(walls_seen_.begin(), walls_seen_.end(), fe.wall) != walls_seen_.end())
+                continue;
+              const auto& wall = walls[fe.wall];
+              if (facet_near(wall.facets[fe.facet], wall.pos, p.pos[i], reach)) {
+                found_.emplace_back(static_cast<std::uint32_t>(i), kWallBase + fe.wall);
+                walls_seen_.push_back(fe.wall);
+              }
+            }
+          }
+    }
     std::uint32_t last = kWallBase;  // the wall last paired with i
-    for (std::uint32_t e = facet_start_[own]; e < facet_start_[own + 1]; ++e) {
+    for (std::uint32_t e = is_big_[i] ? 0 : facet_start_[own];
+         e < (is_big_[i] ? 0 : facet_start_[own + 1]); ++e) {
       const FacetEntry fe = facet_sorted_[e];
       if (fe.wall == last) continue;
       const auto& wall = walls[fe.wall];
