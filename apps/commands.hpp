@@ -37,5 +37,7 @@ void register_analyze_interface(CLI::App& app);
 
 /// `granoscope analyze hhd` and `granoscope analyze vortices` (apps/cmd_hhd.cpp).
 void register_analyze_hhd(CLI::App& app);
+/// `granoscope analyze materials` (apps/cmd_materials.cpp).
+void register_analyze_materials(CLI::App& app);
 
 }  // namespace gs::cli

@@ -70,6 +70,7 @@ int main(int argc, char** argv) {
   gs::cli::register_analyze_silo(app);
   gs::cli::register_analyze_interface(app);
   gs::cli::register_analyze_hhd(app);
+  gs::cli::register_analyze_materials(app);
   try {
     gs::cli::check_subcommand_names(app, argc, argv);
     app.parse(argc, argv);

@@ -1476,6 +1476,11 @@ Scene load_scene(const std::filesystem::path& path, int sweep_point) {
   std::ostringstream flat;
   flat << root;
   s.parameters.emplace_back("scene.toml", flat.str());
+  {
+    std::string names;  // the material of id k is the k-th (analyze materials reads them)
+    for (const auto& n : s.material_names) names += (names.empty() ? "" : ",") + n;
+    s.parameters.emplace_back("material_names", names);
+  }
   return s;
 }
 
