@@ -370,27 +370,32 @@ TEST(HertzMindlin, Dem8DrumScene) {
   const auto scenes = std::filesystem::path(GS_SOURCE_DIR) / "data" / "scenes";
   if (!std::filesystem::exists(std::filesystem::path(GS_SOURCE_DIR) / ".." / "shared" / "dem8"))
     GTEST_SKIP() << "../shared/dem8 absent";
-  const Scene s = load_scene(scenes / "dem8_drum.toml");
-  ASSERT_EQ(s.particles.size(), 38000u);
-  std::size_t m1 = 0, m2 = 0;
-  for (const auto& p : s.particles) {
-    m1 += p.material_id == 0 && p.radius == 0.001;
-    m2 += p.material_id == 1 && p.radius == 0.002;
+  for (const char* name : {"dem8_drum.toml", "dem8_drum_laptop.toml"}) {
+    SCOPED_TRACE(name);
+    const Scene s = load_scene(scenes / name);
+    EXPECT_EQ(s.steps, std::string(name) == "dem8_drum.toml" ? 6250000 : 62500);
+    EXPECT_EQ(s.config.dt, 8e-7);
+    ASSERT_EQ(s.particles.size(), 38000u);
+    std::size_t m1 = 0, m2 = 0;
+    for (const auto& p : s.particles) {
+      m1 += p.material_id == 0 && p.radius == 0.001;
+      m2 += p.material_id == 1 && p.radius == 0.002;
+    }
+    EXPECT_EQ(m1, 30000u);
+    EXPECT_EQ(m2, 8000u);
+    EXPECT_EQ(s.config.pair_restitution,
+              (std::vector<double>{0.5, 0.45, 0.4, 0.45, 0.4, 0.4, 0.4, 0.4, 0.4}));
+    EXPECT_EQ(s.config.pair_friction_deg[1], 11.309932474020215);
+    EXPECT_EQ(s.config.pair_friction_deg[2], -1.0);  // M1-steel: the smaller of the two
+    std::size_t triangles = 0;
+    for (const auto& w : s.walls) {
+      EXPECT_EQ(w.material, 2);
+      EXPECT_EQ(w.angular_velocity, Eigen::Vector3d(0, 2, 0));
+      EXPECT_EQ(w.rotation_center, Eigen::Vector3d::Zero());
+      triangles += w.facets.size();
+    }
+    EXPECT_EQ(triangles, 1200u);
   }
-  EXPECT_EQ(m1, 30000u);
-  EXPECT_EQ(m2, 8000u);
-  EXPECT_EQ(s.config.pair_restitution,
-            (std::vector<double>{0.5, 0.45, 0.4, 0.45, 0.4, 0.4, 0.4, 0.4, 0.4}));
-  EXPECT_EQ(s.config.pair_friction_deg[1], 11.309932474020215);
-  EXPECT_EQ(s.config.pair_friction_deg[2], -1.0);  // M1-steel: the smaller of the two
-  std::size_t triangles = 0;
-  for (const auto& w : s.walls) {
-    EXPECT_EQ(w.material, 2);
-    EXPECT_EQ(w.angular_velocity, Eigen::Vector3d(0, 2, 0));
-    EXPECT_EQ(w.rotation_center, Eigen::Vector3d::Zero());
-    triangles += w.facets.size();
-  }
-  EXPECT_EQ(triangles, 1200u);
 }
 
 }  // namespace
