@@ -55,11 +55,28 @@ template <bool kPeriodic>
 [[gnu::always_inline]] inline void hm_lanes(ContactBatch& batch, int count, double dt) {
   auto in3 = [&](Batch::Field f, int j) { return batch.get3(f, j); };
   auto out3 = [&](Batch::Field f, int j, const V3& x) { batch.set3(f, j, x); };
+  // Three passes, so that the two without calls vectorise: the geometry (its normal,
+  // penetration and contact point go to NX, PEN, PTX, the arms to C1X, C2X), the powers of the
+  // penetration (glibc's pow, scalar, as YADE calls it), then the law. Each lane's operations
+  // and their order are those of one scalar pass: the same bits.
+  for (int j = 0; j < count; ++j) {
+    const LaneGeometry g = lane_geometry(batch, j);
+    out3(Batch::C1X, j, g.c1);
+    out3(Batch::C2X, j, g.c2);
+  }
+  double pow15[ContactBatch::kLanes], pow05[ContactBatch::kLanes];
+  for (int j = 0; j < count; ++j) {
+    pow15[j] = std::pow(batch.v[Batch::PEN][j], 1.5);
+    pow05[j] = std::pow(batch.v[Batch::PEN][j], 0.5);
+  }
   for (int j = 0; j < count; ++j) {
     const double r1 = batch.v[Batch::R1][j], r2 = batch.v[Batch::R2][j];
-    const LaneGeometry g = lane_geometry(batch, j);
+    LaneGeometry g;
+    g.n = in3(Batch::NX, j);
+    g.c1 = in3(Batch::C1X, j);
+    g.c2 = in3(Batch::C2X, j);
     const V3 n = g.n;
-    const double un = g.pen;
+    const double un = batch.v[Batch::PEN][j];
     const V3 zero{0, 0, 0};
     const double kno = batch.v[Batch::KN][j], kso = batch.v[Batch::KS][j];
     const double betan = batch.v[Batch::KR][j], betas = batch.v[Batch::KTW][j];
@@ -69,9 +86,9 @@ template <bool kPeriodic>
     const V3 w1 = in3(Batch::W1X, j), w2 = in3(Batch::W2X, j);
     const V3 v1 = in3(Batch::V1X, j), v2 = in3(Batch::V2X, j);
     // Normal force and the tangent stiffnesses (seed 004 eq 3.2's Hertzian counterpart).
-    const double fn_el = kno * std::pow(un, 1.5);
-    const double kn = 3. / 2. * kno * std::pow(un, 0.5);
-    const double ks = kso * std::pow(un, 0.5);
+    const double fn_el = kno * pow15[j];
+    const double kn = 3. / 2. * kno * pow05[j];
+    const double ks = kso * pow05[j];
     const double cn = 2. * std::sqrt(mbar * kn) * betan;
     const double cs = 2. * std::sqrt(mbar * ks) * betas;
     // The stored elastic shear force, rotated into the current tangent plane (ScGeom::rotate).
