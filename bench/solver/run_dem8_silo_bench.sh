@@ -1,0 +1,67 @@
+#!/usr/bin/env bash
+# DEM8 Case 1 (silo discharge, M1, large orifice; docs/dem8.md): speed against YADE 2023.02a -j1
+# running the benchmark script's engines (yade_dem8_silo.py) on the same spheres for the same
+# STEPS steps (default 2000, dt 1.5 us), in the same script. The spheres are a frame of a
+# granoscope run of data/scenes/dem8_silo_laptop.toml (RUN_DIR; default its last frame, FRAME),
+# started at rest with the orifice open: both codes run the same discharging silo. granoscope
+# runs it with 1 and 2 threads (contact = "yade": one wall per triangle, as YADE's facets).
+# Particle-steps count the spheres at the start.
+#   bench/solver/run_dem8_silo_bench.sh RUN_DIR [BUILD_DIR]   (needs yade and ../shared/dem8)
+set -euo pipefail
+here=$(cd "$(dirname "$0")" && pwd)
+root=$(cd "$here/../.." && pwd)
+run=${1:?usage: run_dem8_silo_bench.sh RUN_DIR [BUILD_DIR]}
+build=${2:-$root/build}
+gs=$build/bin/granoscope
+py=/usr/bin/python3
+d8=$(cd "$root/../shared/dem8" 2>/dev/null && pwd) || { echo "needs ../shared/dem8"; exit 1; }
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+[ -x "$gs" ] || { echo "build first (scripts/build)"; exit 1; }
+steps=${STEPS:-2000}
+traj=$run/trajectory.h5
+[ -f "$traj" ] || traj=$run/trajectory.h5.partial
+"$gs" convert "$traj" "$work/frame.csv" --frame "${FRAME:--1}" > /dev/null
+"$py" - "$root/data/scenes/dem8_silo_laptop.toml" "$work" "$d8" "$steps" <<'PY'
+import csv, re, sys
+scene, work, d8, steps = sys.argv[1:5]
+rows = list(csv.DictReader(open(work + "/frame.csv")))
+with open(work + "/packing.csv", "w") as f:
+    f.write("id,x,y,z,r\n")
+    for k, r in enumerate(rows):
+        f.write("%d,%s,%s,%s,%s\n" % (k, r["x"], r["y"], r["z"], r["radius"] if "radius" in r else r["r"]))
+s = open(scene).read()
+s = re.sub(r"\n\[fill\].*?(?=\n\[)", "\n", s, flags=re.S)          # no filling: the packing
+s = re.sub(r"\n\[\[walls\]\].*?(?=\n\[)", "\n", s, flags=re.S)  # no lid: the orifice open
+s = s.replace('name = "dem8_silo_laptop"', 'name = "silo_bench"\npacking = "packing.csv"')
+s = s.replace('"../../../shared/dem8/', '"%s/' % d8).replace('contact = "merged"', 'contact = "yade"')
+s = re.sub(r"\nsteps = .*", "\nsteps = %s" % steps, s)
+s = re.sub(r"\nevery = .*", "\nevery = 100000000", s)
+s = re.sub(r"\ncheckpoint_every = .*", "\ncheckpoint_every = 100000000", s)
+open(work + "/silo.toml", "w").write(s)
+print(len(rows))
+PY
+n=$($py -c "import csv;print(sum(1 for _ in csv.DictReader(open('$work/packing.csv'))))")
+for t in 1 2; do
+  "$gs" simulate "$work/silo.toml" --threads $t -q -o "$work/run$t" > "$work/gs$t.txt"
+done
+yade -n -x -j1 "$here/yade_dem8_silo.py" "$work/packing.csv" \
+  "$d8/case1_silo/walls_large_orifice.txt" -0.0554222 M1 "$steps" > "$work/yade.txt" 2>&1
+"$py" - "$work" "$steps" "$n" <<'PY'
+import csv, re, sys
+work, steps, n = sys.argv[1], int(sys.argv[2]), int(sys.argv[3])
+y = open(work + "/yade.txt").read()
+yt = float(re.search(r"wall time ([0-9.]+)", y).group(1))
+ye = int(re.search(r"erased (\d+)", y).group(1))
+rows = [("YADE 2023.02a -j1", yt, ye)]
+for t in (1, 2):
+    out = open("%s/gs%d.txt" % (work, t)).read()
+    s = float(re.search(r"steps of \d+ particles in ([0-9.]+) s", out).group(1))
+    rem = float(list(csv.DictReader(open("%s/run%d/history.csv" % (work, t))))[-1]["removed"])
+    rows.append(("granoscope, %d thread%s" % (t, "s" if t > 1 else ""), s, int(rem)))
+print("DEM8 Case 1 (large orifice, M1), %d spheres from rest, %d steps of 1.5 us:" % (n, steps))
+print("  %-26s %8s %16s %7s %8s" % ("run", "time s", "particle-steps/s", "ratio", "removed"))
+base = n * steps / rows[0][1]
+for name, t, e in rows:
+    print("  %-26s %8.2f %16.3g %6.1fx %8d" % (name, t, n * steps / t, n * steps / t / base, e))
+PY
