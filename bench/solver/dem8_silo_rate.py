@@ -16,6 +16,37 @@ import os
 import sys
 
 
+def fill_count(out):
+    """The [fill] count of the run's scene: its copy beside the checkpoints while it runs, or the
+    trajectory's metadata once it has ended."""
+    text = None
+    scene = os.path.join(out, "checkpoint-scene.toml")
+    if os.path.exists(scene):
+        text = open(scene).read()
+    else:
+        for name in ("trajectory.h5", "trajectory.h5.partial"):
+            path = os.path.join(out, name)
+            if os.path.exists(path):
+                try:
+                    import h5py
+                    with h5py.File(path, "r") as f:
+                        v = f["metadata"].attrs.get("scene.toml")
+                        text = v.decode() if isinstance(v, bytes) else v
+                except (ImportError, OSError, KeyError):
+                    text = None
+                break
+    if not text:
+        return None
+    section = None
+    for line in text.splitlines():
+        line = line.split("#")[0].strip()
+        if line.startswith("["):
+            section = line.strip("[]").strip()
+        elif section == "fill" and line.startswith("count") and "=" in line:
+            return int(line.split("=")[1])
+    return None
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("out", help="the run's output folder")
@@ -44,12 +75,9 @@ def main():
     t0 = t[k0]
     total = a.total
     if total is None:
-        total = 0
-        scene = os.path.join(a.out, "checkpoint-scene.toml")
-        if os.path.exists(scene):
-            for line in open(scene):
-                if line.strip().startswith("count") and "=" in line:
-                    total = int(line.split("=")[1].split("#")[0])
+        total = fill_count(a.out)
+    if total is None:
+        sys.exit(f"error: {a.out}: no [fill] count found (give --total)")
     print(f"history: {path}, {len(rows)} rows; opened at t = {t0:.6f} s (step {rows[k0]['step']})")
     print("t since opening (s)   particles above the orifice")
     step = 0.1

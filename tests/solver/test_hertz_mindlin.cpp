@@ -341,6 +341,7 @@ TEST(HertzMindlin, Dem8SiloScenes) {
     EXPECT_EQ(s.fill->count, c.count);
     EXPECT_EQ(s.fill->layers, c.layers);
     EXPECT_TRUE(s.fill->lattice);
+    EXPECT_EQ(s.fill->damping, std::string(c.file) == "dem8_silo_small_laptop.toml" ? 0.2 : -1.0);
     EXPECT_EQ(s.fill->sizes.dmin_m, 0.004);
     EXPECT_EQ(s.fill->sizes.dmax_m, 0.004);
     EXPECT_EQ(s.particles.size(), static_cast<std::size_t>(c.count));
