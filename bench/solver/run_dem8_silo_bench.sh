@@ -4,7 +4,9 @@
 # STEPS steps (default 2000, dt 1.5 us), in the same script. The spheres are a frame of a
 # granoscope run of data/scenes/dem8_silo_laptop.toml (RUN_DIR; default its last frame, FRAME),
 # started at rest with the orifice open: both codes run the same discharging silo. granoscope
-# runs it with 1 and 2 threads (contact = "yade": one wall per triangle, as YADE's facets).
+# runs it with 1 and 2 threads (contact = "yade": one wall per triangle, as YADE's facets), and
+# LIGGGHTS 3.8 (liggghts_dem8_silo.py: `gran model hertz`, the same materials, the silo as an
+# STL, the same Verlet skin as granoscope's, 1 mm; its Hertz damping is its own) when installed.
 # Particle-steps count the spheres at the start.
 #   bench/solver/run_dem8_silo_bench.sh RUN_DIR [BUILD_DIR]   (needs yade and ../shared/dem8)
 set -euo pipefail
@@ -45,6 +47,11 @@ n=$($py -c "import csv;print(sum(1 for _ in csv.DictReader(open('$work/packing.c
 for t in 1 2; do
   "$gs" simulate "$work/silo.toml" --threads $t -q -o "$work/run$t" > "$work/gs$t.txt"
 done
+if command -v liggghts > /dev/null; then
+  "$py" "$here/liggghts_dem8_silo.py" "$work/packing.csv" "$d8/case1_silo/walls_large_orifice.txt" \
+    -0.0554222 "$steps" 500 "$work/lig"
+  (cd "$work/lig" && liggghts -in in.silo > log.txt 2>&1)
+fi
 yade -n -x -j1 "$here/yade_dem8_silo.py" "$work/packing.csv" \
   "$d8/case1_silo/walls_large_orifice.txt" -0.0554222 M1 "$steps" > "$work/yade.txt" 2>&1
 "$py" - "$work" "$steps" "$n" <<'PY'
@@ -54,6 +61,12 @@ y = open(work + "/yade.txt").read()
 yt = float(re.search(r"wall time ([0-9.]+)", y).group(1))
 ye = int(re.search(r"erased (\d+)", y).group(1))
 rows = [("YADE 2023.02a -j1", yt, ye)]
+import os
+if os.path.exists(work + "/lig/log.txt"):
+    log = open(work + "/lig/log.txt").read()
+    lt = float(re.findall(r"Loop time of ([0-9.e+-]+) on 1 procs for %d steps" % steps, log)[-1])
+    atoms = int(re.findall(r"^\s+%d\s+(\d+)\s+\S+\s*$" % (steps + 1), log, re.M)[-1])
+    rows.append(("LIGGGHTS 3.8, 1 process", lt, n - atoms))
 for t in (1, 2):
     out = open("%s/gs%d.txt" % (work, t)).read()
     s = float(re.search(r"steps of \d+ particles in ([0-9.]+) s", out).group(1))
