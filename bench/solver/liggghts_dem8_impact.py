@@ -12,6 +12,8 @@ Usage: liggghts_dem8_impact.py PARTICLES.txt WALLS.txt N Z0 V0 STEPS EVERY DIR  
 import os
 import sys
 
+from liggghts_dem8_common import hertz_input, write_stl
+
 parts, walls, n, z0, v0, steps, every, d = sys.argv[1:9]
 n, z0, v0, steps, every = int(n), float(z0), float(v0), int(steps), int(every)
 os.makedirs(d, exist_ok=True)
@@ -30,42 +32,9 @@ with open(os.path.join(d, "bed.data"), "w") as f:
     for k, (r, x, y, z) in enumerate(rows):  # id type diameter density x y z
         f.write("%d 1 %.17g 2500 %.17g %.17g %.17g\n" % (k + 1, 2 * r, x, y, z))
     f.write("%d 2 0.02 7200 0 0 %.17g\n" % (n + 1, z0))
-with open(walls) as a, open(os.path.join(d, "walls.stl"), "w") as b:
-    a.readline()
-    b.write("solid box\n")
-    for line in a:
-        c = line.split()
-        if len(c) != 9:
-            continue
-        b.write(" facet normal 0 0 0\n  outer loop\n")
-        for k in range(3):
-            b.write("   vertex %s %s %s\n" % tuple(c[3 * k:3 * k + 3]))
-        b.write("  endloop\n endfacet\n")
-    b.write("endsolid box\n")
-model = "model hertz tangential history"
+write_stl(walls, os.path.join(d, "walls.stl"), "box")
 with open(os.path.join(d, "in.impact"), "w") as f:
-    f.write(f"""atom_style granular
-atom_modify map array
-boundary f f f
-newton off
-communicate single vel yes
-units si
-hard_particles yes
-read_data bed.data
-neighbor 0.0005 bin
-neigh_modify delay 0
-fix m1 all property/global youngsModulus peratomtype 1.0e9 2.1e11
-fix m2 all property/global poissonsRatio peratomtype 0.2 0.2
-fix m3 all property/global coefficientRestitution peratomtypepair 2 0.5 0.4 0.4 0.4
-fix m4 all property/global coefficientFriction peratomtypepair 2 0.3 0.2 0.2 0.2
-pair_style gran {model}
-pair_coeff * *
-timestep 5.0e-7
-fix gravi all gravity 9.81 vector 0.0 0.0 -1.0
-fix cad all mesh/surface file walls.stl type 2
-fix walls all wall/gran {model} mesh n_meshes 1 meshes cad
-fix integr all nve/sphere
-set atom {n + 1} vx 0.0 vy 0.0 vz {-v0!r}
+    f.write(f"""{hertz_input("bed.data", 0.0005, 5.0e-7, 1.0e9, 0.5, 0.3)}set atom {n + 1} vx 0.0 vy 0.0 vz {-v0!r}
 variable bz equal z[{n + 1}]
 thermo_style custom step atoms ke v_bz
 thermo_modify lost ignore norm no

@@ -121,6 +121,13 @@ std::vector<Eigen::Vector3d> place_in_region(const Simulation& sim,
         }
     return true;
   };
+  // Places a sphere at x if nothing is there (true: placed).
+  auto try_place = [&](const Eigen::Vector3d& x, double r) {
+    if (!free_of_particles(x, r) || !clear_of_walls(x, r)) return false;
+    add(x, r);
+    out.push_back(x);
+    return true;
+  };
   if (lattice) {
     // Sites of a simple cubic lattice, spacing a = 1.05 · 2 r_max, ordered from the bottom up
     // (along gravity; x then y within a level when gravity is along z).
@@ -154,10 +161,7 @@ std::vector<Eigen::Vector3d> place_in_region(const Simulation& sim,
         x[v] = lo[v] + rl + static_cast<double>(iv) * a;
         for (int k = 0; k < 3; ++k)
           x[k] = std::clamp(x[k] + jitter * (2 * uniform01(rng) - 1), lo[k] + r, hi[k] - r);
-        if (!free_of_particles(x, r) || !clear_of_walls(x, r)) continue;
-        add(x, r);
-        out.push_back(x);
-        placed = true;
+        placed = try_place(x, r);
       }
       if (!placed) break;
     }
@@ -169,10 +173,7 @@ std::vector<Eigen::Vector3d> place_in_region(const Simulation& sim,
     for (int attempt = 0; attempt < max_attempts && !placed; ++attempt) {
       Eigen::Vector3d x;
       for (int k = 0; k < 3; ++k) x[k] = lo[k] + r + uniform01(rng) * (hi[k] - lo[k] - 2 * r);
-      if (!free_of_particles(x, r) || !clear_of_walls(x, r)) continue;
-      add(x, r);
-      out.push_back(x);
-      placed = true;
+      placed = try_place(x, r);
     }
     if (!placed) break;
   }

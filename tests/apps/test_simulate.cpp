@@ -453,6 +453,21 @@ TEST(Simulate, BadClumpsNameTheFieldAndValue) {
   expect_one_line_errors(dir.path, base, cases);
 }
 
+namespace {
+
+/// Four plane walls around the 10 mm square x, y in [0, 0.01] (scene text).
+std::string side_planes_10mm() {
+  std::string walls;
+  for (const char* w : {"point_m = [0.0, 0.0, 0.0]\nnormal = [1.0, 0.0, 0.0]",
+                        "point_m = [0.01, 0.0, 0.0]\nnormal = [-1.0, 0.0, 0.0]",
+                        "point_m = [0.0, 0.0, 0.0]\nnormal = [0.0, 1.0, 0.0]",
+                        "point_m = [0.0, 0.01, 0.0]\nnormal = [0.0, -1.0, 0.0]"})
+    walls += std::string("[[walls]]\nshape = \"plane\"\n") + w + "\n";
+  return walls;
+}
+
+}  // namespace
+
 // Filling in layers, then the outlet opened (seed 004 §5.2's preparation and discharge): 3
 // layers of 40 spheres fall onto a square mesh floor inside plane walls; the floor is switched
 // off once the last layer has settled and every sphere then leaves through the outlet below it.
@@ -464,12 +479,7 @@ TEST(Simulate, FillInLayersThenOpenTheFloorAndDischargeEverything) {
              "solid floor\nfacet normal 0 0 1\n outer loop\n  vertex 0 0 0\n  vertex 10 0 0\n  "
              "vertex 10 10 0\n endloop\nendfacet\nfacet normal 0 0 1\n outer loop\n  vertex 0 0 "
              "0\n  vertex 10 10 0\n  vertex 0 10 0\n endloop\nendfacet\nendsolid floor\n");
-  std::string walls;
-  for (const char* w : {"point_m = [0.0, 0.0, 0.0]\nnormal = [1.0, 0.0, 0.0]",
-                        "point_m = [0.01, 0.0, 0.0]\nnormal = [-1.0, 0.0, 0.0]",
-                        "point_m = [0.0, 0.0, 0.0]\nnormal = [0.0, 1.0, 0.0]",
-                        "point_m = [0.0, 0.01, 0.0]\nnormal = [0.0, -1.0, 0.0]"})
-    walls += std::string("[[walls]]\nshape = \"plane\"\n") + w + "\n";
+  const std::string walls = side_planes_10mm();
   write_text(dir / "scene.toml", R"([scene]
 name = "fill"
 [material]
@@ -544,12 +554,7 @@ keep_hi_m = [1.0, 1.0, 1.0]
 // of them leave through the outlet under the lid.
 TEST(Simulate, LatticeFillUnderALidWallThenDischarge) {
   gs::test::ScratchDir dir("sim_fill_lid");
-  std::string walls;
-  for (const char* w : {"point_m = [0.0, 0.0, 0.0]\nnormal = [1.0, 0.0, 0.0]",
-                        "point_m = [0.01, 0.0, 0.0]\nnormal = [-1.0, 0.0, 0.0]",
-                        "point_m = [0.0, 0.0, 0.0]\nnormal = [0.0, 1.0, 0.0]",
-                        "point_m = [0.0, 0.01, 0.0]\nnormal = [0.0, -1.0, 0.0]"})
-    walls += std::string("[[walls]]\nshape = \"plane\"\n") + w + "\n";
+  const std::string walls = side_planes_10mm();
   write_text(dir / "scene.toml", R"([scene]
 name = "lid"
 [material]
