@@ -28,7 +28,7 @@ with open(os.path.join(d, "silo.data"), "w") as f:
         f.write("%d 1 %.17g 2500 %.17g %.17g %.17g\n" % (k + 1, 2 * r, x, y, z))
 write_stl(walls, os.path.join(d, "walls.stl"), "silo")
 with open(os.path.join(d, "in.silo"), "w") as f:
-    f.write(f"""{hertz_input("silo.data", 0.001, 1.5e-6, 1.0e9, 0.5, 0.3)}thermo_style custom step atoms ke
+    f.write(f"""{hertz_input("silo.data", 0.0004, 1.5e-6, 1.0e9, 0.5, 0.3)}thermo_style custom step atoms ke
 thermo_modify lost ignore norm no
 thermo {every}
 run 1

@@ -6,7 +6,7 @@
 # started at rest with the orifice open: both codes run the same discharging silo. granoscope
 # runs it with 1 and 2 threads (contact = "yade": one wall per triangle, as YADE's facets), and
 # LIGGGHTS 3.8 (liggghts_dem8_silo.py: `gran model hertz`, the same materials, the silo as an
-# STL, the same Verlet skin as granoscope's, 1 mm; its Hertz damping is its own) when installed.
+# STL, the same Verlet skin as the scene's, 0.4 mm; its Hertz damping is its own) when installed.
 # Particle-steps count the spheres at the start.
 #   bench/solver/run_dem8_silo_bench.sh RUN_DIR [BUILD_DIR]   (needs yade and ../shared/dem8)
 set -euo pipefail

@@ -349,6 +349,7 @@ TEST(HertzMindlin, Dem8SiloScenes) {
     EXPECT_EQ(s.config.pair_restitution, (std::vector<double>{c.m2 ? 0.4 : 0.5, 0.4, 0.4, 0.4}));
     EXPECT_EQ(s.config.dt, c.m2 ? 2e-6 : 1.5e-6);
     EXPECT_EQ(s.config.damping, 0.0);
+    EXPECT_EQ(s.config.skin, 0.0004);
     const double orifice = c.small ? -0.0593008 : -0.0554222;
     ASSERT_TRUE(s.outlet.has_value());
     EXPECT_EQ(s.outlet->first.z(), orifice);
