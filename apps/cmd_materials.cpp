@@ -3,6 +3,7 @@
 // segregation monitor of the DEM8 benchmark's rotating drum (docs/dem8.md, Case 2), as a CSV
 // table with one row per frame.
 #include <CLI/CLI.hpp>
+#include <cmath>
 #include <cstdio>
 #include <map>
 #include <memory>

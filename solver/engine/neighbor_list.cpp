@@ -147,21 +147,26 @@ void NeighborList::build(const ParticleState& p, const std::vector<WallState>& w
   while (first < n && gone(first)) ++first;
   if (first == n) return;  // every particle has left
   Eigen::Vector3d lo = p.pos[first], hi = p.pos[first];
-  radius_scratch_.clear();
+  double rmin = HUGE_VAL;
+  std::size_t active = 0;
   for (std::size_t i = first; i < n; ++i) {
     if (gone(i)) continue;
     rmax = std::max(rmax, p.radius[i]);
+    rmin = std::min(rmin, p.radius[i]);
     lo = lo.cwiseMin(p.pos[i]);
     hi = hi.cwiseMax(p.pos[i]);
-    radius_scratch_.push_back(p.radius[i]);
+    ++active;
   }
   // Mixed sizes: particles larger than twice the 99th percentile of the radii, if they are at
-  // most 1 % of all, stay out of the grid (`big_`), whose cells are sized for the others.
+  // most 1 % of all, stay out of the grid (`big_`), whose cells are sized for the others. (Only
+  // looked for when the sizes span more than a factor 2: 2·r_99 ≥ 2·r_min.)
   big_.clear();
   is_big_.assign(n, 0);
   double rgrid = rmax;
-  const std::size_t active = radius_scratch_.size();
-  if (active >= 200) {
+  if (active >= 200 && rmax > 2 * rmin) {
+    radius_scratch_.clear();
+    for (std::size_t i = first; i < n; ++i)
+      if (!gone(i)) radius_scratch_.push_back(p.radius[i]);
     const std::size_t q = (active - 1) * 99 / 100;
     std::nth_element(radius_scratch_.begin(), radius_scratch_.begin() + static_cast<long>(q),
                      radius_scratch_.end());
@@ -228,18 +233,21 @@ void NeighborList::build(const ParticleState& p, const std::vector<WallState>& w
     slots_[cell_fill_[cell_of_particle_[i]]++] = {
         x[0], x[1], x[2], p.radius[i], static_cast<std::uint32_t>(i), clumped ? p.clump[i] : -1};
   }
-  // Sphere pairs, each found once: a cell with itself and with its forward neighbours. The
-  // criterion |xj − xi| < ri + rj + skin, with a relative hair of slack (more candidates
-  // are harmless; fewer are not).
+  // Whether spheres with squared centre distance d2 are candidates: d < r_a + r_b + skin, with a
+  // relative hair of slack (more candidates are harmless; fewer are not).
+  auto candidates = [&](double d2, double ra, double rb) {
+    const double reach = ra + rb + skin;
+    return d2 < reach * reach * (1 + 1e-12);
+  };
+  // Sphere pairs, each found once: a cell with itself and with its forward neighbours.
   found_.clear();
   const bool no_wrap[3] = {false, false, false};
   for_each_slot_pair(
       dims, no_wrap, cell_start_, [&](std::uint32_t s, std::uint32_t t, const Eigen::Vector3i&) {
         const Slot &a = slots_[s], &b = slots_[t];
         if (a.clump >= 0 && a.clump == b.clump) return;  // one clump
-        const double reach = a.r + b.r + skin;
         const double dx = b.x - a.x, dy = b.y - a.y, dz = b.z - a.z;
-        if (dx * dx + dy * dy + dz * dz < reach * reach * (1 + 1e-12))
+        if (candidates(dx * dx + dy * dy + dz * dz, a.r, b.r))
           found_.emplace_back(std::min(a.index, b.index), std::max(a.index, b.index));
       });
   // The large particles: with each other, and with the slots of the cells their reach covers.
@@ -251,8 +259,7 @@ void NeighborList::build(const ParticleState& p, const std::vector<WallState>& w
     const Eigen::Vector3d& xa = p.pos[a];
     for (std::size_t l = k + 1; l < big_.size(); ++l) {
       const std::uint32_t b = big_[l];
-      const double reach = p.radius[a] + p.radius[b] + skin;
-      if (!same_clump(a, b) && (p.pos[b] - xa).squaredNorm() < reach * reach * (1 + 1e-12))
+      if (!same_clump(a, b) && candidates((p.pos[b] - xa).squaredNorm(), p.radius[a], p.radius[b]))
         found_.emplace_back(std::min(a, b), std::max(a, b));
     }
     const Eigen::Vector3d span = Eigen::Vector3d::Constant(p.radius[a] + rgrid + skin);
@@ -264,9 +271,8 @@ void NeighborList::build(const ParticleState& p, const std::vector<WallState>& w
           for (std::uint32_t t = cell_start_[ci]; t < cell_start_[ci + 1]; ++t) {
             const Slot& b = slots_[t];
             if (same_clump(a, b.index)) continue;
-            const double reach = p.radius[a] + b.r + skin;
             const double dx = b.x - xa[0], dy = b.y - xa[1], dz = b.z - xa[2];
-            if (dx * dx + dy * dy + dz * dz < reach * reach * (1 + 1e-12))
+            if (candidates(dx * dx + dy * dy + dz * dz, p.radius[a], b.r))
               found_.emplace_back(std::min(a, b.index), std::max(a, b.index));
           }
         }

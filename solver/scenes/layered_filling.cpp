@@ -1,7 +1,6 @@
 #include "layered_filling.hpp"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <random>
 #include <unordered_map>
@@ -133,28 +132,28 @@ std::vector<Eigen::Vector3d> place_in_region(const Simulation& sim,
     // (along gravity; x then y within a level when gravity is along z).
     const double rl = *std::max_element(radii.begin(), radii.end());
     const double a = 1.05 * 2 * rl, jitter = 0.01 * 2 * rl;
-    std::array<std::int64_t, 3> n{};
+    Eigen::Array3d count;  // sites per axis
     for (int k = 0; k < 3; ++k) {
       const double span = hi[k] - lo[k] - 2 * rl;
       if (span < 0) return out;
-      n[static_cast<std::size_t>(k)] = static_cast<std::int64_t>(std::floor(span / a)) + 1;
+      count[k] = std::floor(span / a) + 1;
     }
     const Eigen::Vector3d g = sim.config().gravity;
     int up = 2;  // the axis most along gravity is the slowest index, walked against gravity
     for (int k = 0; k < 3; ++k)
       if (std::abs(g[k]) > std::abs(g[up])) up = k;
     const int u = (up + 1) % 3, v = (up + 2) % 3;
-    const auto nu = static_cast<std::size_t>(up), nuu = static_cast<std::size_t>(u),
-               nvv = static_cast<std::size_t>(v);
-    const std::int64_t sites = n[nu] * n[nuu] * n[nvv];
+    const auto levels = static_cast<std::int64_t>(count[up]),
+               nu = static_cast<std::int64_t>(count[u]), nv = static_cast<std::int64_t>(count[v]);
+    const std::int64_t sites = levels * nu * nv;
     std::int64_t next = 0;
     for (const double r : radii) {
       bool placed = false;
       while (!placed && next < sites) {
         const std::int64_t s = next++;
-        std::int64_t level = s / (n[nuu] * n[nvv]);
-        if (g[up] > 0) level = n[nu] - 1 - level;  // gravity along +axis: fill from the top
-        const std::int64_t iv = (s / n[nuu]) % n[nvv], iu = s % n[nuu];
+        std::int64_t level = s / (nu * nv);
+        if (g[up] > 0) level = levels - 1 - level;  // gravity along +axis: fill from the top
+        const std::int64_t iv = (s / nu) % nv, iu = s % nu;
         Eigen::Vector3d x;
         x[up] = lo[up] + rl + static_cast<double>(level) * a;
         x[u] = lo[u] + rl + static_cast<double>(iu) * a;

@@ -694,6 +694,24 @@ void read_materials(const Reader& r, const toml::table& root, bool hertz, Scene&
 }
 
 /// The material a wall or mesh names (`material = "steel"`; default the first).
+/// When a wall or a mesh is switched off: `off_at_s` (a time) and `off_after_fill` (when the
+/// [fill] has settled), e.g. a lid under an outlet.
+struct SwitchOff {
+  double at_s = HUGE_VAL;
+  bool after_fill = false;
+};
+SwitchOff read_switch_off(const Reader& r, const toml::table* t, const std::string& sec) {
+  SwitchOff o;
+  o.at_s = r.number(t, sec, "off_at_s", false, HUGE_VAL);
+  if (!(o.at_s >= 0)) r.fail(sec + ".off_at_s", "must be >= 0", value_str(o.at_s));
+  if (t->contains("off_after_fill")) {
+    const auto* v = (*t)["off_after_fill"].as_boolean();
+    if (!v) r.fail(sec + ".off_after_fill", "expected true or false");
+    o.after_fill = v->get();
+  }
+  return o;
+}
+
 int material_index(const Reader& r, const Scene& s, const toml::table* t, const std::string& sec) {
   if (!t->contains("material")) return 0;
   const std::string name = r.string(t, sec, "material", true, "");
@@ -1259,15 +1277,9 @@ Scene load_scene(const std::filesystem::path& path, int sweep_point) {
         spec.servo_max_velocity = r.positive(servo, ss, "max_velocity_m_s", true, 0);
         if (spec.shape == WallShape::Box) spec.normal = r.vec3(servo, ss, "axis", true, {});
       }
-      // Switched off at a time or when the [fill] has settled (a lid under an outlet).
-      spec.off_at_s = r.number(w, sec, "off_at_s", false, HUGE_VAL);
-      if (!(spec.off_at_s >= 0))
-        r.fail(sec + ".off_at_s", "must be >= 0", value_str(spec.off_at_s));
-      if (w->contains("off_after_fill")) {
-        const auto* v = (*w)["off_after_fill"].as_boolean();
-        if (!v) r.fail(sec + ".off_after_fill", "expected true or false");
-        if (v->get()) s.open_after_fill.push_back(s.walls.size());
-      }
+      const SwitchOff off = read_switch_off(r, w, sec);
+      spec.off_at_s = off.at_s;
+      if (off.after_fill) s.open_after_fill.push_back(s.walls.size());
       s.walls.push_back(spec);
     }
   }
@@ -1314,8 +1326,7 @@ Scene load_scene(const std::filesystem::path& path, int sweep_point) {
           hi = hi.cwiseMax(v);
         }
       const Eigen::Vector3d centre = r.vec3(m, sec, "rotation_center_m", false, 0.5 * (lo + hi));
-      const double off_at = r.number(m, sec, "off_at_s", false, HUGE_VAL);
-      if (!(off_at >= 0)) r.fail(sec + ".off_at_s", "must be >= 0", value_str(off_at));
+      const SwitchOff off = read_switch_off(r, m, sec);
       WallSpec servo;
       if (const auto* sv = (*m)["servo"].as_table()) {
         const std::string ss = sec + ".servo";
@@ -1326,12 +1337,6 @@ Scene load_scene(const std::filesystem::path& path, int sweep_point) {
         servo.servo_max_velocity = r.positive(sv, ss, "max_velocity_m_s", true, 0);
         servo.normal = r.vec3(sv, ss, "axis", true, {});
         if (!(servo.normal.norm() > 0)) r.fail(ss + ".axis", "must not be zero");
-      }
-      bool off_after_fill = false;
-      if (m->contains("off_after_fill")) {
-        const auto* v = (*m)["off_after_fill"].as_boolean();
-        if (!v) r.fail(sec + ".off_after_fill", "expected true or false");
-        off_after_fill = v->get();
       }
       const int body = static_cast<int>(i);
       const int mesh_material = material_index(r, s, m, sec);
@@ -1344,14 +1349,14 @@ Scene load_scene(const std::filesystem::path& path, int sweep_point) {
           w.rotation_center = centre;
           w.body = body;
           w.mesh = name.empty() ? mesh_path.stem().string() : name;
-          w.off_at_s = off_at;
+          w.off_at_s = off.at_s;
           w.material = mesh_material;
           w.servo_stress_Pa = servo.servo_stress_Pa;
           w.servo_area_m2 = servo.servo_area_m2;
           w.servo_gain = servo.servo_gain;
           w.servo_max_velocity = servo.servo_max_velocity;
           w.normal = servo.normal;
-          if (off_after_fill) s.open_after_fill.push_back(s.walls.size());
+          if (off.after_fill) s.open_after_fill.push_back(s.walls.size());
           s.walls.push_back(std::move(w));
         }
       } catch (const std::invalid_argument& e) {
