@@ -15,13 +15,16 @@
 //  * v, path (a) `bicgstab` (the paper's): eq 18 exactly as written, BiCGSTAB (Eigen, diagonal
 //    preconditioner). In 3D its matrix is −CᵀMC (C the P1 curl, M = diag|T_k|): the normal
 //    equations of eq 11; negative definite on generic meshes but conditioned like h^-4.
-//  * v, path (b) `cholmod` (`auto`, the default, picks it or `cg`) and its variants `ldlt` (path c:
-//  Eigen SimplicialLDLT) and
-//    `cg` (Jacobi-preconditioned CG): the component-wise Laplacian K v_a = (Σ_k |T_k| ξ_k ×
-//    (∇φ_i)_k)_a with the same K as for u, factored once for all 1 + (1 or 3) right-hand sides.
-//    Since K⊗I = CᵀMC + DᵀMD exactly for P1 fields vanishing on the hull (D the P1 divergence),
-//    this minimises ‖∇×v − ξ‖² + ‖∇·v‖² (Coulomb gauge as a penalty): identical to eq 18 in 2D,
+//  * v, path (b) `cholmod` and its variants `ldlt` (path c: Eigen SimplicialLDLT) and `cg`
+//    (Jacobi-preconditioned CG): the component-wise Laplacian K v_a = (Σ_k |T_k| ξ_k × (∇φ_i)_k)_a
+//    with the same K as for u, factored once for all 1 + (1 or 3) right-hand sides. Since
+//    K⊗I = CᵀMC + DᵀMD exactly for P1 fields vanishing on the hull (D the P1 divergence), this
+//    minimises ‖∇×v − ξ‖² + ‖∇·v‖² (Coulomb gauge as a penalty): identical to eq 18 in 2D,
 //    identical in 3D when the minimiser is divergence-free; otherwise ⟨∇×v, h⟩ = ‖∇·v‖², reported.
+//  * v, `projection` (`auto`, the default in 3D): eq 18's system CᵀMC v = CᵀMξ itself (the
+//    paper's L2 projection, path (a)'s answer), by conjugate gradients preconditioned with path
+//    (b)'s Laplacian factor and block Jacobi: ∇×v ⊥ h and ∇×v ⊥ ∇u to round-off. In 2D it is
+//    path (b).
 #pragma once
 
 #include <Eigen/Core>
@@ -33,23 +36,27 @@
 namespace gs::analysis {
 
 enum class HhdSolver {
-  Auto,      // path (b): Cholmod in 2D and up to kHhdAutoDirectMax unknowns in 3D, Cg above
-  Cholmod,   // path (b): Laplacian, CHOLMOD Cholesky (supernodal/simplicial as CHOLMOD picks)
-  Ldlt,      // path (c): Laplacian, Eigen SimplicialLDLT (AMD ordering)
-  Cg,        // path (b) iterative: Laplacian, Jacobi-preconditioned conjugate gradients
-  BiCgStab,  // path (a): eq 17 and eq 18 as written, BiCGSTAB (the paper's)
+  Auto,        // 3D: Projection; 2D: Cholmod (in 2D path (b) is eq 18 exactly)
+  Projection,  // eq 18 as the paper defines it, solved as a projection (3D: PCG on CᵀMC with the
+               // Laplacian factor and block Jacobi; 2D: path (b), the same system)
+  Cholmod,     // path (b): Laplacian, CHOLMOD Cholesky (supernodal/simplicial as CHOLMOD picks)
+  Ldlt,        // path (c): Laplacian, Eigen SimplicialLDLT (AMD ordering)
+  Cg,          // path (b) iterative: Laplacian, Jacobi-preconditioned conjugate gradients
+  BiCgStab,    // path (a): eq 17 and eq 18 as written, BiCGSTAB (the paper's)
 };
 const char* hhd_solver_name(HhdSolver s);
-/// 3D meshes with more unknowns use CG under HhdSolver::Auto: with Debian's reference BLAS the
-/// supernodal factorization of a 3D Laplacian (O(N^2) flops) is slower than Jacobi-CG beyond
-/// ~2e4 nodes (bench/bench_hhd.cpp).
-inline constexpr std::size_t kHhdAutoDirectMax = 20000;
-/// "auto", "cholmod", "ldlt", "cg", "bicgstab"; throws std::invalid_argument listing them.
+/// Default relative residual of the iterative paths `cg` and `bicgstab`, per system.
+inline constexpr double kHhdTolerance = 1e-10;
+/// Default relative residual of eq 18 for `projection` in 3D: ∇×v is then within ~0.5× this of
+/// the exact projection (measured, docs/hhd.md), ∇×v ⊥ h to round-off whatever the tolerance.
+inline constexpr double kHhdProjectionTolerance = 1e-7;
+/// "auto", "projection", "cholmod", "ldlt", "cg", "bicgstab"; throws std::invalid_argument
+/// listing them.
 HhdSolver hhd_solver_from_name(const std::string& name);
 
 struct HhdOptions {
   HhdSolver solver = HhdSolver::Auto;
-  double tolerance = 1e-10;    // iterative solvers: relative residual ‖r‖/‖b‖ per system
+  double tolerance = 0.0;  // iterative solvers: relative residual ‖r‖/‖b‖ per system; 0: default
   int max_iterations = 10000;  // iterative solvers, per system
 };
 
@@ -88,6 +95,7 @@ std::vector<double> p1_divergence(const HhdMesh& mesh, const P1Geometry& g,
 
 struct HhdReport {
   std::string solver;        // the one used (auto resolved)
+  double tolerance = 0.0;    // the relative residual the iterative solver aimed at (0: direct)
   std::size_t unknowns = 0;  // nodes solved for (not Dirichlet, in a simplex of positive measure)
   int iterations_u = 0, iterations_v = 0;  // iterative solvers (v: the most over components)
   bool converged = true;                   // iterative solvers reached `tolerance`
@@ -102,6 +110,12 @@ struct HhdResult {
   int dim = 3;
   Eigen::VectorXd u;  // scalar potential per node (units of ξ × length)
   Eigen::MatrixXd v;  // vector potential per node: N×3, or N×1 (v_z) in 2D
+  // The potential the vortex centres and tubes use (seed 000 §5–6): `projection` in 3D gives
+  // path (b)'s v, the solution of (K⊗I) w = CᵀMξ = CᵀM(∇×v), i.e. the potential of eq 18's curl
+  // part with ∇·w penalised (Coulomb gauge). Eq 18 fixes only ∇×v: its own P1 v carries a
+  // discretisation gauge (‖∇·v‖ ≫ ‖∇×v‖ on irregular meshes) that would make |v| maxima noise.
+  // Every other path: equal to v.
+  Eigen::MatrixXd v_coulomb;
   std::vector<double> measure;
   std::vector<Eigen::Vector3d> xi, grad_u, curl_v, harmonic;  // per simplex (z = 0 in 2D)
   // Measure-weighted L2 norms ‖a‖ = sqrt(Σ_k |T_k| a_k·a_k) and inner products of the parts.

@@ -63,6 +63,9 @@ VortexAnalysis analyze_vortices(const std::vector<Eigen::Vector3d>& points,
   a.excluded = a.mesh.dirichlet;
   for (std::size_t i = a.true_nodes; i < a.excluded.size(); ++i) a.excluded[i] = 1;
   a.extrema = find_extrema(a.hhd, a.rings, a.excluded, o.axis);
+  mark_significant(a.extrema, o.significance_relative, o.significance_absolute);
+  a.significance_relative = o.significance_relative;
+  a.significance_absolute = o.significance_absolute;
   if (o.tubes) {
     a.tubes = trace_vortex_tubes(a.mesh, a.hhd, a.rings, a.extrema, o.tube_delta, a.excluded);
   }
@@ -70,10 +73,19 @@ VortexAnalysis analyze_vortices(const std::vector<Eigen::Vector3d>& points,
   return a;
 }
 
-std::array<std::size_t, 4> count_extrema(const std::vector<Extremum>& extrema) {
+std::array<std::size_t, 4> count_extrema(const std::vector<Extremum>& extrema,
+                                         bool significant_only) {
   std::array<std::size_t, 4> c{0, 0, 0, 0};
-  for (const auto& e : extrema) ++c[static_cast<std::size_t>(e.kind)];
+  for (const auto& e : extrema)
+    if (e.significant || !significant_only) ++c[static_cast<std::size_t>(e.kind)];
   return c;
+}
+
+std::size_t count_significant_tubes(const std::vector<VortexTube>& tubes,
+                                    const std::vector<Extremum>& extrema) {
+  std::size_t n = 0;
+  for (const auto& t : tubes) n += extrema.at(t.extremum).significant ? 1 : 0;
+  return n;
 }
 
 }  // namespace gs::analysis

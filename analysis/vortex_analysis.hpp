@@ -23,6 +23,8 @@ struct VortexAnalysisOptions {
   Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();  // 3D handedness axis
   double tube_delta = 0.05;                         // δ of §6
   bool tubes = true;
+  double significance_relative = kSignificanceRelative;  // see mark_significant
+  double significance_absolute = 0.0;                    // in the potentials' units (ξ × m)
 };
 
 struct VortexAnalysis {
@@ -34,6 +36,7 @@ struct VortexAnalysis {
   HhdResult hhd;
   std::vector<Extremum> extrema;
   std::vector<VortexTube> tubes;
+  double significance_relative = 0.0, significance_absolute = 0.0;  // as applied
   double seconds_ghosts = 0.0, seconds_delaunay = 0.0, seconds_detection = 0.0;
 };
 
@@ -44,7 +47,12 @@ VortexAnalysis analyze_vortices(const std::vector<Eigen::Vector3d>& points,
                                 const std::vector<Eigen::Vector3d>& vectors, int dim,
                                 const VortexAnalysisOptions& options = {});
 
-/// Counts of each extremum kind among `extrema`, indexed by ExtremumKind.
-std::array<std::size_t, 4> count_extrema(const std::vector<Extremum>& extrema);
+/// Counts of each extremum kind among `extrema` (only the significant ones when
+/// `significant_only`), indexed by ExtremumKind.
+std::array<std::size_t, 4> count_extrema(const std::vector<Extremum>& extrema,
+                                         bool significant_only);
+/// Tubes whose vortex centre is significant.
+std::size_t count_significant_tubes(const std::vector<VortexTube>& tubes,
+                                    const std::vector<Extremum>& extrema);
 
 }  // namespace gs::analysis

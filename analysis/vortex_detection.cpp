@@ -24,8 +24,8 @@ int strict_extremum(const std::vector<double>& f, const VertexRings& rings, std:
 }
 
 Eigen::Vector3d potential(const HhdResult& r, std::int32_t i) {
-  if (r.dim == 3) return r.v.row(i).transpose();
-  return Eigen::Vector3d(0.0, 0.0, r.v(i, 0));
+  if (r.dim == 3) return r.v_coulomb.row(i).transpose();
+  return Eigen::Vector3d(0.0, 0.0, r.v_coulomb(i, 0));
 }
 
 }  // namespace
@@ -59,7 +59,7 @@ std::vector<Extremum> find_extrema(const HhdResult& r, const VertexRings& rings,
   std::vector<double> vortex(n), u(n);
   for (std::size_t i = 0; i < n; ++i) {
     const auto ii = static_cast<Eigen::Index>(i);
-    vortex[i] = r.dim == 3 ? r.v.row(ii).norm() : r.v(ii, 0);
+    vortex[i] = r.dim == 3 ? r.v_coulomb.row(ii).norm() : r.v_coulomb(ii, 0);
     u[i] = r.u(ii);
   }
   std::vector<Extremum> out;
@@ -91,6 +91,28 @@ std::vector<Extremum> find_extrema(const HhdResult& r, const VertexRings& rings,
   return out;
 }
 
+void mark_significant(std::vector<Extremum>& extrema, double relative, double absolute) {
+  if (!(relative >= 0.0 && relative <= 1.0)) {
+    throw std::invalid_argument("relative significance must be in [0, 1] (" +
+                                std::to_string(relative) + ")");
+  }
+  if (!(absolute >= 0.0 && std::isfinite(absolute))) {
+    throw std::invalid_argument("absolute significance must be >= 0 (" + std::to_string(absolute) +
+                                ")");
+  }
+  const auto is_vortex = [](const Extremum& e) {
+    return e.kind == ExtremumKind::RightVortex || e.kind == ExtremumKind::LeftVortex;
+  };
+  double strongest[2] = {0.0, 0.0};  // vortices, sources and sinks
+  for (const auto& e : extrema) {
+    double& s = strongest[is_vortex(e) ? 0 : 1];
+    s = std::max(s, e.magnitude);
+  }
+  for (auto& e : extrema) {
+    e.significant = e.magnitude >= std::max(relative * strongest[is_vortex(e) ? 0 : 1], absolute);
+  }
+}
+
 std::vector<VortexTube> trace_vortex_tubes(const HhdMesh& mesh, const HhdResult& r,
                                            const VertexRings& rings,
                                            const std::vector<Extremum>& extrema, double delta,
@@ -101,7 +123,7 @@ std::vector<VortexTube> trace_vortex_tubes(const HhdMesh& mesh, const HhdResult&
   }
   std::vector<VortexTube> tubes;
   if (r.dim != 3) return tubes;
-  const auto norm = [&](std::int32_t i) { return r.v.row(i).norm(); };
+  const auto norm = [&](std::int32_t i) { return r.v_coulomb.row(i).norm(); };
   const auto is_excluded = [&](std::int32_t i) {
     return !excluded.empty() && excluded[static_cast<std::size_t>(i)];
   };
@@ -110,7 +132,7 @@ std::vector<VortexTube> trace_vortex_tubes(const HhdMesh& mesh, const HhdResult&
     std::vector<std::int32_t> path;
     std::vector<std::int32_t> held{start};
     std::int32_t c = start;
-    Eigen::Vector3d d = sign * r.v.row(start).transpose();
+    Eigen::Vector3d d = sign * r.v_coulomb.row(start).transpose();
     while (true) {
       const double vc = norm(c);
       std::int32_t best = -1;
@@ -132,7 +154,7 @@ std::vector<VortexTube> trace_vortex_tubes(const HhdMesh& mesh, const HhdResult&
       }
       path.push_back(best);
       held.push_back(best);
-      const Eigen::Vector3d vb = r.v.row(best).transpose();
+      const Eigen::Vector3d vb = r.v_coulomb.row(best).transpose();
       d = vb.dot(d) >= 0.0 ? vb : Eigen::Vector3d(-vb);
       c = best;
     }

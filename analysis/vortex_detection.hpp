@@ -11,6 +11,11 @@
 //    out-of-plane direction of the specimen), left-handed otherwise.
 //  * Sources (local dilatancy, ∇·ξ > 0) are minima of u, sinks (contractancy) maxima of u.
 // The magnitude of an extremum is |v_z|, |v| or |u| at the node (the circle size of Figs 8–9).
+// Significance: every strict extremum is found (a smooth field on 56 000 random points has ~800
+// noise-level u extrema, at ≤ 4e-4 of its one source); `mark_significant` flags those that
+// count (summaries, series, figures): magnitude ≥ relative × the strongest extremum of the same
+// potential (v for vortices, u for sources and sinks) and ≥ an absolute floor in the
+// potential's units (ξ × m).
 #pragma once
 
 #include <Eigen/Core>
@@ -32,7 +37,19 @@ struct Extremum {
   double value = 0.0;                           // 2D vortex: v_z; 3D vortex: |v|; source/sink: u
   double magnitude = 0.0;                       // |value|
   Eigen::Vector3d v = Eigen::Vector3d::Zero();  // vector potential at the node (2D: (0, 0, v_z))
+  bool significant = true;                      // see mark_significant
 };
+
+/// Default relative significance: 5 % of the strongest extremum of the same potential. Measured
+/// (docs/hhd.md): the noise extrema of a smooth field reach 3.1 % of its source at 1 500 random
+/// nodes and 0.04 % at 56 000; on DEM increments (plane-strain demo) every vortex is ≥ 20 % of
+/// the strongest and 75–80 % of the sources and sinks are ≥ 5 %.
+inline constexpr double kSignificanceRelative = 0.05;
+
+/// Sets Extremum::significant: magnitude ≥ max(relative × M, absolute), M the largest magnitude
+/// among the vortices (for a vortex) or among the sources and sinks (for a source or sink).
+/// Throws std::invalid_argument unless 0 ≤ relative ≤ 1 and absolute ≥ 0 (finite).
+void mark_significant(std::vector<Extremum>& extrema, double relative, double absolute = 0.0);
 
 /// All extrema of `r` (vortices first, then sources and sinks; each group by node index).
 /// `excluded` has one flag per node (empty: none).

@@ -7,6 +7,7 @@
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -45,10 +46,12 @@ struct FieldArgs {
   double ghost_spacing = 0.0, ghost_min_distance = -1.0, ghost_extent = 0.0, ghost_radius = 0.0;
   double d50 = 0.0;
   std::string solver = "auto";
-  double tolerance = 1e-10;
+  std::optional<double> tolerance;  // unset: the solver's default
   int max_iterations = 10000;
   std::vector<double> axis;
   double delta = 0.05;
+  double significance = analysis::kSignificanceRelative;
+  double significance_abs = 0.0;
 };
 
 void add_field_options(CLI::App* s, FieldArgs& a) {
@@ -67,16 +70,23 @@ void add_field_options(CLI::App* s, FieldArgs& a) {
   s->add_option("--d50", a.d50, "d50 in m for the ghost defaults (default: from the frame)");
   s->add_option(
       "--solver", a.solver,
-      "auto (default: cholmod, or cg for 3D meshes over 20000 nodes) | cholmod (path b) | "
-      "ldlt (path c) | cg (path b, iterative) | bicgstab (path a: eq 17-18 as written, "
-      "the paper's)");
-  s->add_option("--tolerance", a.tolerance, "iterative solvers: relative residual (1e-10)");
+      "auto (default: projection in 3D, cholmod in 2D) | projection (eq 18's L2 projection: "
+      "PCG preconditioned by the Laplacian factor) | cholmod (path b: Laplacian, gauge as a "
+      "penalty) | ldlt (path c) | cg (path b, iterative) | bicgstab (path a: eq 17-18 as "
+      "written, the paper's)");
+  s->add_option("--tolerance", a.tolerance,
+                "iterative solvers: relative residual (projection 1e-7, cg and bicgstab 1e-10)");
   s->add_option("--max-iterations", a.max_iterations, "iterative solvers (10000)");
   s->add_option("--axis", a.axis,
                 "3D: out-of-plane axis x y z giving the handedness of vortices (default z, or the "
                 "slab normal)")
       ->expected(3);
   s->add_option("--delta", a.delta, "vortex-tube threshold delta (seed 000 §6: 0.05)");
+  s->add_option("--significance", a.significance,
+                "extrema that count (summary, series, figures): magnitude >= this fraction of "
+                "the strongest of the same potential (0.05; 0 counts every strict extremum)");
+  s->add_option("--significance-abs", a.significance_abs,
+                "and >= this magnitude in the potential's units (vector units x m; 0)");
 }
 
 // One field to decompose: positions and vectors of the nodes (2D: in-plane coordinates).
@@ -136,8 +146,8 @@ analysis::VortexAnalysisOptions analysis_options(const FieldArgs& a, const Field
   } catch (const std::invalid_argument& e) {
     throw InputError(source, "--solver: unknown solver", a.solver);
   }
-  if (!(a.tolerance > 0.0 && a.tolerance < 1.0)) {
-    throw InputError(source, "--tolerance must be in (0, 1)", value_str(a.tolerance));
+  if (a.tolerance && !(*a.tolerance > 0.0 && *a.tolerance < 1.0)) {
+    throw InputError(source, "--tolerance must be in (0, 1)", value_str(*a.tolerance));
   }
   if (a.max_iterations < 1) {
     throw InputError(source, "--max-iterations must be >= 1", std::to_string(a.max_iterations));
@@ -145,7 +155,15 @@ analysis::VortexAnalysisOptions analysis_options(const FieldArgs& a, const Field
   if (!(a.delta >= 0.0 && a.delta < 1.0)) {
     throw InputError(source, "--delta must be in [0, 1)", value_str(a.delta));
   }
-  o.hhd.tolerance = a.tolerance;
+  if (!(a.significance >= 0.0 && a.significance <= 1.0)) {
+    throw InputError(source, "--significance must be in [0, 1]", value_str(a.significance));
+  }
+  if (!(a.significance_abs >= 0.0 && std::isfinite(a.significance_abs))) {
+    throw InputError(source, "--significance-abs must be >= 0", value_str(a.significance_abs));
+  }
+  o.significance_relative = a.significance;
+  o.significance_absolute = a.significance_abs;
+  o.hhd.tolerance = a.tolerance.value_or(0.0);
   o.hhd.max_iterations = a.max_iterations;
   o.tube_delta = a.delta;
   if (a.axis.size() == 3) {
@@ -217,14 +235,15 @@ void write_extrema_csv(const fs::path& path, const VortexAnalysis& a, const Fiel
   {
     std::ofstream o(out.temp_path());
     if (!o) throw InputError(path.string(), "cannot write file");
-    o << "kind,node,id,x,y,z,value,magnitude,vx,vy,vz\n";
+    o << "kind,node,id,x,y,z,value,magnitude,vx,vy,vz,significant\n";
     char buf[512];
     for (const auto& e : a.extrema) {
       const auto& p = a.mesh.points[static_cast<std::size_t>(e.node)];
-      std::snprintf(buf, sizeof buf, "%s,%d,%lld,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n",
+      std::snprintf(buf, sizeof buf,
+                    "%s,%d,%lld,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%d\n",
                     analysis::extremum_kind_name(e.kind), e.node,
                     static_cast<long long>(f.id[static_cast<std::size_t>(e.node)]), p.x(), p.y(),
-                    p.z(), e.value, e.magnitude, e.v.x(), e.v.y(), e.v.z());
+                    p.z(), e.value, e.magnitude, e.v.x(), e.v.y(), e.v.z(), e.significant ? 1 : 0);
       o << buf;
     }
     if (!o.flush()) throw InputError(path.string(), "write failed");
@@ -242,7 +261,7 @@ void write_tubes_vtp(const fs::path& path, const VortexAnalysis& a) {
     for (const auto i : t.nodes) {
       lines.back().push_back(static_cast<std::int64_t>(pts.size()));
       pts.push_back(a.mesh.points[static_cast<std::size_t>(i)]);
-      vnorm.push_back(a.hhd.v.row(i).norm());
+      vnorm.push_back(a.hhd.v_coulomb.row(i).norm());
     }
     kind.push_back(static_cast<double>(a.extrema[t.extremum].kind));
     magnitude.push_back(a.extrema[t.extremum].magnitude);
@@ -263,6 +282,7 @@ void write_hhd_vtu(const fs::path& path, const VortexAnalysis& a,
   write_vtu_mesh(path, a.mesh.points, dim == 3 ? 10 : 5, cells,
                  {{"u", 1, std::vector<double>(r.u.data(), r.u.data() + r.u.size())},
                   {"v", static_cast<int>(r.v.cols()), flat(r.v)},
+                  {"v_coulomb", static_cast<int>(r.v_coulomb.cols()), flat(r.v_coulomb)},
                   {"vector", 3, flat(vectors)},
                   {"ghost", 1, ghost}},
                  {{"xi", 3, flat(r.xi)},
@@ -282,6 +302,7 @@ void write_report_attrs(H5FieldFile& h, const VortexAnalysis& a) {
   h.attr("converged", static_cast<long long>(r.report.converged ? 1 : 0));
   h.attr("residual_eq17", r.report.residual_eq17);
   h.attr("residual_eq18", r.report.residual_eq18);
+  h.attr("tolerance", r.report.tolerance);
   h.attr("norm_xi", r.norm_xi);
   h.attr("norm_grad_u", r.norm_grad_u);
   h.attr("norm_curl_v", r.norm_curl_v);
@@ -304,13 +325,15 @@ double cosine(double dot, double a, double b) {
 
 void print_summary(const char* what, const VortexAnalysis& a) {
   const auto& r = a.hhd;
-  const auto c = analysis::count_extrema(a.extrema);
+  const auto c = analysis::count_extrema(a.extrema, true);
+  const auto all = analysis::count_extrema(a.extrema, false);
   std::printf(
       "%s: %zu nodes (%zu ghosts), %zu %s, solver %s (%s%d/%d iterations), "
       "residual eq17 %.2e eq18 %.2e\n"
       "  |xi| %.4g  |grad u| %.4g  |curl v| %.4g  |h| %.4g  cos(grad,curl) %.2e "
       "cos(grad,h) %.2e cos(curl,h) %.2e |div v| %.3g\n"
-      "  vortices right %zu left %zu, sources %zu, sinks %zu, tubes %zu\n"
+      "  vortices right %zu left %zu, sources %zu, sinks %zu, tubes %zu (significant: >= %g of "
+      "the strongest%s; all strict extrema: right %zu left %zu, sources %zu, sinks %zu)\n"
       "  time ghosts %.3f s, delaunay %.3f s, assembly %.3f s, factor %.3f s, solve %.3f s, "
       "detection %.3f s\n",
       what, a.mesh.points.size(), a.mesh.points.size() - a.true_nodes, a.mesh.simplices.size(),
@@ -320,8 +343,12 @@ void print_summary(const char* what, const VortexAnalysis& a) {
       r.norm_harmonic, cosine(r.dot_grad_curl, r.norm_grad_u, r.norm_curl_v),
       cosine(r.dot_grad_harmonic, r.norm_grad_u, r.norm_harmonic),
       cosine(r.dot_curl_harmonic, r.norm_curl_v, r.norm_harmonic), r.norm_div_v, c[0], c[1], c[2],
-      c[3], a.tubes.size(), a.seconds_ghosts, a.seconds_delaunay, r.report.seconds_assembly,
-      r.report.seconds_factor, r.report.seconds_solve, a.seconds_detection);
+      c[3], analysis::count_significant_tubes(a.tubes, a.extrema), a.significance_relative,
+      a.significance_absolute > 0.0 ? (" and >= " + value_str(a.significance_absolute)).c_str()
+                                    : "",
+      all[0], all[1], all[2], all[3], a.seconds_ghosts, a.seconds_delaunay,
+      r.report.seconds_assembly, r.report.seconds_factor, r.report.seconds_solve,
+      a.seconds_detection);
 }
 
 // ---- analyze hhd ---------------------------------------------------------------------------
@@ -385,6 +412,8 @@ void run_hhd(const HhdArgs& a) {
   h.write("/nodes/id", f.id);
   h.write("/nodes/u", std::vector<double>(r.hhd.u.data(), r.hhd.u.data() + r.hhd.u.size()));
   write_rows(h, "/nodes/v", flat(r.hhd.v), static_cast<std::size_t>(r.hhd.v.cols()));
+  write_rows(h, "/nodes/v_coulomb", flat(r.hhd.v_coulomb),
+             static_cast<std::size_t>(r.hhd.v_coulomb.cols()));
   std::vector<std::uint8_t> ghost(r.mesh.points.size(), 0);
   for (std::size_t i = r.true_nodes; i < ghost.size(); ++i) ghost[i] = 1;
   h.write("/nodes/ghost", ghost);
@@ -399,6 +428,7 @@ void run_hhd(const HhdArgs& a) {
   write_rows(h, "/simplices/curl_v", flat(r.hhd.curl_v), 3);
   write_rows(h, "/simplices/harmonic", flat(r.hhd.harmonic), 3);
   std::vector<std::int32_t> enode, ekind;
+  std::vector<std::uint8_t> esig;
   std::vector<double> evalue, emag;
   std::vector<Eigen::Vector3d> epos, ev;
   for (const auto& e : r.extrema) {
@@ -406,6 +436,7 @@ void run_hhd(const HhdArgs& a) {
     ekind.push_back(static_cast<std::int32_t>(e.kind));
     evalue.push_back(e.value);
     emag.push_back(e.magnitude);
+    esig.push_back(e.significant ? 1 : 0);
     epos.push_back(r.mesh.points[static_cast<std::size_t>(e.node)]);
     ev.push_back(e.v);
   }
@@ -414,6 +445,9 @@ void run_hhd(const HhdArgs& a) {
   h.write("/extrema/kind", ekind);
   h.write("/extrema/value", evalue);
   h.write("/extrema/magnitude", emag);
+  h.write("/extrema/significant", esig);
+  h.attr("significance_relative", r.significance_relative, "/extrema");
+  h.attr("significance_absolute", r.significance_absolute, "/extrema");
   write_rows(h, "/extrema/position", flat(epos), 3);
   write_rows(h, "/extrema/v", flat(ev), 3);
   std::vector<std::int64_t> offsets{0};
@@ -439,7 +473,7 @@ void run_hhd(const HhdArgs& a) {
   print_summary("hhd", r);
   if (!r.hhd.report.converged) {
     std::printf("warning: %s did not reach --tolerance %.1e in %d iterations\n",
-                r.hhd.report.solver.c_str(), a.field.tolerance, a.field.max_iterations);
+                r.hhd.report.solver.c_str(), r.hhd.report.tolerance, a.field.max_iterations);
   }
 }
 
@@ -495,6 +529,7 @@ void run_vortices(const SeriesArgs& a) {
   std::vector<std::int64_t> f0, f1;
   std::vector<double> time, strain;
   std::vector<std::int32_t> right, left, sources, sinks, tubes;
+  std::array<std::vector<std::int32_t>, 4> all_counts;  // every strict extremum
   for (long k = a.from; k + a.every <= last; k += stride) {
     cache.erase(cache.begin(), cache.lower_bound(k));
     const Frame& ref = frame(k);
@@ -502,7 +537,9 @@ void run_vortices(const SeriesArgs& a) {
     const FrameMotion m = motion_between(ref, frame(k + a.every), a.input);
     const Field f = field_from_motion(m, a.field, a.input);
     const VortexAnalysis r = run_analysis(f, analysis_options(a.field, f, a.input), a.input);
-    const auto c = analysis::count_extrema(r.extrema);
+    const auto c = analysis::count_extrema(r.extrema, true);
+    const auto all = analysis::count_extrema(r.extrema, false);
+    for (std::size_t q = 0; q < 4; ++q) all_counts[q].push_back(static_cast<std::int32_t>(all[q]));
     f0.push_back(k);
     f1.push_back(k + a.every);
     time.push_back(ref.time);
@@ -511,7 +548,8 @@ void run_vortices(const SeriesArgs& a) {
     left.push_back(static_cast<std::int32_t>(c[1]));
     sources.push_back(static_cast<std::int32_t>(c[2]));
     sinks.push_back(static_cast<std::int32_t>(c[3]));
-    tubes.push_back(static_cast<std::int32_t>(r.tubes.size()));
+    tubes.push_back(
+        static_cast<std::int32_t>(analysis::count_significant_tubes(r.tubes, r.extrema)));
     std::printf("frames %ld-%ld strain %.5f: right %zu left %zu sources %zu sinks %zu (%.2f s)\n",
                 k, k + a.every, eps, c[0], c[1], c[2], c[3],
                 r.seconds_delaunay + r.hhd.report.seconds_assembly + r.hhd.report.seconds_factor +
@@ -536,6 +574,12 @@ void run_vortices(const SeriesArgs& a) {
   h.write("/series/sources", sources);
   h.write("/series/sinks", sinks);
   h.write("/series/tubes", tubes);
+  h.write("/series/right_all", all_counts[0]);
+  h.write("/series/left_all", all_counts[1]);
+  h.write("/series/sources_all", all_counts[2]);
+  h.write("/series/sinks_all", all_counts[3]);
+  h.attr("significance_relative", a.field.significance);
+  h.attr("significance_absolute", a.field.significance_abs);
   // Fourier spectrum of the counts against strain (Figs 17–18), when strain increases strictly.
   const bool increasing =
       strain.size() >= 4 && std::adjacent_find(strain.begin(), strain.end(),

@@ -113,6 +113,7 @@ int main(int argc, char** argv) {
                 d.simplices.size(), delaunay_s);
     const auto b = run_path(m, xi, f, HhdSolver::Cholmod, 1);
     print_path("path b  cholmod", b);
+    print_path("eq18 projection (pcg)", run_path(m, xi, f, HhdSolver::Projection, 10000));
     const auto cg = run_path(m, xi, f, HhdSolver::Cg, 100000);
     print_path("path b' cg (Jacobi)", cg);
     if (static_cast<long>(m.points.size()) <= ldlt_max) {

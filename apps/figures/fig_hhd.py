@@ -5,7 +5,9 @@ each drawn with a line-integral-convolution texture (Cabral & Leedom 1993, seed 
 coloured by the field's magnitude; vortex centres on the curl v panel and sources/sinks on the
 grad u panel as circles whose diameter grows with the extremum's magnitude (green: right-handed
 vortices / sources, red: left-handed vortices / sinks, as in Figs 8-9). Ghost nodes are not drawn.
-3D: the vortex tubes (line width growing with |v|) and the vortex centres (Fig. 11).
+3D: the vortex tubes (line width growing with |v| of the Coulomb potential they follow) and the
+vortex centres (Fig. 11). Only the significant extrema (/extrema/significant, `--significance`)
+and their tubes are drawn; the HDF5 file and the CSV keep every one.
 """
 import h5py
 import numpy as np
@@ -30,6 +32,11 @@ def make(input_path, out_dir, args):
                                       "simplices/curl_v", "simplices/harmonic", "extrema/node",
                                       "extrema/kind", "extrema/magnitude", "tubes/offsets",
                                       "tubes/nodes", "tubes/extremum")}
+        # Files from before the significance threshold: every extremum counts.
+        data["nodes/v_coulomb"] = f["nodes/v_coulomb"][()] if "nodes/v_coulomb" in f \
+            else data["nodes/v"]
+        data["extrema/significant"] = f["extrema/significant"][()].astype(bool) \
+            if "extrema/significant" in f else np.ones(len(data["extrema/kind"]), bool)
     if dim == 2:
         return [_four_fields(data, out_dir)]
     return [_tubes_3d(data, out_dir)]
@@ -99,9 +106,10 @@ def _four_fields(d, out_dir):
              ("simplices/harmonic", "harmonic part h (Fig. 10)")]
     grids, _ = _grid_fields(pos, tri, [d[n] for n, _ in names], region)
     fig, axes = plt.subplots(1, 4, figsize=(18, 5.2))
-    kind = d["extrema/kind"]
-    node = d["extrema/node"]
-    mag = d["extrema/magnitude"]
+    sig = d["extrema/significant"]  # only the significant extrema are drawn
+    kind = d["extrema/kind"][sig]
+    node = d["extrema/node"][sig]
+    mag = d["extrema/magnitude"][sig]
     for ax, g, (_, title), k in zip(axes, grids, names, range(4)):
         vx, vy = np.nan_to_num(g[..., 0]), np.nan_to_num(g[..., 1])
         m = np.hypot(vx, vy)
@@ -138,18 +146,20 @@ def _four_fields(d, out_dir):
 
 def _tubes_3d(d, out_dir):
     pos = d["nodes/position"]
-    v = d["nodes/v"]
+    v = d["nodes/v_coulomb"]  # the potential the centres and tubes are found on
     vn = np.linalg.norm(v, axis=1) if v.ndim == 2 else np.abs(v)
     off = d["tubes/offsets"]
     nodes = d["tubes/nodes"]
-    kind = d["extrema/kind"]
-    node = d["extrema/node"]
+    sig = d["extrema/significant"]
+    tube_sig = sig[d["tubes/extremum"]] if len(d["tubes/extremum"]) else np.zeros(0, bool)
+    kind = d["extrema/kind"][sig]
+    node = d["extrema/node"][sig]
     fig = plt.figure(figsize=(7, 7))
     ax = fig.add_subplot(projection="3d")
     top = vn.max() if vn.size and vn.max() > 0 else 1.0
     for t in range(len(off) - 1):
         path = nodes[off[t]:off[t + 1]]
-        if len(path) < 2:
+        if len(path) < 2 or not tube_sig[t]:
             continue
         p = pos[path]
         ax.plot(p[:, 0], p[:, 1], p[:, 2], color="green",

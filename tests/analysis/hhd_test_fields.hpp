@@ -105,4 +105,36 @@ struct AnalyticField {
   }
 };
 
+/// N uniformly random points in the unit cube (seeded), their Delaunay mesh, Dirichlet = hull:
+/// an irregular mesh with slivers, as DEM centres and users' point clouds give.
+inline analysis::HhdMesh random_cube_mesh(std::size_t n, unsigned seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  analysis::HhdMesh m;
+  m.dim = 3;
+  for (std::size_t i = 0; i < n; ++i) m.points.emplace_back(u(rng), u(rng), u(rng));
+  const auto d = analysis::delaunay_mesh(m.points);
+  m.simplices = d.simplices;
+  m.dirichlet = d.on_hull;
+  return m;
+}
+
+/// The field a new user tries first (issue 20's table): a Lamb–Oseen vortex along z through
+/// (0.5, 0.5) (circulation 1, core radius 0.1), a Gaussian source at (0.3, 0.6, 0.4) (width 0.1)
+/// and a uniform translation (0.2, 0.1, 0). Its vortex crosses the hull, so its N-P vector
+/// potential is not divergence-free: paths (a) and (b) differ on it.
+inline Eigen::Vector3d vortex_source_translation(const Eigen::Vector3d& p) {
+  const double rc = 0.1, circulation = 1.0, s = 0.1;
+  const Eigen::Vector3d d(p.x() - 0.5, p.y() - 0.5, 0.0);
+  const double r2 = d.squaredNorm();
+  Eigen::Vector3d vortex = Eigen::Vector3d::Zero();
+  if (r2 > 0.0) {
+    vortex = circulation / (2.0 * std::numbers::pi * r2) * (1.0 - std::exp(-r2 / (rc * rc))) *
+             Eigen::Vector3d(-d.y(), d.x(), 0.0);
+  }
+  const Eigen::Vector3d e = p - Eigen::Vector3d(0.3, 0.6, 0.4);
+  const Eigen::Vector3d source = 0.5 * e * std::exp(-e.squaredNorm() / (2 * s * s)) / (s * s);
+  return vortex + source + Eigen::Vector3d(0.2, 0.1, 0.0);
+}
+
 }  // namespace gs::test

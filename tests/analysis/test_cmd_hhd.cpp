@@ -19,6 +19,7 @@
 
 #include "cli_util.hpp"
 #include "hdf5_trajectory.hpp"
+#include "hhd_test_fields.hpp"
 
 namespace fs = std::filesystem;
 
@@ -49,25 +50,27 @@ Eigen::Vector2d lamb_oseen(const Eigen::Vector2d& x, const Eigen::Vector2d& c, d
   return ut * Eigen::Vector2d(-d.y(), d.x()) / std::sqrt(r2);
 }
 
-// Extrema rows of kind `kind` from the CSV output: (x, y, z, magnitude).
-std::vector<std::array<double, 4>> extrema_rows(const fs::path& csv, const std::string& kind) {
+// Extrema rows of kind `kind` from the CSV output: (x, y, z, magnitude, significant).
+std::vector<std::array<double, 5>> extrema_rows(const fs::path& csv, const std::string& kind) {
   std::ifstream in(csv);
   std::string line;
   std::getline(in, line);
-  EXPECT_EQ(line, "kind,node,id,x,y,z,value,magnitude,vx,vy,vz");
-  std::vector<std::array<double, 4>> out;
+  EXPECT_EQ(line, "kind,node,id,x,y,z,value,magnitude,vx,vy,vz,significant");
+  std::vector<std::array<double, 5>> out;
   while (std::getline(in, line)) {
     std::stringstream s(line);
-    std::string f[11];
+    std::string f[12];
     for (auto& x : f) std::getline(s, x, ',');
-    if (f[0] == kind)
-      out.push_back({std::stod(f[3]), std::stod(f[4]), std::stod(f[5]), std::stod(f[7])});
+    if (f[0] == kind) {
+      out.push_back(
+          {std::stod(f[3]), std::stod(f[4]), std::stod(f[5]), std::stod(f[7]), std::stod(f[11])});
+    }
   }
   return out;
 }
 
-std::array<double, 4> strongest(const std::vector<std::array<double, 4>>& rows) {
-  std::array<double, 4> best{0, 0, 0, -1};
+std::array<double, 5> strongest(const std::vector<std::array<double, 5>>& rows) {
+  std::array<double, 5> best{0, 0, 0, -1, 0};
   for (const auto& r : rows)
     if (r[3] > best[3]) best = r;
   return best;
@@ -229,6 +232,10 @@ TEST(CmdHhd, Trajectory3DTubesSliceAndSeries) {
     EXPECT_GT(strain[i], strain[i - 1]);
   }
   for (auto l : lefts) EXPECT_GE(l, 1);
+  const auto lefts_all =
+      read_array<std::int32_t>(dir / "v.h5", "/series/left_all", H5T_NATIVE_INT32);
+  ASSERT_EQ(lefts_all.size(), lefts.size());
+  for (std::size_t i = 0; i < lefts.size(); ++i) EXPECT_GE(lefts_all[i], lefts[i]);
   EXPECT_EQ(read_array<double>(dir / "v.h5", "/spectrum/left/period", H5T_NATIVE_DOUBLE).size(),
             4u);
   ASSERT_EQ(run("figures " + (dir / "v.h5").string() + " -o " + (dir / "fv").string(), dir / "log"),
@@ -370,6 +377,70 @@ TEST(CmdHhd, ToleranceOfTheIterativeSolver) {
   fs::remove_all(dir);
 }
 
+TEST(CmdHhd, ProjectionDefaultAndSignificantExtrema3D) {
+  // Issue 20's field (vortex across the hull + Gaussian source + translation) on 1 500 random
+  // points: the default 3D solver is eq 18's projection, with orthogonal parts; one source is
+  // counted, though u has many noise-level strict extrema (all in the CSV, flagged).
+  const auto dir = temp_dir();
+  std::mt19937_64 rng(12);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  {
+    std::ofstream o(dir / "f.csv");
+    o << "x,y,z,ux,uy,uz\n";
+    o.precision(17);
+    for (int i = 0; i < 1500; ++i) {
+      const Eigen::Vector3d x(u(rng), u(rng), u(rng));
+      const Eigen::Vector3d v = gs::test::vortex_source_translation(x);
+      o << x.x() << "," << x.y() << "," << x.z() << "," << v.x() << "," << v.y() << "," << v.z()
+        << "\n";
+    }
+  }
+  const auto analyze = [&](const std::string& extra) {
+    const std::string cmd = "analyze hhd --csv " + (dir / "f.csv").string() + " -o " +
+                            (dir / "h.h5").string() + " --extrema " + (dir / "e.csv").string() +
+                            extra;
+    EXPECT_EQ(run(cmd, dir / "log"), 0) << slurp(dir / "log");
+    return slurp(dir / "log");
+  };
+  std::string log = analyze("");
+  EXPECT_NE(log.find("solver projection"), std::string::npos) << log;
+  const auto h5 = dir / "h.h5";
+  EXPECT_EQ(gs::test::read_attr(h5, "/", "tolerance"), 1e-7);
+  const double dch = gs::test::read_attr(h5, "/", "dot_curl_harmonic");
+  const double nc = gs::test::read_attr(h5, "/", "norm_curl_v");
+  const double nh = gs::test::read_attr(h5, "/", "norm_harmonic");
+  EXPECT_LT(std::abs(dch) / (nc * nh), 1e-8);
+  const auto sources = extrema_rows(dir / "e.csv", "source");
+  const auto sinks = extrema_rows(dir / "e.csv", "sink");
+  const auto src = strongest(sources);
+  EXPECT_LT((Eigen::Vector3d(src[0], src[1], src[2]) - Eigen::Vector3d(0.3, 0.6, 0.4)).norm(),
+            2.0 / std::cbrt(1500.0));
+  // The flag is the rule: magnitude >= 5 % of the strongest source or sink.
+  double top = 0.0;
+  std::size_t significant = 0;
+  for (const auto* rows : {&sources, &sinks})
+    for (const auto& r : *rows) top = std::max(top, r[3]);
+  for (const auto* rows : {&sources, &sinks})
+    for (const auto& r : *rows) {
+      EXPECT_EQ(r[4], r[3] >= 0.05 * top ? 1.0 : 0.0);
+      significant += r[4] == 1.0 ? 1 : 0;
+    }
+  EXPECT_EQ(significant, 1u);
+  EXPECT_GT(sources.size() + sinks.size(), 10u);  // the noise extrema are still reported
+  const auto sig = read_array<std::uint8_t>(h5, "/extrema/significant", H5T_NATIVE_UINT8);
+  EXPECT_EQ(std::count(sig.begin(), sig.end(), 1), 2);  // the source and the vortex
+  char expect[128];
+  std::snprintf(expect, sizeof expect, "sources 1, sinks 0");
+  EXPECT_NE(log.find(expect), std::string::npos) << log;
+  // --significance 0 counts every strict extremum; an absolute floor above the source none.
+  log = analyze(" --significance 0");
+  std::snprintf(expect, sizeof expect, "sources %zu, sinks %zu", sources.size(), sinks.size());
+  EXPECT_NE(log.find(expect), std::string::npos) << log;
+  log = analyze(" --significance-abs " + std::to_string(2.0 * src[3]));
+  EXPECT_NE(log.find("sources 0, sinks 0"), std::string::npos) << log;
+  fs::remove_all(dir);
+}
+
 // One line "error: ..." naming `part`, exit 2, no output file.
 void expect_rejected(const std::string& args, const fs::path& dir, const std::string& part) {
   EXPECT_EQ(run(args + " -o " + (dir / "o.h5").string(), dir / "log"), 2) << args;
@@ -404,6 +475,11 @@ TEST(CmdHhd, BadInputExitsTwoWithOneLine) {
   expect_rejected(csv("ok.csv", "x,y,ux,uy\n0,0,1,1\n1,0,1,1\n0,1,1,1\n1,1,1,1\n0.5,0.4,0,0\n") +
                       " --solver gmres",
                   dir, "unknown solver");
+  const std::string ok =
+      csv("ok3.csv", "x,y,ux,uy\n0,0,1,1\n1,0,1,1\n0,1,1,1\n1,1,1,1\n0.5,0.4,0,0\n");
+  expect_rejected(ok + " --significance 1.5", dir, "--significance must be in [0, 1] (1.5)");
+  expect_rejected(ok + " --significance-abs -1", dir, "--significance-abs must be >= 0 (-1)");
+  expect_rejected(ok + " --tolerance 0", dir, "--tolerance must be in (0, 1) (0)");
   expect_rejected(
       csv("ok2.csv", "x,y,ux,uy\n0,0,1,1\n1,0,1,1\n0,1,1,1\n1,1,1,1\n0.5,0.4,0,0\n") + " --ghosts",
       dir, "give --d50");
