@@ -1,17 +1,26 @@
-// Speed against error of the Helmholtz–Hodge decomposition (seed 000 eq 9–18) in 3D: for jittered
-// lattices of ~1e4, 5.6e4 and 2e5 nodes in the unit cube, the time of the Delaunay mesh, of the
-// assembly and of each solver path, the L2 error of the parts against the analytic decomposition
-// of tests/analysis/hhd_test_fields.hpp (ξ = ∇U + ∇×V + c, V divergence-free), and the ratio of
-// path (a) to path (b) in the same process. Then the whole pipeline (mesh, HHD, extrema, tubes)
-// on the 5.6e4-node set: issue 7's target is < 2 s on 2 cores.
+// Speed against error of the Helmholtz–Hodge decomposition (seed 000 eq 9–18) in 3D, every solver
+// path in the same process (path (a) the paper's BiCGSTAB on eq 18 as written; path (b) the
+// Laplacian with the gauge as a penalty, CHOLMOD or CG; path (c) Eigen LDLT; `projection` eq 18
+// by PCG, the default), on two kinds of input:
+//  * lattice: jittered lattices of the unit cube and the analytic field of
+//    tests/analysis/hhd_test_fields.hpp (ξ = ∇U + ∇×V + c, V divergence-free): the L2 error of
+//    each part against the exact decomposition;
+//  * random: N uniformly random points (slivers included) and issue 20's field (a Lamb–Oseen
+//    vortex crossing the hull, a Gaussian source, a translation): |∇×v|, |h|, cos(∇×v, h),
+//    cos(∇u, h), ‖∇·v‖ and the relative difference of ∇×v from path (a)'s where it converged.
+// Then the whole pipeline (mesh, HHD, extrema, tubes) on the 5.6e4-node lattice.
 //   build/bin/bench_hhd [N ...]      (default 10000 56000 200000)
-// Environment: GS_BENCH_LDLT_MAX (largest N for the Eigen LDLT path, default 60000: its AMD
-// ordering fills in far more than CHOLMOD's METIS) and GS_BENCH_BICGSTAB_ITERATIONS (cap of path
-// (a), default 3000; a capped run is reported as not converged with its residual).
+// Environment: GS_BENCH_MESH (lattice, random or both: default both), GS_BENCH_PATHS (comma list
+// of auto, projection, cholmod, cg, ldlt, bicgstab; default all), GS_BENCH_LDLT_MAX (largest N
+// for LDLT, default 60000: its AMD ordering fills in far more than CHOLMOD's METIS),
+// GS_BENCH_BICGSTAB_ITERATIONS (cap of path (a), default 3000; a capped run is reported as not
+// converged with its residual), GS_BENCH_PIPELINE=0 skips the pipeline.
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <optional>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -34,54 +43,130 @@ long env_long(const char* name, long fallback) {
   return v ? std::atol(v) : fallback;
 }
 
-struct PathResult {
-  double seconds = 0.0, err_grad = 0.0, err_curl = 0.0, err_h = 0.0;
-  HhdReport report;
-  double div_ratio = 0.0;
+std::string env_string(const char* name, const char* fallback) {
+  const char* v = std::getenv(name);
+  return v ? v : fallback;
+}
+
+bool wanted(const std::string& path) {
+  const std::string list = env_string("GS_BENCH_PATHS", "");
+  if (list.empty()) return true;
+  std::stringstream s(list);
+  std::string item;
+  while (std::getline(s, item, ','))
+    if (item == path) return true;
+  return false;
+}
+
+double cosine(double dot, double a, double b) {
+  return a > 0.0 && b > 0.0 ? dot / (a * b) : 0.0;
+}
+
+struct Run {
+  double seconds = 0.0;
+  HhdResult r;
 };
 
-PathResult run_path(const HhdMesh& m, const std::vector<Eigen::Vector3d>& xi,
-                    const gs::test::AnalyticField& f, HhdSolver solver, int max_iterations) {
+Run run(const HhdMesh& m, const std::vector<Eigen::Vector3d>& xi, HhdSolver solver,
+        int max_iterations) {
   HhdOptions o;
   o.solver = solver;
-  o.tolerance = 1e-10;
   o.max_iterations = max_iterations;
   const auto t0 = Clock::now();
-  const auto r = helmholtz_hodge(m, xi, o);
-  PathResult p;
-  p.seconds = since(t0);
-  p.report = r.report;
-  double eg = 0, ec = 0, eh = 0, ng = 0, nc = 0, nh = 0;
-  for (std::size_t k = 0; k < m.simplices.size(); ++k) {
-    Eigen::Vector3d x = Eigen::Vector3d::Zero();
-    for (std::size_t a = 0; a < 4; ++a) x += m.points[static_cast<std::size_t>(m.simplices[k][a])];
-    x /= 4.0;
-    const double w = r.measure[k];
-    eg += w * (r.grad_u[k] - f.grad_U(x)).squaredNorm();
-    ec += w * (r.curl_v[k] - f.curl_V(x)).squaredNorm();
-    eh += w * (r.harmonic[k] - f.c).squaredNorm();
-    ng += w * f.grad_U(x).squaredNorm();
-    nc += w * f.curl_V(x).squaredNorm();
-    nh += w * f.c.squaredNorm();
+  Run out;
+  out.r = helmholtz_hodge(m, xi, o);
+  out.seconds = since(t0);
+  return out;
+}
+
+void print_head(const char* name, const Run& p) {
+  const auto& r = p.r.report;
+  std::printf("  %-26s %8.3f s (assembly %.3f, factor %.3f, solve %.3f)", name, p.seconds,
+              r.seconds_assembly, r.seconds_factor, r.seconds_solve);
+  if (r.iterations_u + r.iterations_v > 0) std::printf(" it %d/%d", r.iterations_u, r.iterations_v);
+  if (!r.converged) std::printf(" NOT CONVERGED");
+}
+
+// Measure-weighted relative L2 difference of two per-simplex fields.
+double relative_difference(const HhdResult& a, const HhdResult& b) {
+  double d = 0.0, n = 0.0;
+  for (std::size_t k = 0; k < a.measure.size(); ++k) {
+    d += a.measure[k] * (a.curl_v[k] - b.curl_v[k]).squaredNorm();
+    n += a.measure[k] * b.curl_v[k].squaredNorm();
   }
-  p.err_grad = std::sqrt(eg / ng);
-  p.err_curl = std::sqrt(ec / nc);
-  p.err_h = std::sqrt(eh / nh);
-  p.div_ratio = r.norm_curl_v > 0 ? r.norm_div_v / r.norm_curl_v : 0.0;
+  return n > 0.0 ? std::sqrt(d / n) : 0.0;
+}
+
+void print_parts(const HhdResult& r, const HhdResult* reference) {
+  std::printf(
+      "\n      |curl v| %.4f |h| %.4f cos(curl,h) %+.1e cos(grad,h) %+.1e cos(grad,curl) %+.1e "
+      "|div v| %.3g eq18 res %.1e",
+      r.norm_curl_v, r.norm_harmonic, cosine(r.dot_curl_harmonic, r.norm_curl_v, r.norm_harmonic),
+      cosine(r.dot_grad_harmonic, r.norm_grad_u, r.norm_harmonic),
+      cosine(r.dot_grad_curl, r.norm_grad_u, r.norm_curl_v), r.norm_div_v, r.report.residual_eq18);
+  if (reference) std::printf(" curl vs path a %.1e", relative_difference(r, *reference));
+  std::printf("\n");
+}
+
+struct Path {
+  const char* key;
+  const char* label;
+  HhdSolver solver;
+};
+
+const std::vector<Path>& paths() {
+  static const std::vector<Path> p = {{"bicgstab", "path a  bicgstab (paper)", HhdSolver::BiCgStab},
+                                      {"projection", "projection (default)", HhdSolver::Projection},
+                                      {"cholmod", "path b  cholmod", HhdSolver::Cholmod},
+                                      {"cg", "path b' cg (Jacobi)", HhdSolver::Cg},
+                                      {"ldlt", "path c  ldlt (Eigen)", HhdSolver::Ldlt}};
   return p;
 }
 
-void print_path(const char* name, const PathResult& p) {
-  const auto& r = p.report;
-  std::printf(
-      "  %-28s %8.3f s (assembly %.3f, factor/setup %.3f, solve %.3f)  err grad %.3e "
-      "curl %.3e h %.3e  eq18 res %.1e%s",
-      name, p.seconds, r.seconds_assembly, r.seconds_factor, r.seconds_solve, p.err_grad,
-      p.err_curl, p.err_h, r.residual_eq18, r.converged ? "" : "  NOT CONVERGED");
-  if (r.iterations_u + r.iterations_v > 0) {
-    std::printf("  it %d/%d", r.iterations_u, r.iterations_v);
+// Every wanted path on one mesh; path (a) first, as the reference of the others' ∇×v.
+void all_paths(const HhdMesh& m, const std::vector<Eigen::Vector3d>& xi,
+               const gs::test::AnalyticField* exact) {
+  const long ldlt_max = env_long("GS_BENCH_LDLT_MAX", 60000);
+  const int bicg_max = static_cast<int>(env_long("GS_BENCH_BICGSTAB_ITERATIONS", 3000));
+  std::optional<Run> a;
+  double seconds_b = 0.0, seconds_proj = 0.0;
+  for (const auto& p : paths()) {
+    if (!wanted(p.key)) continue;
+    if (p.solver == HhdSolver::Ldlt && static_cast<long>(m.points.size()) > ldlt_max) {
+      std::printf("  %-26s skipped (N > GS_BENCH_LDLT_MAX = %ld)\n", p.label, ldlt_max);
+      continue;
+    }
+    const Run r = run(m, xi, p.solver, p.solver == HhdSolver::BiCgStab ? bicg_max : 100000);
+    print_head(p.label, r);
+    if (exact) {
+      double eg = 0, ec = 0, eh = 0, ng = 0, nc = 0, nh = 0;
+      for (std::size_t k = 0; k < m.simplices.size(); ++k) {
+        Eigen::Vector3d x = Eigen::Vector3d::Zero();
+        for (std::size_t q = 0; q < 4; ++q)
+          x += m.points[static_cast<std::size_t>(m.simplices[k][q])];
+        x /= 4.0;
+        const double w = r.r.measure[k];
+        eg += w * (r.r.grad_u[k] - exact->grad_U(x)).squaredNorm();
+        ec += w * (r.r.curl_v[k] - exact->curl_V(x)).squaredNorm();
+        eh += w * (r.r.harmonic[k] - exact->c).squaredNorm();
+        ng += w * exact->grad_U(x).squaredNorm();
+        nc += w * exact->curl_V(x).squaredNorm();
+        nh += w * exact->c.squaredNorm();
+      }
+      std::printf("  err grad %.3e curl %.3e h %.3e", std::sqrt(eg / ng), std::sqrt(ec / nc),
+                  std::sqrt(eh / nh));
+    }
+    print_parts(r.r, a && a->r.report.converged ? &a->r : nullptr);
+    if (p.solver == HhdSolver::BiCgStab) a = r;
+    if (p.solver == HhdSolver::Cg) seconds_b = r.seconds;
+    if (p.solver == HhdSolver::Projection) seconds_proj = r.seconds;
   }
-  std::printf("\n");
+  if (seconds_b > 0.0 && seconds_proj > 0.0) {
+    std::printf("  ratio projection / path b' cg (the former default at this size): %.1f",
+                seconds_proj / seconds_b);
+    if (a) std::printf("   path a / projection: %.1f", a->seconds / seconds_proj);
+    std::printf("\n");
+  }
 }
 
 }  // namespace
@@ -90,62 +175,56 @@ int main(int argc, char** argv) {
   std::vector<long> sizes;
   for (int i = 1; i < argc; ++i) sizes.push_back(std::atol(argv[i]));
   if (sizes.empty()) sizes = {10000, 56000, 200000};
-  const long ldlt_max = env_long("GS_BENCH_LDLT_MAX", 60000);
-  const int bicg_max = static_cast<int>(env_long("GS_BENCH_BICGSTAB_ITERATIONS", 3000));
+  const std::string mesh_kind = env_string("GS_BENCH_MESH", "both");
   gs::test::AnalyticField f;
   f.dim = 3;
-  std::printf(
-      "HHD 3D, unit cube, jittered lattice, xi = grad U + curl V + c (errors: relative "
-      "L2 against the analytic parts)\n");
   for (const long target : sizes) {
-    const int n = static_cast<int>(std::lround(std::cbrt(static_cast<double>(target)))) - 1;
-    auto t0 = Clock::now();
-    auto m = gs::test::box_mesh(3, n, 7);  // includes its Delaunay; timed again below
-    const double mesh_s = since(t0);
-    t0 = Clock::now();
-    const auto d = delaunay_mesh(m.points);
-    const double delaunay_s = since(t0);
-    (void)mesh_s;
-    std::vector<Eigen::Vector3d> nodal;
-    for (const auto& p : m.points) nodal.push_back(f.xi(p));
-    const auto xi = simplex_mean(m, nodal);
-    std::printf("N = %zu nodes, %zu tetrahedra: Delaunay %.3f s\n", m.points.size(),
-                d.simplices.size(), delaunay_s);
-    const auto b = run_path(m, xi, f, HhdSolver::Cholmod, 1);
-    print_path("path b  cholmod", b);
-    print_path("eq18 projection (pcg)", run_path(m, xi, f, HhdSolver::Projection, 10000));
-    const auto cg = run_path(m, xi, f, HhdSolver::Cg, 100000);
-    print_path("path b' cg (Jacobi)", cg);
-    if (static_cast<long>(m.points.size()) <= ldlt_max) {
-      print_path("path c  ldlt (Eigen)", run_path(m, xi, f, HhdSolver::Ldlt, 1));
-    } else {
-      std::printf("  %-28s skipped (N > GS_BENCH_LDLT_MAX = %ld)\n", "path c  ldlt (Eigen)",
-                  ldlt_max);
-    }
-    const auto a = run_path(m, xi, f, HhdSolver::BiCgStab, bicg_max);
-    print_path("path a  bicgstab (paper)", a);
-    std::printf("  ratio path a / path b: %.1f (time)   path b: |div v| / |curl v| = %.2e\n",
-                a.seconds / b.seconds, b.div_ratio);
-  }
-  // Whole pipeline on ~5.6e4 nodes: mesh + ξ + HHD + extrema + tubes.
-  {
-    const auto m = gs::test::box_mesh(3, 37, 8);
-    std::vector<Eigen::Vector3d> nodal;
-    for (const auto& p : m.points) nodal.push_back(f.xi(p));
-    for (auto solver : {HhdSolver::Cholmod, HhdSolver::Cg}) {
-      VortexAnalysisOptions o;
-      o.hhd.solver = solver;
-      const auto t0 = Clock::now();
-      const auto a = analyze_vortices(m.points, nodal, 3, o);
-      const double total = since(t0);
-      const auto& r = a.hhd.report;
+    if (mesh_kind != "random") {
+      const int n = static_cast<int>(std::lround(std::cbrt(static_cast<double>(target)))) - 1;
+      auto t0 = Clock::now();
+      const auto m = gs::test::box_mesh(3, n, 7);
+      const double mesh_s = since(t0);
+      std::vector<Eigen::Vector3d> nodal;
+      for (const auto& p : m.points) nodal.push_back(f.xi(p));
       std::printf(
-          "pipeline %zu nodes, %s: total %.3f s = Delaunay %.3f + assembly %.3f + "
-          "factor/setup %.3f + solve %.3f + detection %.3f (+ rest); %zu extrema, %zu "
-          "tubes\n",
-          m.points.size(), r.solver.c_str(), total, a.seconds_delaunay, r.seconds_assembly,
-          r.seconds_factor, r.seconds_solve, a.seconds_detection, a.extrema.size(), a.tubes.size());
+          "lattice N = %zu nodes, %zu tetrahedra (mesh %.2f s); xi = grad U + curl V + c, errors "
+          "relative L2 against the exact parts\n",
+          m.points.size(), m.simplices.size(), mesh_s);
+      all_paths(m, simplex_mean(m, nodal), &f);
     }
+    if (mesh_kind != "lattice") {
+      auto t0 = Clock::now();
+      const auto m = gs::test::random_cube_mesh(static_cast<std::size_t>(target), 1);
+      const double mesh_s = since(t0);
+      std::vector<Eigen::Vector3d> nodal;
+      for (const auto& p : m.points) nodal.push_back(gs::test::vortex_source_translation(p));
+      std::printf(
+          "random N = %zu nodes, %zu tetrahedra (Delaunay %.2f s); issue 20's field (vortex "
+          "across the hull + source + translation)\n",
+          m.points.size(), m.simplices.size(), mesh_s);
+      all_paths(m, simplex_mean(m, nodal), nullptr);
+    }
+    std::fflush(stdout);
+  }
+  if (env_long("GS_BENCH_PIPELINE", 1) == 0) return 0;
+  // Whole pipeline on ~5.6e4 nodes: mesh + ξ + HHD + extrema + tubes.
+  const auto m = gs::test::box_mesh(3, 37, 8);
+  std::vector<Eigen::Vector3d> nodal;
+  for (const auto& p : m.points) nodal.push_back(f.xi(p));
+  for (auto solver : {HhdSolver::Projection, HhdSolver::Cholmod, HhdSolver::Cg}) {
+    VortexAnalysisOptions o;
+    o.hhd.solver = solver;
+    const auto t0 = Clock::now();
+    const auto a = analyze_vortices(m.points, nodal, 3, o);
+    const double total = since(t0);
+    const auto& r = a.hhd.report;
+    const auto c = count_extrema(a.extrema, true);
+    std::printf(
+        "pipeline %zu nodes, %s: total %.3f s = Delaunay %.3f + assembly %.3f + factor %.3f + "
+        "solve %.3f + detection %.3f (+ rest); %zu extrema (%zu significant), %zu tubes\n",
+        m.points.size(), r.solver.c_str(), total, a.seconds_delaunay, r.seconds_assembly,
+        r.seconds_factor, r.seconds_solve, a.seconds_detection, a.extrema.size(),
+        c[0] + c[1] + c[2] + c[3], a.tubes.size());
   }
   return 0;
 }

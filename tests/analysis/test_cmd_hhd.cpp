@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -16,6 +17,7 @@
 #include <random>
 #include <sstream>
 #include <string>
+#include <utility>
 
 #include "cli_util.hpp"
 #include "hdf5_trajectory.hpp"
@@ -438,6 +440,58 @@ TEST(CmdHhd, ProjectionDefaultAndSignificantExtrema3D) {
   EXPECT_NE(log.find(expect), std::string::npos) << log;
   log = analyze(" --significance-abs " + std::to_string(2.0 * src[3]));
   EXPECT_NE(log.find("sources 0, sinks 0"), std::string::npos) << log;
+  fs::remove_all(dir);
+}
+
+TEST(CmdHhd, DemIncrementPartsOrthogonalWithTheDefault) {
+  // Issue 20's acceptance on a DEM increment: the plane-strain demo (the shipped tiny scene,
+  // loaded to 4 % strain), its last increment decomposed in 3D. The default (eq 18's
+  // projection) gives cos(∇×v, h) and cos(∇u, h) below 1e-8; path (b) does not (so the check
+  // can fail) and its ∇u is the same.
+  const auto dir = temp_dir();
+  std::string scene = slurp(fs::path(GS_TEST_DATA_DIR) / "scenes" / "plane_strain_tiny.toml");
+  for (const auto& [from, to] :
+       {std::pair<std::string, std::string>{"max_strain = 0.01", "max_strain = 0.04"},
+        {"frame_every_strain = 0.005", "frame_every_strain = 0.004"}}) {
+    const auto at = scene.find(from);
+    ASSERT_NE(at, std::string::npos) << from;
+    scene.replace(at, from.size(), to);
+  }
+  std::ofstream(dir / "ps.toml") << scene;
+  ASSERT_EQ(run("simulate " + (dir / "ps.toml").string() + " -q -o " + (dir / "run").string(),
+                dir / "log"),
+            0)
+      << slurp(dir / "log");
+  const std::string run_h5 = (dir / "run" / "plane_strain.h5").string();
+  const auto attr = [](const fs::path& h5, const char* name) {
+    return gs::test::read_attr(h5, "/", name);
+  };
+  const auto cosines = [&](const fs::path& h5) {
+    return std::array<double, 3>{
+        std::abs(attr(h5, "dot_curl_harmonic")) /
+            (attr(h5, "norm_curl_v") * attr(h5, "norm_harmonic")),
+        std::abs(attr(h5, "dot_grad_harmonic")) /
+            (attr(h5, "norm_grad_u") * attr(h5, "norm_harmonic")),
+        std::abs(attr(h5, "dot_grad_curl")) / (attr(h5, "norm_grad_u") * attr(h5, "norm_curl_v"))};
+  };
+  for (const char* pair : {" --from 1 --to 2", " --from 9 --to 10"}) {
+    SCOPED_TRACE(pair);
+    ASSERT_EQ(run("analyze hhd " + run_h5 + pair + " -o " + (dir / "p.h5").string(), dir / "log"),
+              0)
+        << slurp(dir / "log");
+    ASSERT_EQ(
+        run("analyze hhd " + run_h5 + pair + " --solver cholmod -o " + (dir / "b.h5").string(),
+            dir / "log"),
+        0)
+        << slurp(dir / "log");
+    const auto p = cosines(dir / "p.h5");
+    const auto b = cosines(dir / "b.h5");
+    for (double c : p) EXPECT_LT(c, 1e-8);
+    EXPECT_GT(b[0], 1e-3);
+    EXPECT_LT(b[1], 1e-8);
+    EXPECT_EQ(attr(dir / "p.h5", "converged"), 1.0);
+    EXPECT_EQ(attr(dir / "p.h5", "norm_grad_u"), attr(dir / "b.h5", "norm_grad_u"));
+  }
   fs::remove_all(dir);
 }
 
