@@ -2,6 +2,8 @@
 #include <omp.h>
 
 #include <CLI/CLI.hpp>
+#include <chrono>
+#include <cstdio>
 #include <iostream>
 #include <opencv2/imgcodecs.hpp>
 #include <sstream>
@@ -54,8 +56,14 @@ void run_dic(const DicArgs& a) {
     throw InputError("--zncc-min", "must be in (-1, 1)", value_str(a.zncc_min));
   if (a.search < 0) throw InputError("--search", "must be >= 0 px", std::to_string(a.search));
 
+  using Clock = std::chrono::steady_clock;
+  const auto since = [](Clock::time_point t) {
+    return std::chrono::duration<double>(Clock::now() - t).count();
+  };
+  const auto t_start = Clock::now();
   std::vector<cv::Mat> images;
   for (const auto& p : a.images) images.push_back(dic::read_grey_image(p));
+  const double seconds_read = since(t_start);
   for (std::size_t k = 1; k < images.size(); ++k)
     if (images[k].size() != images[0].size())
       throw InputError(a.images[k], "image size differs from the reference",
@@ -111,6 +119,7 @@ void run_dic(const DicArgs& a) {
   info.small_strain = a.strain == "small";
   info.image_rows = images[0].rows;
   info.image_cols = images[0].cols;
+  const auto t_write = Clock::now();
   const std::filesystem::path out(a.output);
   // The HDF5, CSV and VTI files appear together or not at all.
   StagingDir staging(out.has_parent_path() ? out.parent_path() : std::filesystem::path("."));
@@ -130,7 +139,21 @@ void run_dic(const DicArgs& a) {
     }
   });
   staging.commit();
+  const double seconds_write = since(t_write);
+  const double seconds_total = since(t_start);
   std::cout << report.str();
+  const double pois =
+      static_cast<double>(result.grid.size()) * static_cast<double>(result.frames.size());
+  char timing[512];
+  std::snprintf(timing, sizeof timing,
+                "time: read %.2f s, prefilter %.2f s, seeds %.2f s, propagation %.2f s (%.2f "
+                "IC-GN iterations per POI), strain %.2f s, write %.2f s; %.0f POIs in %.2f s = "
+                "%.3g POI/s end to end (%d threads)\n",
+                seconds_read, result.seconds_prefilter, result.seconds_seeds,
+                result.seconds_propagation, static_cast<double>(result.icgn_iterations) / pois,
+                result.seconds_strain, seconds_write, pois, seconds_total, pois / seconds_total,
+                opt.dic.threads);
+  std::cout << timing;
   std::cout << "wrote " << out.string() << " (subset " << a.subset << " px, step " << a.step
             << " px, VSG " << info.vsg_px << " px)\n";
 }

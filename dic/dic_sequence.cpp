@@ -1,5 +1,6 @@
 #include "dic_sequence.hpp"
 
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -78,6 +79,10 @@ SequenceResult correlate_sequence(const std::vector<cv::Mat>& images, const cv::
     } catch (const std::runtime_error& e) {
       throw std::runtime_error("image " + std::to_string(k + 1) + ": " + e.what());
     }
+    out.seconds_prefilter += f.seconds_prefilter;
+    out.seconds_seeds += f.seconds_seeds;
+    out.seconds_propagation += f.seconds_propagation;
+    out.icgn_iterations += f.icgn_iterations;
     const FrameResult inc = from_field(f);
     if (!options.incremental || k == 1) {
       fr = inc;
@@ -99,8 +104,11 @@ SequenceResult correlate_sequence(const std::vector<cv::Mat>& images, const cv::
         }
       }
     }
+    const auto t0 = std::chrono::steady_clock::now();
     fr.strain =
         plane_fit_strain(out.grid, fr.u, fr.v, fr.valid, options.strain_window_radius, subset);
+    out.seconds_strain +=
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     out.frames.push_back(std::move(fr));
   }
   return out;

@@ -28,6 +28,10 @@ struct FrameResult {
 struct SequenceResult {
   PoiGrid grid;
   std::vector<FrameResult> frames;  // one per image after the reference
+  // Wall-clock seconds summed over the frames (DicField's stages, then the plane-fit strain).
+  double seconds_prefilter = 0.0, seconds_seeds = 0.0, seconds_propagation = 0.0;
+  double seconds_strain = 0.0;
+  long long icgn_iterations = 0;  // summed over the frames' solved POIs
 };
 
 /// images[0] is the reference. All images must have the same size. `roi` optional (CV_8U).

@@ -1,6 +1,7 @@
 #include "reliability_guided.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <stdexcept>
 #include <string>
 
@@ -39,6 +40,11 @@ DicField correlate(const cv::Mat& reference, const cv::Mat& deformed, const PoiG
                    const DicOptions& options) {
   if (reference.size() != deformed.size())
     throw std::invalid_argument("reference and deformed images differ in size");
+  using Clock = std::chrono::steady_clock;
+  const auto since = [](Clock::time_point t) {
+    return std::chrono::duration<double>(Clock::now() - t).count();
+  };
+  auto t0 = Clock::now();
   cv::Mat ref64;
   cv::Mat def64;
   reference.convertTo(ref64, CV_64F);
@@ -48,6 +54,8 @@ DicField correlate(const cv::Mat& reference, const cv::Mat& deformed, const PoiG
   const int threads = std::max(1, options.threads);
 
   DicField out;
+  out.seconds_prefilter = since(t0);
+  t0 = Clock::now();
   out.grid = grid;
   const auto n = static_cast<std::size_t>(grid.size());
   out.p.assign(n, Shape::Zero());
@@ -60,6 +68,7 @@ DicField correlate(const cv::Mat& reference, const cv::Mat& deformed, const PoiG
     out.p[i] = r.p;
     out.zncc[i] = r.zncc;
     out.solved[i] = 1;
+    out.icgn_iterations += r.iterations;
     out.valid[i] = (r.ok && r.zncc >= options.zncc_min) ? 1 : 0;
   };
 
@@ -105,6 +114,8 @@ DicField correlate(const cv::Mat& reference, const cv::Mat& deformed, const PoiG
     if (out.valid[static_cast<std::size_t>(candidates[s])]) front.push_back(candidates[s]);
   }
   out.seeds = static_cast<int>(front.size());
+  out.seconds_seeds = since(t0);
+  t0 = Clock::now();
   if (front.empty())
     throw std::runtime_error("no seed reached the ZNCC threshold (best " +
                              std::to_string(best_seed) + ")");
@@ -162,6 +173,7 @@ DicField correlate(const cv::Mat& reference, const cv::Mat& deformed, const PoiG
       if (out.valid[static_cast<std::size_t>(next[q])]) front.push_back(next[q]);
     }
   }
+  out.seconds_propagation = since(t0);
   return out;
 }
 

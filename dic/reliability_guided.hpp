@@ -46,6 +46,10 @@ struct DicField {
   std::vector<std::uint8_t> valid;
   std::vector<std::uint8_t> solved;  // reached by propagation (valid or not)
   int seeds = 0;                     // valid seeds
+  // Wall-clock seconds of the stages: B-spline prefilters and reference gradients, seed search
+  // (integer ZNCC + IC-GN), reliability-guided propagation (IC-GN).
+  double seconds_prefilter = 0.0, seconds_seeds = 0.0, seconds_propagation = 0.0;
+  long long icgn_iterations = 0;  // summed over the solved POIs
 };
 
 /// Correlates `deformed` against `reference` (same size, CV_64F or convertible) over `grid`.
