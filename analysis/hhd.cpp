@@ -282,7 +282,6 @@ Eigen::MatrixXd projection_pcg(const HhdMesh& m, const P1Geometry& g, const std:
   const double bnorm = b.norm();
   if (bnorm == 0.0) return v;
   const auto d = curl_curl_block_inverses(m, g, idx, static_cast<int>(n));
-  const auto local = [&](const Eigen::MatrixXd& r) { return apply_blocks(d, r); };
   // λ_max(D⁻¹A) by power iteration from a fixed start (deterministic).
   Eigen::MatrixXd q = Eigen::MatrixXd::Ones(n, 3);
   for (Eigen::Index i = 0; i < n; ++i)
@@ -290,7 +289,7 @@ Eigen::MatrixXd projection_pcg(const HhdMesh& m, const P1Geometry& g, const std:
   double lambda = 1.0;
   for (int it = 0; it < 12; ++it) {
     const Eigen::MatrixXd aq = apply_curl_curl(m, g, idx, q);
-    const Eigen::MatrixXd dq = local(aq);
+    const Eigen::MatrixXd dq = apply_blocks(d, aq);
     const double qaq = frobenius_dot(q, aq);
     const double qdq = frobenius_dot(dq, aq);
     if (qaq > 0.0) lambda = qdq / qaq;  // Rayleigh quotient of D⁻¹A in the A inner product
@@ -298,9 +297,9 @@ Eigen::MatrixXd projection_pcg(const HhdMesh& m, const P1Geometry& g, const std:
   }
   const double omega = 1.5 / lambda;
   auto precondition = [&](const Eigen::MatrixXd& r) {
-    Eigen::MatrixXd z = omega * local(r);
+    Eigen::MatrixXd z = omega * apply_blocks(d, r);
     z += solve_k(Eigen::MatrixXd(r - apply_curl_curl(m, g, idx, z)));
-    z += omega * local(Eigen::MatrixXd(r - apply_curl_curl(m, g, idx, z)));
+    z += omega * apply_blocks(d, Eigen::MatrixXd(r - apply_curl_curl(m, g, idx, z)));
     return z;
   };
   Eigen::MatrixXd r = b;

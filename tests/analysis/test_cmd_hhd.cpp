@@ -337,24 +337,44 @@ TEST(CmdHhd, PeriodicBoundaryCrossingIsTheMinimumImage) {
   fs::remove_all(dir);
 }
 
+// `n` uniformly random points in [0, side)^dim (seeded) and field(point) as a CSV with header
+// x,y[,z],ux,uy[,uz] (2D: the field's z is dropped).
+template <class Field>
+void write_field_csv(const fs::path& path, int dim, int n, unsigned seed, double side,
+                     Field field) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(0.0, side);
+  std::ofstream o(path);
+  o << (dim == 3 ? "x,y,z,ux,uy,uz\n" : "x,y,ux,uy\n");
+  o.precision(17);
+  for (int i = 0; i < n; ++i) {
+    Eigen::Vector3d x = Eigen::Vector3d::Zero();
+    if (dim == 3) {
+      x = Eigen::Vector3d(u(rng), u(rng), u(rng));
+    } else {
+      const Eigen::Vector2d x2(u(rng), u(rng));
+      x.head<2>() = x2;
+    }
+    const Eigen::Vector3d v = field(x);
+    o << x.x() << "," << x.y() << ",";
+    if (dim == 3) o << x.z() << ",";
+    o << v.x() << "," << v.y();
+    if (dim == 3) o << "," << v.z();
+    o << "\n";
+  }
+}
+
 TEST(CmdHhd, ToleranceOfTheIterativeSolver) {
   // --solver cg --tolerance TOL: each system stops at the relative residual ||K u - b|| / ||b||
   // <= TOL (Eigen's CG criterion), so the eq 17 residual the command reports is at most TOL,
   // and a tighter tolerance takes more iterations and ends with a smaller residual.
   const auto dir = temp_dir();
-  std::mt19937_64 rng(9);
-  std::uniform_real_distribution<double> u(0.0, 0.05);
-  {
-    std::ofstream o(dir / "f.csv");
-    o << "x,y,ux,uy\n";
-    o.precision(17);
-    for (int i = 0; i < 800; ++i) {
-      const Eigen::Vector2d x(u(rng), u(rng));
-      const Eigen::Vector2d v = 1e-6 * (lamb_oseen(x, {0.02, 0.03}, 1e-2, 5e-3) +
-                                        Eigen::Vector2d(x.x() - 0.025, 0.5 * (x.y() - 0.02)));
-      o << x.x() << "," << x.y() << "," << v.x() << "," << v.y() << "\n";
-    }
-  }
+  write_field_csv(dir / "f.csv", 2, 800, 9, 0.05, [](const Eigen::Vector3d& p) {
+    const Eigen::Vector2d x = p.head<2>();
+    const Eigen::Vector2d v = 1e-6 * (lamb_oseen(x, {0.02, 0.03}, 1e-2, 5e-3) +
+                                      Eigen::Vector2d(x.x() - 0.025, 0.5 * (x.y() - 0.02)));
+    return Eigen::Vector3d(v.x(), v.y(), 0.0);
+  });
   double last_residual = 1.0, last_iterations = 0.0;
   for (const double tol : {1e-3, 1e-6, 1e-12}) {
     SCOPED_TRACE(tol);
@@ -384,19 +404,7 @@ TEST(CmdHhd, ProjectionDefaultAndSignificantExtrema3D) {
   // points: the default 3D solver is eq 18's projection, with orthogonal parts; one source is
   // counted, though u has many noise-level strict extrema (all in the CSV, flagged).
   const auto dir = temp_dir();
-  std::mt19937_64 rng(12);
-  std::uniform_real_distribution<double> u(0.0, 1.0);
-  {
-    std::ofstream o(dir / "f.csv");
-    o << "x,y,z,ux,uy,uz\n";
-    o.precision(17);
-    for (int i = 0; i < 1500; ++i) {
-      const Eigen::Vector3d x(u(rng), u(rng), u(rng));
-      const Eigen::Vector3d v = gs::test::vortex_source_translation(x);
-      o << x.x() << "," << x.y() << "," << x.z() << "," << v.x() << "," << v.y() << "," << v.z()
-        << "\n";
-    }
-  }
+  write_field_csv(dir / "f.csv", 3, 1500, 12, 1.0, gs::test::vortex_source_translation);
   const auto analyze = [&](const std::string& extra) {
     const std::string cmd = "analyze hhd --csv " + (dir / "f.csv").string() + " -o " +
                             (dir / "h.h5").string() + " --extrema " + (dir / "e.csv").string() +
