@@ -125,19 +125,15 @@ void run_dic(const DicArgs& a) {
   StagingDir staging(out.has_parent_path() ? out.parent_path() : std::filesystem::path("."));
   std::ostringstream report;  // printed once everything is in place
   staging.write([&] {
-    dic::write_dic_hdf5(staging / out.filename(), result, info);
-    for (std::size_t k = 0; k < result.frames.size(); ++k) {
-      char suffix[32];
-      std::snprintf(suffix, sizeof suffix, "_%04zu", k + 1);
-      const auto base = staging / (out.stem().string() + suffix);
-      if (!a.no_csv) dic::write_dic_csv(base.string() + ".csv", result, k, info);
-      if (!a.no_vtk) dic::write_dic_vti(base.string() + ".vti", result, k, info);
-      std::size_t nvalid = 0;
-      for (const auto v : result.frames[k].valid) nvalid += v;
-      report << a.images[k + 1] << ": " << nvalid << "/" << result.frames[k].valid.size()
-             << " valid POIs\n";
-    }
+    dic::write_dic_outputs(staging / out.filename(), result, info, !a.no_csv, !a.no_vtk,
+                           opt.dic.threads);
   });
+  for (std::size_t k = 0; k < result.frames.size(); ++k) {
+    std::size_t nvalid = 0;
+    for (const auto v : result.frames[k].valid) nvalid += v;
+    report << a.images[k + 1] << ": " << nvalid << "/" << result.frames[k].valid.size()
+           << " valid POIs\n";
+  }
   staging.commit();
   const double seconds_write = since(t_write);
   const double seconds_total = since(t_start);

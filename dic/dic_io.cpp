@@ -1,9 +1,12 @@
 #include "dic_io.hpp"
 
+#include <algorithm>
+#include <charconv>
 #include <cmath>
+#include <cstdio>
+#include <exception>
 #include <fstream>
 #include <functional>
-#include <iomanip>
 
 #include "atomic_file.hpp"
 #include "errors.hpp"
@@ -82,20 +85,51 @@ void write_dic_hdf5(const std::filesystem::path& path, const SequenceResult& res
   h.commit();
 }
 
+namespace {
+
+// printf's %.10g (what std::setprecision(10) gives), through std::to_chars: several times faster
+// than the stream.
+void put(std::string& out, double v) {
+  char buf[32];
+  const auto r = std::to_chars(buf, buf + sizeof buf, v, std::chars_format::general, 10);
+  out.append(buf, r.ptr);
+}
+void put(std::string& out, int v) {
+  char buf[16];
+  const auto r = std::to_chars(buf, buf + sizeof buf, v);
+  out.append(buf, r.ptr);
+}
+
+}  // namespace
+
 void write_dic_csv(const std::filesystem::path& path, const SequenceResult& result,
                    std::size_t frame, const DicRunInfo& info) {
   AtomicOutput out(path);
   {
-    std::ofstream os(out.temp_path());
+    std::ofstream os(out.temp_path(), std::ios::binary);
     if (!os) throw InputError(path.string(), "cannot write CSV");
     const FrameResult& f = result.frames.at(frame);
     const auto strain = strain_columns(info.small_strain);
-    os << "x,y,u,v,exx,eyy,exy,zncc,valid\n" << std::setprecision(10);
-    for (int i = 0; i < result.grid.size(); ++i) {
+    const std::vector<double>* columns[] = {
+        &f.u, &f.v, &strain[0].get(f), &strain[1].get(f), &strain[2].get(f), &f.zncc};
+    std::string text = "x,y,u,v,exx,eyy,exy,zncc,valid\n";
+    const int n = result.grid.size();
+    for (int i = 0; i < n; ++i) {
       const auto c = static_cast<std::size_t>(i);
-      os << result.grid.x(i) << ',' << result.grid.y(i) << ',' << f.u[c] << ',' << f.v[c] << ','
-         << strain[0].get(f)[c] << ',' << strain[1].get(f)[c] << ',' << strain[2].get(f)[c] << ','
-         << f.zncc[c] << ',' << static_cast<int>(f.valid[c]) << '\n';
+      put(text, result.grid.x(i));
+      text += ',';
+      put(text, result.grid.y(i));
+      for (const auto* col : columns) {
+        text += ',';
+        put(text, (*col)[c]);
+      }
+      text += ',';
+      text += f.valid[c] ? '1' : '0';
+      text += '\n';
+      if (text.size() > (1u << 20) || i + 1 == n) {
+        os.write(text.data(), static_cast<std::streamsize>(text.size()));
+        text.clear();
+      }
     }
     os.flush();
     if (!os) throw InputError(path.string(), "cannot write CSV");
@@ -113,6 +147,40 @@ void write_dic_vti(const std::filesystem::path& path, const SequenceResult& resu
   arrays.push_back({"valid", 1, std::vector<double>(f.valid.begin(), f.valid.end())});
   write_vti_image(path, Eigen::Vector3d(g.x0, g.y0, 0.0), Eigen::Vector3d(g.step, g.step, 1.0),
                   {g.nx, g.ny, 1}, arrays);
+}
+
+std::filesystem::path frame_output_path(const std::filesystem::path& h5, std::size_t frame,
+                                        const std::string& extension) {
+  char suffix[32];
+  std::snprintf(suffix, sizeof suffix, "_%04zu", frame + 1);
+  return h5.parent_path() / (h5.stem().string() + suffix + extension);
+}
+
+void write_dic_outputs(const std::filesystem::path& h5, const SequenceResult& result,
+                       const DicRunInfo& info, bool csv, bool vtk, int threads) {
+  // Tasks, the longest first: the HDF5 file, all VTI files (one after the other), each CSV file.
+  std::vector<std::function<void()>> tasks;
+  tasks.emplace_back([&] { write_dic_hdf5(h5, result, info); });
+  if (vtk)
+    tasks.emplace_back([&] {
+      for (std::size_t k = 0; k < result.frames.size(); ++k)
+        write_dic_vti(frame_output_path(h5, k, ".vti"), result, k, info);
+    });
+  if (csv)
+    for (std::size_t k = 0; k < result.frames.size(); ++k)
+      tasks.emplace_back(
+          [&, k] { write_dic_csv(frame_output_path(h5, k, ".csv"), result, k, info); });
+  std::vector<std::exception_ptr> errors(tasks.size());
+#pragma omp parallel for schedule(dynamic, 1) num_threads(std::max(1, threads))
+  for (int t = 0; t < static_cast<int>(tasks.size()); ++t) {
+    try {
+      tasks[static_cast<std::size_t>(t)]();
+    } catch (...) {
+      errors[static_cast<std::size_t>(t)] = std::current_exception();
+    }
+  }
+  for (const auto& e : errors)
+    if (e) std::rethrow_exception(e);
 }
 
 void write_ground_truth_hdf5(const std::filesystem::path& path, const Camera& camera,

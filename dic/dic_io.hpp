@@ -34,6 +34,15 @@ void write_dic_csv(const std::filesystem::path& path, const SequenceResult& resu
 /// VTK XML image data of the POI grid (origin = first POI, spacing = step) with point arrays.
 void write_dic_vti(const std::filesystem::path& path, const SequenceResult& result,
                    std::size_t frame, const DicRunInfo& info);
+/// Per-frame name beside the HDF5 file: dic.h5, frame 0 -> dic_0001 + extension.
+std::filesystem::path frame_output_path(const std::filesystem::path& h5, std::size_t frame,
+                                        const std::string& extension);
+/// All outputs of a run: the HDF5 file `h5` and, per frame, the CSV and VTI files named by
+/// frame_output_path (when `csv` / `vtk`), on up to `threads` threads. Each file is written by
+/// one thread; the HDF5 file and the VTK files each by one thread at a time (neither library is
+/// thread-safe), the CSV files beside them. Throws the first gs::InputError of any file.
+void write_dic_outputs(const std::filesystem::path& h5, const SequenceResult& result,
+                       const DicRunInfo& info, bool csv, bool vtk, int threads);
 
 }  // namespace gs::dic
 

@@ -22,26 +22,66 @@ StrainField plane_fit_strain(const PoiGrid& grid, const std::vector<double>& u,
     vec->assign(n, nan);
   s.valid.assign(n, 0);
   const int need = (2 * m + 1) * (2 * m + 1) / 2;
+  // The normal equations of each window, A = sum w r r^T, bu = sum w r u, bv = sum w r v with
+  // r = (1, dx, dy) (px) and w = valid, are separable sums: first along x over the row (the
+  // moments 0, 1, 2 of w and 0, 1 of w u, w v in dx), then along y (times 1, dy, dy^2). The
+  // window coordinates stay local and exact: no running sums, no cancellation.
+  const int nx = grid.nx, ny = grid.ny;
+  const double h = grid.step;
+  enum { W0, W1, W2, U0, U1, V0, V1, kRow };
+  std::vector<double> rows(static_cast<std::size_t>(kRow) * n);
+  const auto at = [&](int k, std::size_t c) -> double& {
+    return rows[static_cast<std::size_t>(k) * n + c];
+  };
+#pragma omp parallel for schedule(static)
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i) {
+      double t[kRow] = {};
+      for (int ii = std::max(0, i - m); ii <= std::min(nx - 1, i + m); ++ii) {
+        const auto q = static_cast<std::size_t>(j * nx + ii);
+        if (!valid[q]) continue;
+        const double dx = (ii - i) * h;
+        t[W0] += 1.0;
+        t[W1] += dx;
+        t[W2] += dx * dx;
+        t[U0] += u[q];
+        t[U1] += dx * u[q];
+        t[V0] += v[q];
+        t[V1] += dx * v[q];
+      }
+      for (int k = 0; k < kRow; ++k) at(k, static_cast<std::size_t>(j * nx + i)) = t[k];
+    }
 #pragma omp parallel for schedule(static)
   for (int idx = 0; idx < grid.size(); ++idx) {
     const auto c = static_cast<std::size_t>(idx);
     if (!valid[c]) continue;
-    const int i = idx % grid.nx;
-    const int j = idx / grid.nx;
+    const int i = idx % nx;
+    const int j = idx / nx;
     Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
     Eigen::Vector3d bu = Eigen::Vector3d::Zero();
     Eigen::Vector3d bv = Eigen::Vector3d::Zero();
-    int count = 0;
-    for (int jj = std::max(0, j - m); jj <= std::min(grid.ny - 1, j + m); ++jj)
-      for (int ii = std::max(0, i - m); ii <= std::min(grid.nx - 1, i + m); ++ii) {
-        const auto q = static_cast<std::size_t>(jj * grid.nx + ii);
-        if (!valid[q]) continue;
-        const Eigen::Vector3d r(1.0, (ii - i) * grid.step, (jj - j) * grid.step);
-        A += r * r.transpose();
-        bu += r * u[q];
-        bv += r * v[q];
-        ++count;
-      }
+    double w = 0.0;
+    for (int jj = std::max(0, j - m); jj <= std::min(ny - 1, j + m); ++jj) {
+      const auto q = static_cast<std::size_t>(jj * nx + i);
+      const double dy = (jj - j) * h;
+      w += at(W0, q);
+      A(0, 1) += at(W1, q);
+      A(0, 2) += dy * at(W0, q);
+      A(1, 1) += at(W2, q);
+      A(1, 2) += dy * at(W1, q);
+      A(2, 2) += dy * dy * at(W0, q);
+      bu[0] += at(U0, q);
+      bu[1] += at(U1, q);
+      bu[2] += dy * at(U0, q);
+      bv[0] += at(V0, q);
+      bv[1] += at(V1, q);
+      bv[2] += dy * at(V0, q);
+    }
+    A(0, 0) = w;
+    A(1, 0) = A(0, 1);
+    A(2, 0) = A(0, 2);
+    A(2, 1) = A(1, 2);
+    const auto count = static_cast<int>(w);
     if (count < need) continue;
     const Eigen::LDLT<Eigen::Matrix3d> ldlt(A);
     if (ldlt.info() != Eigen::Success || !ldlt.isPositive()) continue;

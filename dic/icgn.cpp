@@ -2,6 +2,7 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/Dense>
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <vector>
@@ -11,13 +12,15 @@ namespace gs::dic {
 IcgnSolver::IcgnSolver(const cv::Mat& reference, const BSplineImage& deformed, int radius,
                        IcgnOptions options)
     : def_(deformed), radius_(radius), options_(options) {
+  use_avx2(true);
   if (radius < 1) throw std::invalid_argument("IcgnSolver: subset radius must be >= 1");
   reference.convertTo(ref_, CV_64F);
   if (ref_.rows != deformed.rows() || ref_.cols != deformed.cols())
     throw std::invalid_argument("IcgnSolver: reference and deformed images differ in size");
-  const BSplineImage spline(ref_);
+  const BSplineImage spline(ref_, options.threads);
   gx_.create(ref_.rows, ref_.cols, CV_64F);
   gy_.create(ref_.rows, ref_.cols, CV_64F);
+#pragma omp parallel for schedule(static) num_threads(std::max(1, options.threads))
   for (int r = 0; r < ref_.rows; ++r)
     for (int c = 0; c < ref_.cols; ++c) {
       const Sample s = spline.sample(c, r);
@@ -26,82 +29,176 @@ IcgnSolver::IcgnSolver(const cv::Mat& reference, const BSplineImage& deformed, i
     }
 }
 
-IcgnResult IcgnSolver::solve(int x0, int y0, const Shape& guess) const {
+#if defined(__x86_64__) && defined(__GNUC__)
+#define GS_DIC_X86 1
+#endif
+
+void IcgnSolver::use_avx2(bool on) {
+#ifdef GS_DIC_X86
+  avx2_ = on && __builtin_cpu_supports("avx2");
+#else
+  avx2_ = false;
+  (void)on;
+#endif
+}
+
+namespace {
+
+Eigen::Matrix3d to_matrix(const Shape& p) {
+  Eigen::Matrix3d M;
+  M << 1.0 + p[1], p[2], p[0], p[4], 1.0 + p[5], p[3], 0.0, 0.0, 1.0;
+  return M;
+}
+
+// Sums over a subset of a product q(dx, dy) times the six components of the steepest-descent
+// image J = (gx, gx dx, gx dy, gy, gy dx, gy dy). Accumulated per row as the x-moments of
+// q gx and q gy (sum, sum dx), then weighted with dy: the per-pixel work is four products.
+struct RowMoments {
+  double x0 = 0.0, x1 = 0.0, y0 = 0.0, y1 = 0.0;  // sum q gx, sum q gx dx, sum q gy, sum q gy dx
+};
+inline void add_row(Shape& sum, const RowMoments& m, double dy) {
+  sum[0] += m.x0;
+  sum[1] += m.x1;
+  sum[2] += m.x0 * dy;
+  sum[3] += m.y0;
+  sum[4] += m.y1;
+  sum[5] += m.y0 * dy;
+}
+
+}  // namespace
+
+// IC-GN with the ZNSSD criterion (Pan, Li & Tong 2013, eqs 4-9): the Hessian H = sum J J^T of
+// the reference subset is fixed; each iteration needs b = sum J (f~ - (|f~|/|g~|) g~), with
+// f~ = f - f_mean and g~ = g - g_mean. Expanding g~, b = JF - ratio (JG - g_mean JS) with the
+// constants JF = sum J f~ and JS = sum J, so one pass over the deformed subset accumulates
+// everything: sum g, sum g^2, sum f~ g and JG = sum J g.
+[[gnu::always_inline]] inline IcgnResult IcgnSolver::solve_impl(int x0, int y0,
+                                                                const Shape& guess) const {
   IcgnResult res;
   res.p = guess;
   const int R = radius_;
   if (x0 - R < 0 || y0 - R < 0 || x0 + R >= ref_.cols || y0 + R >= ref_.rows) return res;
   const int side = 2 * R + 1;
   const auto n = static_cast<std::size_t>(side) * static_cast<std::size_t>(side);
-  std::vector<double> f(n);
-  std::vector<Shape> J(n);
-  std::vector<double> g(n);
+  const double nd = static_cast<double>(n);
+  // Reference subset: f~, gx, gy as contiguous arrays (one scratch buffer per thread).
+  thread_local std::vector<double> scratch;
+  scratch.resize(3 * n);
+  double* const f = scratch.data();
+  double* const gxs = f + n;
+  double* const gys = gxs + n;
   double fsum = 0.0;
-  std::size_t k = 0;
-  for (int dy = -R; dy <= R; ++dy) {
-    const double* fr = ref_.ptr<double>(y0 + dy);
-    const double* gxr = gx_.ptr<double>(y0 + dy);
-    const double* gyr = gy_.ptr<double>(y0 + dy);
-    for (int dx = -R; dx <= R; ++dx, ++k) {
-      const int c = x0 + dx;
-      f[k] = fr[c];
-      fsum += fr[c];
-      J[k] << gxr[c], gxr[c] * dx, gxr[c] * dy, gyr[c], gyr[c] * dx, gyr[c] * dy;
+  for (int dy = -R, k = 0; dy <= R; ++dy) {
+    const double* fr = ref_.ptr<double>(y0 + dy) + x0 - R;
+    const double* gxr = gx_.ptr<double>(y0 + dy) + x0 - R;
+    const double* gyr = gy_.ptr<double>(y0 + dy) + x0 - R;
+    for (int i = 0; i < side; ++i, ++k) {
+      f[k] = fr[i];
+      gxs[k] = gxr[i];
+      gys[k] = gyr[i];
+      fsum += fr[i];
     }
   }
-  const double fmean = fsum / static_cast<double>(n);
+  const double fmean = fsum / nd;
+  // H from the moments of gx^2, gx gy, gy^2 over (1, dx, dy, dx^2, dx dy, dy^2); JF; JS.
+  // h[q][.]: moments (1, dx, dy, dx^2, dx dy, dy^2) of q = gx^2, gx gy, gy^2.
+  double h[3][6] = {};
   double fss = 0.0;
-  Eigen::Matrix<double, 6, 6> H = Eigen::Matrix<double, 6, 6>::Zero();
-  for (k = 0; k < n; ++k) {
-    f[k] -= fmean;
-    fss += f[k] * f[k];
-    H.selfadjointView<Eigen::Lower>().rankUpdate(J[k]);
+  Shape JF = Shape::Zero();
+  Shape JS = Shape::Zero();
+  for (int dy = -R, k = 0; dy <= R; ++dy) {
+    double m[3][3] = {};  // x-moments 0, 1, 2 of gx^2, gx gy, gy^2 along this row
+    RowMoments mf, ms;
+    for (int dx = -R; dx <= R; ++dx, ++k) {
+      const double fk = f[k] - fmean;
+      f[k] = fk;
+      fss += fk * fk;
+      const double gx = gxs[k];
+      const double gy = gys[k];
+      const double q[3] = {gx * gx, gx * gy, gy * gy};
+      for (int i = 0; i < 3; ++i) {
+        m[i][0] += q[i];
+        m[i][1] += q[i] * dx;
+        m[i][2] += q[i] * dx * dx;
+      }
+      mf.x0 += gx * fk;
+      mf.x1 += gx * fk * dx;
+      mf.y0 += gy * fk;
+      mf.y1 += gy * fk * dx;
+      ms.x0 += gx;
+      ms.x1 += gx * dx;
+      ms.y0 += gy;
+      ms.y1 += gy * dx;
+    }
+    const double dyd = dy;
+    for (int i = 0; i < 3; ++i) {
+      h[i][0] += m[i][0];
+      h[i][1] += m[i][1];
+      h[i][2] += m[i][0] * dyd;
+      h[i][3] += m[i][2];
+      h[i][4] += m[i][1] * dyd;
+      h[i][5] += m[i][0] * dyd * dyd;
+    }
+    add_row(JF, mf, dyd);
+    add_row(JS, ms, dyd);
   }
-  H = H.selfadjointView<Eigen::Lower>();
   const double df = std::sqrt(fss);
   // Textureless subset: grey-level std below 0.1% of a 255 range is noise, not speckle.
-  if (df < 0.255 * std::sqrt(static_cast<double>(n))) return res;
+  if (df < 0.255 * std::sqrt(nd)) return res;
+  // H blocks: (gx-gx), (gx-gy), (gy-gy), each over the moment matrix of (1, dx, dy).
+  Eigen::Matrix<double, 6, 6> H;
+  const auto block = [](const double* m) {
+    Eigen::Matrix3d B;
+    B << m[0], m[1], m[2], m[1], m[3], m[4], m[2], m[4], m[5];
+    return B;
+  };
+  H.block<3, 3>(0, 0) = block(h[0]);
+  H.block<3, 3>(0, 3) = block(h[1]);
+  H.block<3, 3>(3, 0) = block(h[1]);
+  H.block<3, 3>(3, 3) = block(h[2]);
   const Eigen::LDLT<Eigen::Matrix<double, 6, 6>> Hinv(H);
   if (Hinv.info() != Eigen::Success || !Hinv.isPositive()) return res;
 
-  Eigen::Matrix3d W;
-  auto to_matrix = [](const Shape& p) {
-    Eigen::Matrix3d M;
-    M << 1.0 + p[1], p[2], p[0], p[4], 1.0 + p[5], p[3], 0.0, 0.0, 1.0;
-    return M;
-  };
-  W = to_matrix(res.p);
+  Eigen::Matrix3d W = to_matrix(res.p);
   const double R2 = static_cast<double>(R) * R;
+  const double Rd = R;
   for (int it = 1; it <= options_.max_iterations; ++it) {
     res.iterations = it;
-    // Deformed subset.
-    double gsum = 0.0;
-    k = 0;
-    for (int dy = -R; dy <= R; ++dy) {
+    // The warp is affine, so the subset's image is a parallelogram: it lies inside the image
+    // when its four corners do.
+    for (const double cy : {-Rd, Rd})
+      for (const double cx : {-Rd, Rd})
+        if (!def_.inside(x0 + W(0, 2) + W(0, 0) * cx + W(0, 1) * cy,
+                         y0 + W(1, 2) + W(1, 0) * cx + W(1, 1) * cy))
+          return res;
+    double gsum = 0.0, gsq = 0.0, fg = 0.0;
+    Shape JG = Shape::Zero();
+    for (int dy = -R, k = 0; dy <= R; ++dy) {
       const double bx = x0 + W(0, 2) + W(0, 1) * dy;
       const double by = y0 + W(1, 2) + W(1, 1) * dy;
+      RowMoments mg;
       for (int dx = -R; dx <= R; ++dx, ++k) {
-        const double x = bx + W(0, 0) * dx;
-        const double y = by + W(1, 0) * dx;
-        if (!def_.inside(x, y)) return res;
-        g[k] = def_.value(x, y);
-        gsum += g[k];
+        const double g = def_.value(bx + W(0, 0) * dx, by + W(1, 0) * dx);
+        gsum += g;
+        gsq += g * g;
+        fg += f[k] * g;
+        const double gxg = gxs[k] * g;
+        const double gyg = gys[k] * g;
+        mg.x0 += gxg;
+        mg.x1 += gxg * dx;
+        mg.y0 += gyg;
+        mg.y1 += gyg * dx;
       }
+      add_row(JG, mg, dy);
     }
-    const double gmean = gsum / static_cast<double>(n);
-    double gss = 0.0;
-    double fg = 0.0;
-    for (k = 0; k < n; ++k) {
-      g[k] -= gmean;
-      gss += g[k] * g[k];
-      fg += f[k] * g[k];
-    }
+    const double gmean = gsum / nd;
+    const double gss = gsq - gsum * gmean;  // sum (g - g_mean)^2
+    // sum f~ (g - g_mean) = sum f~ g, since sum f~ = 0.
+    if (!(gss > 0.0)) return res;
     const double dg = std::sqrt(gss);
-    if (dg <= 0.0) return res;
     res.zncc = fg / (df * dg);
     const double ratio = df / dg;
-    Shape b = Shape::Zero();
-    for (k = 0; k < n; ++k) b.noalias() += J[k] * (f[k] - ratio * g[k]);
+    const Shape b = JF - ratio * (JG - gmean * JS);
     const Shape dp = -Hinv.solve(b);
     // W <- W o W(dp)^-1
     W = W * to_matrix(dp).inverse();
@@ -117,6 +214,27 @@ IcgnResult IcgnSolver::solve(int x0, int y0, const Shape& guess) const {
   res.p << W(0, 2), W(0, 0) - 1.0, W(0, 1), W(1, 2), W(1, 0), W(1, 1) - 1.0;
   res.ok = true;
   return res;
+}
+
+// The same loop compiled twice: for AVX2 (the B-spline's 4-vectors in one register) and for
+// the baseline instruction set. Neither contracts to FMA, so both give the same bits.
+#ifdef GS_DIC_X86
+__attribute__((target("avx2"))) IcgnResult IcgnSolver::solve_avx2(int x0, int y0,
+                                                                  const Shape& guess) const {
+  return solve_impl(x0, y0, guess);
+}
+#else
+IcgnResult IcgnSolver::solve_avx2(int x0, int y0, const Shape& guess) const {
+  return solve_impl(x0, y0, guess);
+}
+#endif
+
+IcgnResult IcgnSolver::solve_generic(int x0, int y0, const Shape& guess) const {
+  return solve_impl(x0, y0, guess);
+}
+
+IcgnResult IcgnSolver::solve(int x0, int y0, const Shape& guess) const {
+  return avx2_ ? solve_avx2(x0, y0, guess) : solve_generic(x0, y0, guess);
 }
 
 }  // namespace gs::dic

@@ -19,6 +19,8 @@ struct IcgnOptions {
   /// Stop when sqrt(du^2 + dv^2 + R^2 (dux^2 + duy^2 + dvx^2 + dvy^2)) < tolerance (px),
   /// R = subset half-width: the largest displacement change over the subset.
   double tolerance = 1e-3;
+  /// Threads that build the reference's B-spline and gradients in the constructor.
+  int threads = 1;
 };
 
 struct IcgnResult {
@@ -38,6 +40,10 @@ class IcgnSolver {
   int radius() const { return radius_; }
   /// Refines `guess` for the subset centred at integer pixel (x0, y0) of the reference.
   IcgnResult solve(int x0, int y0, const Shape& guess) const;
+  /// Whether `solve` runs the AVX2 build of the loop (x86-64 CPUs that have it). Both builds
+  /// give the same bits; `use_avx2(false)` forces the generic one (tests compare them).
+  bool avx2() const { return avx2_; }
+  void use_avx2(bool on);
 
  private:
   cv::Mat ref_;  // CV_64F
@@ -46,6 +52,10 @@ class IcgnSolver {
   const BSplineImage& def_;
   int radius_;
   IcgnOptions options_;
+  bool avx2_ = false;
+  IcgnResult solve_impl(int x0, int y0, const Shape& guess) const;
+  IcgnResult solve_avx2(int x0, int y0, const Shape& guess) const;
+  IcgnResult solve_generic(int x0, int y0, const Shape& guess) const;
 };
 
 }  // namespace gs::dic

@@ -49,9 +49,11 @@ DicField correlate(const cv::Mat& reference, const cv::Mat& deformed, const PoiG
   cv::Mat def64;
   reference.convertTo(ref64, CV_64F);
   deformed.convertTo(def64, CV_64F);
-  const BSplineImage def_spline(def64);
-  const IcgnSolver solver(ref64, def_spline, options.radius, options.icgn);
   const int threads = std::max(1, options.threads);
+  const BSplineImage def_spline(def64, threads);
+  IcgnOptions icgn = options.icgn;
+  icgn.threads = threads;
+  const IcgnSolver solver(ref64, def_spline, options.radius, icgn);
 
   DicField out;
   out.seconds_prefilter = since(t0);

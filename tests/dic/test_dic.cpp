@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <limits>
 #include <opencv2/imgcodecs.hpp>
 #include <random>
 
@@ -94,6 +95,108 @@ TEST(Icgn, RecoversSubPixelTranslations) {
     EXPECT_LT(std::abs(su / count), 0.01) << "mean bias in u at shift " << t;
     EXPECT_LT(std::abs(sv / count), 0.01) << "mean bias in v at shift " << t;
   }
+}
+
+TEST(Icgn, Avx2AndGenericBuildsGiveTheSameBits) {
+  // The IC-GN loop is compiled twice (icgn.cpp); neither build contracts to FMA, so the AVX2 one
+  // must reproduce the generic one exactly, iteration counts included.
+  const int n = 96;
+  const SpecklePattern pat(-10, -10, n + 10, n + 10, SpeckleParams{});
+  const cv::Mat ref = render(pat, n, identity());
+  const cv::Mat def = render(
+      pat, n,
+      [](const Eigen::Vector2d& x) {
+        return Eigen::Vector2d(x.x() - 0.37 - 0.004 * (x.x() - 48), x.y() + 0.61);
+      },
+      2.55, 11);
+  const BSplineImage spline(def);
+  IcgnSolver solver(ref, spline, 15);
+  if (!solver.avx2()) GTEST_SKIP() << "this CPU has no AVX2: only the generic build runs";
+  int checked = 0;
+  for (int y = 20; y <= 76; y += 7)
+    for (int x = 20; x <= 76; x += 7) {
+      solver.use_avx2(true);
+      const IcgnResult a = solver.solve(x, y, Shape::Zero());
+      solver.use_avx2(false);
+      const IcgnResult g = solver.solve(x, y, Shape::Zero());
+      ASSERT_TRUE(a.ok);
+      for (int k = 0; k < 6; ++k) EXPECT_EQ(a.p[k], g.p[k]) << x << "," << y << " p" << k;
+      EXPECT_EQ(a.zncc, g.zncc);
+      EXPECT_EQ(a.iterations, g.iterations);
+      ++checked;
+    }
+  EXPECT_EQ(checked, 81);
+}
+
+TEST(BSpline, PrefilterDoesNotDependOnTheThreadCount) {
+  // Columns are filtered in blocks of 64 spread over the threads: 150 columns make a partial
+  // block, 7 rows take the short-line (full mirror sum) branch of the initialisation.
+  for (const cv::Size size : {cv::Size(150, 90), cv::Size(150, 7)}) {
+    cv::Mat img(size, CV_64F);
+    std::mt19937_64 rng(5);
+    std::uniform_real_distribution<double> grey(0.0, 255.0);
+    for (int r = 0; r < img.rows; ++r)
+      for (int c = 0; c < img.cols; ++c) img.at<double>(r, c) = grey(rng);
+    const cv::Mat one = bspline_prefilter(img, 1);
+    const cv::Mat three = bspline_prefilter(img, 3);
+    EXPECT_EQ(cv::norm(one, three, cv::NORM_INF), 0.0) << size;
+    const BSplineImage spline(img, 3);
+    for (int r = 0; r < img.rows; ++r)
+      for (int c = 0; c < img.cols; ++c)
+        ASSERT_NEAR(spline.value(c, r), img.at<double>(r, c), 1e-9) << size << r << "," << c;
+  }
+}
+
+TEST(DicStrain, PlaneFitIsExactOnAffineFieldsWithHolesAndBorders) {
+  // u, v affine in (x, y): the least-squares plane of any window with enough valid POIs is the
+  // field itself, whatever POIs are missing and wherever the window is clipped by the border.
+  PoiGrid grid;
+  grid.nx = 37;
+  grid.ny = 23;
+  grid.x0 = 15;
+  grid.y0 = 15;
+  grid.step = 3;
+  grid.in_roi.assign(static_cast<std::size_t>(grid.size()), 1);
+  const double ux = 2.5e-3, uy = -1.2e-3, vx = 0.7e-3, vy = -4.1e-3;
+  std::vector<double> u(static_cast<std::size_t>(grid.size())), v(u.size());
+  std::vector<std::uint8_t> valid(u.size(), 1);
+  std::mt19937_64 rng(3);
+  std::bernoulli_distribution hole(0.2);
+  for (int i = 0; i < grid.size(); ++i) {
+    const auto c = static_cast<std::size_t>(i);
+    valid[c] = hole(rng) ? 0 : 1;
+    u[c] = valid[c] ? 0.31 + ux * grid.x(i) + uy * grid.y(i)
+                    : std::numeric_limits<double>::quiet_NaN();
+    v[c] = valid[c] ? -1.7 + vx * grid.x(i) + vy * grid.y(i)
+                    : std::numeric_limits<double>::quiet_NaN();
+  }
+  const int m = 4;
+  const StrainField s = plane_fit_strain(grid, u, v, valid, m, 21);
+  int fitted = 0, border = 0;
+  for (int i = 0; i < grid.size(); ++i) {
+    const auto c = static_cast<std::size_t>(i);
+    // Expected validity: a valid POI with at least (2m+1)^2/2 valid POIs in its clipped window.
+    int count = 0;
+    const int gi = i % grid.nx, gj = i / grid.nx;
+    for (int jj = std::max(0, gj - m); jj <= std::min(grid.ny - 1, gj + m); ++jj)
+      for (int ii = std::max(0, gi - m); ii <= std::min(grid.nx - 1, gi + m); ++ii)
+        count += valid[static_cast<std::size_t>(jj * grid.nx + ii)];
+    const bool expect = valid[c] && count >= (2 * m + 1) * (2 * m + 1) / 2;
+    ASSERT_EQ(s.valid[c] != 0, expect) << i;
+    if (!expect) {
+      EXPECT_TRUE(std::isnan(s.exx[c]));
+      continue;
+    }
+    EXPECT_NEAR(s.ux[c], ux, 1e-15);
+    EXPECT_NEAR(s.uy[c], uy, 1e-15);
+    EXPECT_NEAR(s.vx[c], vx, 1e-15);
+    EXPECT_NEAR(s.vy[c], vy, 1e-15);
+    EXPECT_NEAR(s.exx[c], ux + 0.5 * (ux * ux + vx * vx), 1e-15);
+    ++fitted;
+    border += (gi < m || gj < m || gi >= grid.nx - m || gj >= grid.ny - m) ? 1 : 0;
+  }
+  EXPECT_GT(fitted, grid.size() / 2);
+  EXPECT_GT(border, 50);  // clipped windows were fitted too
 }
 
 TEST(Dic, UniformStrainAndLargeShiftFromSeeds) {
