@@ -28,6 +28,7 @@ struct DicArgs {
   std::string roi;
   int subset = 31;
   int step = 2;
+  std::string shape = "affine";
   int strain_window = 15;
   std::string strain = "green";
   double zncc_min = 0.9;
@@ -47,6 +48,8 @@ void run_dic(const DicArgs& a) {
   if (a.subset < 5 || a.subset % 2 == 0)
     throw InputError("--subset", "must be an odd number of px >= 5", std::to_string(a.subset));
   if (a.step < 1) throw InputError("--step", "must be >= 1 px", std::to_string(a.step));
+  if (a.shape != "affine" && a.shape != "quadratic")
+    throw InputError("--shape", "must be affine or quadratic", a.shape);
   if (a.strain_window < 3 || a.strain_window % 2 == 0)
     throw InputError("--strain-window", "must be an odd number of POIs >= 3",
                      std::to_string(a.strain_window));
@@ -85,6 +88,7 @@ void run_dic(const DicArgs& a) {
   dic::SequenceOptions opt;
   opt.dic.radius = radius;
   opt.dic.search = a.search;
+  opt.dic.icgn.order = a.shape == "quadratic" ? 2 : 1;
   opt.dic.zncc_min = a.zncc_min;
   opt.dic.threads = a.threads > 0 ? a.threads : omp_get_max_threads();
   opt.step = a.step;
@@ -113,6 +117,7 @@ void run_dic(const DicArgs& a) {
   info.images = a.images;
   info.subset_px = a.subset;
   info.step_px = a.step;
+  info.shape_function = a.shape;
   info.strain_window_points = a.strain_window;
   info.vsg_px = result.frames.front().strain.vsg_px;
   info.incremental = a.incremental;
@@ -245,6 +250,9 @@ void register_dic(CLI::App& app) {
       ->required();
   c->add_option("--subset", args->subset, "subset size, px (odd)")->capture_default_str();
   c->add_option("--step", args->step, "POI spacing, px")->capture_default_str();
+  c->add_option("--shape", args->shape,
+                "subset shape function: affine (first order) or quadratic (second order)")
+      ->capture_default_str();
   c->add_option("--roi", args->roi, "region-of-interest mask image (non-zero = inside)");
   c->add_flag("--incremental", args->incremental,
               "correlate each image with the previous one and accumulate (default: cumulative)");

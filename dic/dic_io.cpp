@@ -43,6 +43,7 @@ void write_dic_hdf5(const std::filesystem::path& path, const SequenceResult& res
   h.attr("schema_version", 1);
   h.attr("subset_px", info.subset_px);
   h.attr("step_px", info.step_px);
+  h.attr("shape_function", info.shape_function);
   h.attr("strain_window_points", info.strain_window_points);
   h.attr("vsg_px", info.vsg_px);
   h.attr("mode", info.incremental ? "incremental" : "cumulative");

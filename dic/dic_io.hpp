@@ -17,6 +17,7 @@ struct DicRunInfo {
   std::vector<std::string> images;  // reference first
   int subset_px = 31;
   int step_px = 2;
+  std::string shape_function = "affine";  // or "quadratic"
   int strain_window_points = 15;  // 2m+1
   double vsg_px = 0.0;
   bool incremental = false;

@@ -14,6 +14,8 @@ IcgnSolver::IcgnSolver(const cv::Mat& reference, const BSplineImage& deformed, i
     : def_(deformed), radius_(radius), options_(options) {
   use_avx2(true);
   if (radius < 1) throw std::invalid_argument("IcgnSolver: subset radius must be >= 1");
+  if (options.order != 1 && options.order != 2)
+    throw std::invalid_argument("IcgnSolver: shape function order must be 1 or 2");
   reference.convertTo(ref_, CV_64F);
   if (ref_.rows != deformed.rows() || ref_.cols != deformed.cols())
     throw std::invalid_argument("IcgnSolver: reference and deformed images differ in size");
@@ -44,7 +46,10 @@ void IcgnSolver::use_avx2(bool on) {
 
 namespace {
 
-Eigen::Matrix3d to_matrix(const Shape& p) {
+using Shape1 = Eigen::Matrix<double, 6, 1>;  // the affine part: (u, ux, uy, v, vx, vy)
+
+template <class P>
+Eigen::Matrix3d to_matrix(const P& p) {
   Eigen::Matrix3d M;
   M << 1.0 + p[1], p[2], p[0], p[4], 1.0 + p[5], p[3], 0.0, 0.0, 1.0;
   return M;
@@ -56,7 +61,7 @@ Eigen::Matrix3d to_matrix(const Shape& p) {
 struct RowMoments {
   double x0 = 0.0, x1 = 0.0, y0 = 0.0, y1 = 0.0;  // sum q gx, sum q gx dx, sum q gy, sum q gy dx
 };
-inline void add_row(Shape& sum, const RowMoments& m, double dy) {
+inline void add_row(Shape1& sum, const RowMoments& m, double dy) {
   sum[0] += m.x0;
   sum[1] += m.x1;
   sum[2] += m.x0 * dy;
@@ -104,8 +109,8 @@ inline void add_row(Shape& sum, const RowMoments& m, double dy) {
   // h[q][.]: moments (1, dx, dy, dx^2, dx dy, dy^2) of q = gx^2, gx gy, gy^2.
   double h[3][6] = {};
   double fss = 0.0;
-  Shape JF = Shape::Zero();
-  Shape JS = Shape::Zero();
+  Shape1 JF = Shape1::Zero();
+  Shape1 JS = Shape1::Zero();
   for (int dy = -R, k = 0; dy <= R; ++dy) {
     double m[3][3] = {};  // x-moments 0, 1, 2 of gx^2, gx gy, gy^2 along this row
     RowMoments mf, ms;
@@ -159,7 +164,7 @@ inline void add_row(Shape& sum, const RowMoments& m, double dy) {
   const Eigen::LDLT<Eigen::Matrix<double, 6, 6>> Hinv(H);
   if (Hinv.info() != Eigen::Success || !Hinv.isPositive()) return res;
 
-  Eigen::Matrix3d W = to_matrix(res.p);
+  Eigen::Matrix3d W = to_matrix(res.p.head<6>());
   const double R2 = static_cast<double>(R) * R;
   const double Rd = R;
   for (int it = 1; it <= options_.max_iterations; ++it) {
@@ -175,7 +180,7 @@ inline void add_row(Shape& sum, const RowMoments& m, double dy) {
     using v4d = BSplineImage::v4d;
     v4d vsum{}, vsq{}, vfg{};
     double gsum = 0.0, gsq = 0.0, fg = 0.0;
-    Shape JG = Shape::Zero();
+    Shape1 JG = Shape1::Zero();
     const v4d lane = {0.0, 1.0, 2.0, 3.0};
     for (int dy = -R, k = 0; dy <= R; ++dy) {
       const double bx = x0 + W(0, 2) + W(0, 1) * dy;
@@ -236,8 +241,8 @@ inline void add_row(Shape& sum, const RowMoments& m, double dy) {
     const double dg = std::sqrt(gss);
     res.zncc = fg / (df * dg);
     const double ratio = df / dg;
-    const Shape b = JF - ratio * (JG - gmean * JS);
-    const Shape dp = -Hinv.solve(b);
+    const Shape1 b = JF - ratio * (JG - gmean * JS);
+    const Shape1 dp = -Hinv.solve(b);
     // W <- W o W(dp)^-1
     W = W * to_matrix(dp).inverse();
     const double norm =
@@ -249,7 +254,264 @@ inline void add_row(Shape& sum, const RowMoments& m, double dy) {
       break;
     }
   }
-  res.p << W(0, 2), W(0, 0) - 1.0, W(0, 1), W(1, 2), W(1, 0), W(1, 1) - 1.0;
+  res.p.setZero();
+  res.p.head<6>() << W(0, 2), W(0, 0) - 1.0, W(0, 1), W(1, 2), W(1, 0), W(1, 1) - 1.0;
+  res.ok = true;
+  return res;
+}
+
+Shape shift_shape(const Shape& p, double ddx, double ddy) {
+  Shape q = p;
+  // u(d) = u + ux d_x + uy d_y + uxx d_x^2/2 + uxy d_x d_y + uyy d_y^2/2, and its gradient.
+  for (const int a : {0, 3}) {
+    const int s = a == 0 ? 6 : 9;  // second-order block of this component
+    q[a] += (p[a + 1] * ddx + p[a + 2] * ddy) +
+            (0.5 * p[s] * ddx * ddx + p[s + 1] * ddx * ddy + 0.5 * p[s + 2] * ddy * ddy);
+    q[a + 1] += p[s] * ddx + p[s + 1] * ddy;
+    q[a + 2] += p[s + 1] * ddx + p[s + 2] * ddy;
+  }
+  return q;
+}
+
+namespace {
+
+// Second-order warps as 6 x 6 matrices (Gao, Pan et al. 2015): the matrix maps the monomials
+// xi(d) = (dx^2, dx dy, dy^2, dx, dy, 1) of a reference offset d to those of its image
+// w(d) = d + (U, V), products truncated at degree 2. Composition and inversion of warps become
+// matrix products and inverses (exact for affine warps, second-order accurate otherwise).
+using Quad = Eigen::Matrix<double, 6, 1>;  // coefficients over xi
+using Warp2 = Eigen::Matrix<double, 6, 6>;
+
+Quad quad_mul(const Quad& P, const Quad& Q) {  // P Q up to degree 2
+  Quad r;
+  r << P[0] * Q[5] + P[5] * Q[0] + P[3] * Q[3],
+      P[1] * Q[5] + P[5] * Q[1] + P[3] * Q[4] + P[4] * Q[3],
+      P[2] * Q[5] + P[5] * Q[2] + P[4] * Q[4], P[3] * Q[5] + P[5] * Q[3], P[4] * Q[5] + P[5] * Q[4],
+      P[5] * Q[5];
+  return r;
+}
+
+Warp2 to_warp2(const Shape& p) {
+  Quad X, Y;  // dx + U and dy + V over xi
+  X << 0.5 * p[6], p[7], 0.5 * p[8], 1.0 + p[1], p[2], p[0];
+  Y << 0.5 * p[9], p[10], 0.5 * p[11], p[4], 1.0 + p[5], p[3];
+  Warp2 M;
+  M.row(0) = quad_mul(X, X).transpose();
+  M.row(1) = quad_mul(X, Y).transpose();
+  M.row(2) = quad_mul(Y, Y).transpose();
+  M.row(3) = X.transpose();
+  M.row(4) = Y.transpose();
+  M.row(5) << 0.0, 0.0, 0.0, 0.0, 0.0, 1.0;
+  return M;
+}
+
+Shape from_warp2(const Warp2& M) {
+  Shape p;
+  p << M(3, 5), M(3, 3) - 1.0, M(3, 4), M(4, 5), M(4, 3), M(4, 4) - 1.0, 2.0 * M(3, 0), M(3, 1),
+      2.0 * M(3, 2), 2.0 * M(4, 0), M(4, 1), 2.0 * M(4, 2);
+  return p;
+}
+
+// Parameter k of the shape is c_k times the monomial dx^px_k dy^py_k of component comp_k
+// (0: U, 1: V); its steepest-descent image is J_k = c_k g_comp dx^px dy^py.
+constexpr int kComp[12] = {0, 0, 0, 1, 1, 1, 0, 0, 0, 1, 1, 1};
+constexpr int kPx[12] = {0, 1, 0, 0, 1, 0, 2, 1, 0, 2, 1, 0};
+constexpr int kPy[12] = {0, 0, 1, 0, 0, 1, 0, 1, 2, 0, 1, 2};
+constexpr double kCoef[12] = {1, 1, 1, 1, 1, 1, 0.5, 1, 0.5, 0.5, 1, 0.5};
+
+}  // namespace
+
+// Second-order IC-GN: the same ZNSSD algebra as solve_impl (b = JF - ratio (JG - g_mean JS)),
+// with 12 parameters. Every sum over the subset is a moment sum q dx^i dy^j: per row the
+// x-moments, then weighted with powers of dy.
+[[gnu::always_inline]] inline IcgnResult IcgnSolver::solve_impl2(int x0, int y0,
+                                                                 const Shape& guess) const {
+  using Vec12 = Eigen::Matrix<double, 12, 1>;
+  IcgnResult res;
+  res.p = guess;
+  const int R = radius_;
+  if (x0 - R < 0 || y0 - R < 0 || x0 + R >= ref_.cols || y0 + R >= ref_.rows) return res;
+  const int side = 2 * R + 1;
+  const auto n = static_cast<std::size_t>(side) * static_cast<std::size_t>(side);
+  const double nd = static_cast<double>(n);
+  thread_local std::vector<double> scratch;
+  scratch.resize(3 * n);
+  double* const f = scratch.data();
+  double* const gxs = f + n;
+  double* const gys = gxs + n;
+  double fsum = 0.0;
+  for (int dy = -R, k = 0; dy <= R; ++dy) {
+    const double* fr = ref_.ptr<double>(y0 + dy) + x0 - R;
+    const double* gxr = gx_.ptr<double>(y0 + dy) + x0 - R;
+    const double* gyr = gy_.ptr<double>(y0 + dy) + x0 - R;
+    for (int i = 0; i < side; ++i, ++k) {
+      f[k] = fr[i];
+      gxs[k] = gxr[i];
+      gys[k] = gyr[i];
+      fsum += fr[i];
+    }
+  }
+  const double fmean = fsum / nd;
+  // Mq[q][i][j] = sum q dx^i dy^j (i + j <= 4) for q = gx^2, gx gy, gy^2; MF[c][i][j] = sum
+  // g_c f~ dx^i dy^j and MS[c][i][j] = sum g_c dx^i dy^j (i + j <= 2).
+  double Mq[3][5][5] = {};
+  double MF[2][3][3] = {};
+  double MS[2][3][3] = {};
+  double fss = 0.0;
+  for (int dy = -R, k = 0; dy <= R; ++dy) {
+    double xq[3][5] = {}, xf[2][3] = {}, xs[2][3] = {};
+    for (int dx = -R; dx <= R; ++dx, ++k) {
+      const double fk = f[k] - fmean;
+      f[k] = fk;
+      fss += fk * fk;
+      const double g[2] = {gxs[k], gys[k]};
+      const double q[3] = {g[0] * g[0], g[0] * g[1], g[1] * g[1]};
+      const double pw[5] = {1.0, 1.0 * dx, 1.0 * dx * dx, 1.0 * dx * dx * dx,
+                            1.0 * dx * dx * dx * dx};
+      for (int a = 0; a < 3; ++a)
+        for (int i = 0; i < 5; ++i) xq[a][i] += q[a] * pw[i];
+      for (int c = 0; c < 2; ++c)
+        for (int i = 0; i < 3; ++i) {
+          xf[c][i] += g[c] * fk * pw[i];
+          xs[c][i] += g[c] * pw[i];
+        }
+    }
+    const double py[5] = {1.0, 1.0 * dy, 1.0 * dy * dy, 1.0 * dy * dy * dy,
+                          1.0 * dy * dy * dy * dy};
+    for (int a = 0; a < 3; ++a)
+      for (int i = 0; i < 5; ++i)
+        for (int j = 0; i + j < 5; ++j) Mq[a][i][j] += xq[a][i] * py[j];
+    for (int c = 0; c < 2; ++c)
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; i + j < 3; ++j) {
+          MF[c][i][j] += xf[c][i] * py[j];
+          MS[c][i][j] += xs[c][i] * py[j];
+        }
+  }
+  const double df = std::sqrt(fss);
+  if (df < 0.255 * std::sqrt(nd)) return res;  // textureless, as in solve_impl
+  Eigen::Matrix<double, 12, 12> H;
+  Vec12 JF, JS;
+  for (int k = 0; k < 12; ++k) {
+    for (int l = 0; l < 12; ++l) {
+      const int q = kComp[k] + kComp[l];  // 0: gx gx, 1: gx gy, 2: gy gy
+      H(k, l) = kCoef[k] * kCoef[l] * Mq[q][kPx[k] + kPx[l]][kPy[k] + kPy[l]];
+    }
+    JF[k] = kCoef[k] * MF[kComp[k]][kPx[k]][kPy[k]];
+    JS[k] = kCoef[k] * MS[kComp[k]][kPx[k]][kPy[k]];
+  }
+  const Eigen::LDLT<Eigen::Matrix<double, 12, 12>> Hinv(H);
+  if (Hinv.info() != Eigen::Success || !Hinv.isPositive()) return res;
+
+  Warp2 W = to_warp2(res.p);
+  Shape p = res.p;
+  const double R2 = static_cast<double>(R) * R;
+  for (int it = 1; it <= options_.max_iterations; ++it) {
+    res.iterations = it;
+    // Row dy of the subset maps to x = ax + bx dx + cx dx^2, y = ay + by dx + cy dx^2.
+    const auto row = [&](int dy, double c[6]) {
+      c[0] = x0 + p[0] + p[2] * dy + 0.5 * p[8] * dy * dy;
+      c[1] = 1.0 + p[1] + p[7] * dy;
+      c[2] = 0.5 * p[6];
+      c[3] = y0 + dy + p[3] + p[5] * dy + 0.5 * p[11] * dy * dy;
+      c[4] = p[4] + p[10] * dy;
+      c[5] = 0.5 * p[9];
+    };
+    // The image of the subset is inside when its boundary is (a quadratic warp bends the
+    // edges, so every boundary pixel is checked, not only the corners).
+    bool inside = true;
+    for (int dy = -R; dy <= R && inside; ++dy) {
+      double c[6];
+      row(dy, c);
+      const int step = (dy == -R || dy == R) ? 1 : 2 * R;
+      for (int dx = -R; dx <= R; dx += step)
+        inside = inside &&
+                 def_.inside(c[0] + c[1] * dx + c[2] * dx * dx, c[3] + c[4] * dx + c[5] * dx * dx);
+    }
+    if (!inside) return res;
+    using v4d = BSplineImage::v4d;
+    v4d vsum{}, vsq{}, vfg{};
+    double gsum = 0.0, gsq = 0.0, fg = 0.0;
+    double MG[2][3][3] = {};
+    const v4d lane = {0.0, 1.0, 2.0, 3.0};
+    const auto hsum = [](const v4d& v) { return (v[0] + v[1]) + (v[2] + v[3]); };
+    for (int dy = -R, k = 0; dy <= R; ++dy) {
+      double c[6];
+      row(dy, c);
+      v4d mx[2][3] = {};
+      int dx = -R;
+      for (; dx + 3 <= R; dx += 4, k += 4) {
+        const v4d dxv = dx + lane;
+        double xs[4], ys[4];
+        for (int i = 0; i < 4; ++i) {
+          xs[i] = c[0] + c[1] * dxv[i] + c[2] * dxv[i] * dxv[i];
+          ys[i] = c[3] + c[4] * dxv[i] + c[5] * dxv[i] * dxv[i];
+        }
+        v4d g;
+        def_.value4(xs, ys, g);
+        v4d fv, gxv, gyv;
+        __builtin_memcpy(&fv, f + k, sizeof fv);
+        __builtin_memcpy(&gxv, gxs + k, sizeof gxv);
+        __builtin_memcpy(&gyv, gys + k, sizeof gyv);
+        vsum += g;
+        vsq += g * g;
+        vfg += fv * g;
+        const v4d gg[2] = {gxv * g, gyv * g};
+        for (int a = 0; a < 2; ++a) {
+          mx[a][0] += gg[a];
+          mx[a][1] += gg[a] * dxv;
+          mx[a][2] += gg[a] * dxv * dxv;
+        }
+      }
+      double xm[2][3] = {};
+      for (; dx <= R; ++dx, ++k) {
+        const double g =
+            def_.value(c[0] + c[1] * dx + c[2] * dx * dx, c[3] + c[4] * dx + c[5] * dx * dx);
+        gsum += g;
+        gsq += g * g;
+        fg += f[k] * g;
+        const double gg[2] = {gxs[k] * g, gys[k] * g};
+        for (int a = 0; a < 2; ++a) {
+          xm[a][0] += gg[a];
+          xm[a][1] += gg[a] * dx;
+          xm[a][2] += gg[a] * dx * dx;
+        }
+      }
+      const double py[3] = {1.0, 1.0 * dy, 1.0 * dy * dy};
+      for (int a = 0; a < 2; ++a)
+        for (int i = 0; i < 3; ++i) {
+          const double m = xm[a][i] + hsum(mx[a][i]);
+          for (int j = 0; i + j < 3; ++j) MG[a][i][j] += m * py[j];
+        }
+    }
+    gsum += hsum(vsum);
+    gsq += hsum(vsq);
+    fg += hsum(vfg);
+    const double gmean = gsum / nd;
+    const double gss = gsq - gsum * gmean;
+    if (!(gss > 0.0)) return res;
+    const double dg = std::sqrt(gss);
+    res.zncc = fg / (df * dg);
+    const double ratio = df / dg;
+    Vec12 b;
+    for (int k = 0; k < 12; ++k)
+      b[k] = JF[k] - ratio * (kCoef[k] * MG[kComp[k]][kPx[k]][kPy[k]] - gmean * JS[k]);
+    const Vec12 dp = -Hinv.solve(b);
+    W = W * to_warp2(dp).inverse();  // W <- W o W(dp)^-1
+    p = from_warp2(W);
+    const double norm =
+        std::sqrt(dp[0] * dp[0] + dp[3] * dp[3] +
+                  R2 * (dp[1] * dp[1] + dp[2] * dp[2] + dp[4] * dp[4] + dp[5] * dp[5]) +
+                  R2 * R2 *
+                      (0.25 * (dp[6] * dp[6] + dp[8] * dp[8] + dp[9] * dp[9] + dp[11] * dp[11]) +
+                       dp[7] * dp[7] + dp[10] * dp[10]));
+    if (!std::isfinite(norm)) return res;
+    if (norm < options_.tolerance) {
+      res.converged = true;
+      break;
+    }
+  }
+  res.p = p;
   res.ok = true;
   return res;
 }
@@ -259,16 +521,16 @@ inline void add_row(Shape& sum, const RowMoments& m, double dy) {
 #ifdef GS_DIC_X86
 __attribute__((target("avx2"))) IcgnResult IcgnSolver::solve_avx2(int x0, int y0,
                                                                   const Shape& guess) const {
-  return solve_impl(x0, y0, guess);
+  return options_.order == 2 ? solve_impl2(x0, y0, guess) : solve_impl(x0, y0, guess);
 }
 #else
 IcgnResult IcgnSolver::solve_avx2(int x0, int y0, const Shape& guess) const {
-  return solve_impl(x0, y0, guess);
+  return options_.order == 2 ? solve_impl2(x0, y0, guess) : solve_impl(x0, y0, guess);
 }
 #endif
 
 IcgnResult IcgnSolver::solve_generic(int x0, int y0, const Shape& guess) const {
-  return solve_impl(x0, y0, guess);
+  return options_.order == 2 ? solve_impl2(x0, y0, guess) : solve_impl(x0, y0, guess);
 }
 
 IcgnResult IcgnSolver::solve(int x0, int y0, const Shape& guess) const {

@@ -1,6 +1,8 @@
-// Inverse-compositional Gauss–Newton (IC-GN) subset matching with a first-order shape function
-// and the ZNSSD criterion (Pan, Li & Tong 2013). The reference subset's Hessian is precomputed;
-// each iteration interpolates the deformed subset with the bicubic B-spline.
+// Inverse-compositional Gauss–Newton (IC-GN) subset matching with the ZNSSD criterion (Pan, Li &
+// Tong 2013) and a first-order (affine) or second-order (quadratic) shape function (Gao, Pan et
+// al. 2015, "High-accuracy and high-efficiency second-order IC-GN"). The reference subset's
+// Hessian is precomputed; each iteration interpolates the deformed subset with the bicubic
+// B-spline.
 #pragma once
 
 #include <Eigen/Core>
@@ -10,14 +12,24 @@
 
 namespace gs::dic {
 
-/// First-order shape function p = (u, du/dx, du/dy, v, dv/dx, dv/dy): a reference point
-/// x0 + d maps to x0 + d + (u + ux*dx + uy*dy, v + vx*dx + vy*dy) in the deformed image.
-using Shape = Eigen::Matrix<double, 6, 1>;
+/// Shape function p = (u, ux, uy, v, vx, vy, uxx, uxy, uyy, vxx, vxy, vyy): a reference point
+/// x0 + d maps to x0 + d + (U, V) in the deformed image, with
+///   U = u + ux dx + uy dy + uxx dx^2/2 + uxy dx dy + uyy dy^2/2, V likewise.
+/// First-order (affine) subsets use the first six entries and keep the last six zero.
+using Shape = Eigen::Matrix<double, 12, 1>;
+
+/// The shape function of a neighbouring subset centre (x0 + ddx, y0 + ddy): its Taylor shift.
+/// For first-order shapes this is u + (ux ddx + uy ddy) with the gradients unchanged.
+Shape shift_shape(const Shape& p, double ddx, double ddy);
 
 struct IcgnOptions {
+  /// 1: affine subsets (6 parameters); 2: quadratic subsets (12 parameters), which follow
+  /// displacement fields that curve within a subset (short wavelengths) at some noise cost.
+  int order = 1;
   int max_iterations = 20;
-  /// Stop when sqrt(du^2 + dv^2 + R^2 (dux^2 + duy^2 + dvx^2 + dvy^2)) < tolerance (px),
-  /// R = subset half-width: the largest displacement change over the subset.
+  /// Stop when sqrt(du^2 + dv^2 + R^2 (dux^2 + duy^2 + dvx^2 + dvy^2)
+  ///                + R^4 (duxx^2/4 + duxy^2 + duyy^2/4 + dvxx^2/4 + dvxy^2 + dvyy^2/4)) < tolerance
+  /// (px), R = subset half-width: the largest displacement change over the subset.
   double tolerance = 1e-3;
   /// Threads that build the reference's B-spline and gradients in the constructor.
   int threads = 1;
@@ -54,6 +66,7 @@ class IcgnSolver {
   IcgnOptions options_;
   bool avx2_ = false;
   IcgnResult solve_impl(int x0, int y0, const Shape& guess) const;
+  IcgnResult solve_impl2(int x0, int y0, const Shape& guess) const;
   IcgnResult solve_avx2(int x0, int y0, const Shape& guess) const;
   IcgnResult solve_generic(int x0, int y0, const Shape& guess) const;
 };

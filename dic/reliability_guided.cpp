@@ -161,12 +161,8 @@ DicField correlate(const cv::Mat& reference, const cv::Mat& deformed, const PoiG
           from = jj * grid.nx + ii;
         }
       }
-      const Shape& pn = out.p[static_cast<std::size_t>(from)];
-      const double ddx = grid.x(idx) - grid.x(from);
-      const double ddy = grid.y(idx) - grid.y(from);
-      Shape guess = pn;
-      guess[0] += pn[1] * ddx + pn[2] * ddy;
-      guess[3] += pn[4] * ddx + pn[5] * ddy;
+      const Shape guess = shift_shape(out.p[static_cast<std::size_t>(from)],
+                                      grid.x(idx) - grid.x(from), grid.y(idx) - grid.y(from));
       res[static_cast<std::size_t>(q)] = solver.solve(grid.x(idx), grid.y(idx), guess);
     }
     front.clear();

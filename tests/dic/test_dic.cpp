@@ -110,22 +110,121 @@ TEST(Icgn, Avx2AndGenericBuildsGiveTheSameBits) {
       },
       2.55, 11);
   const BSplineImage spline(def);
-  IcgnSolver solver(ref, spline, 15);
-  if (!solver.avx2()) GTEST_SKIP() << "this CPU has no AVX2: only the generic build runs";
-  int checked = 0;
-  for (int y = 20; y <= 76; y += 7)
-    for (int x = 20; x <= 76; x += 7) {
-      solver.use_avx2(true);
-      const IcgnResult a = solver.solve(x, y, Shape::Zero());
-      solver.use_avx2(false);
-      const IcgnResult g = solver.solve(x, y, Shape::Zero());
-      ASSERT_TRUE(a.ok);
-      for (int k = 0; k < 6; ++k) EXPECT_EQ(a.p[k], g.p[k]) << x << "," << y << " p" << k;
-      EXPECT_EQ(a.zncc, g.zncc);
-      EXPECT_EQ(a.iterations, g.iterations);
-      ++checked;
+  for (const int order : {1, 2}) {
+    IcgnOptions opt;
+    opt.order = order;
+    IcgnSolver solver(ref, spline, 15, opt);
+    if (!solver.avx2()) GTEST_SKIP() << "this CPU has no AVX2: only the generic build runs";
+    int checked = 0;
+    for (int y = 20; y <= 76; y += 7)
+      for (int x = 20; x <= 76; x += 7) {
+        solver.use_avx2(true);
+        const IcgnResult a = solver.solve(x, y, Shape::Zero());
+        solver.use_avx2(false);
+        const IcgnResult g = solver.solve(x, y, Shape::Zero());
+        ASSERT_TRUE(a.ok);
+        for (int k = 0; k < 12; ++k)
+          EXPECT_EQ(a.p[k], g.p[k]) << x << "," << y << " p" << k << " order " << order;
+        EXPECT_EQ(a.zncc, g.zncc);
+        EXPECT_EQ(a.iterations, g.iterations);
+        ++checked;
+      }
+    EXPECT_EQ(checked, 81);
+  }
+}
+
+TEST(Icgn, ShiftShapeIsExactForQuadraticFields) {
+  // u(X) = 0.3 + 2e-3 X - 1e-3 Y + 4e-4 X^2/2 - 3e-4 X Y + 1e-4 Y^2/2 (and a v): the shape at
+  // the origin shifted by (ddx, ddy) is the shape of the same field at (ddx, ddy).
+  const auto at = [](double X, double Y) {
+    Shape p;
+    p << 0.3 + 2e-3 * X - 1e-3 * Y + 2e-4 * X * X - 3e-4 * X * Y + 0.5e-4 * Y * Y,
+        2e-3 + 4e-4 * X - 3e-4 * Y, -1e-3 - 3e-4 * X + 1e-4 * Y,
+        -0.7 + 5e-3 * X + 3e-3 * Y + 1e-4 * X * X + 2e-4 * X * Y - 3e-4 * Y * Y,
+        5e-3 + 2e-4 * X + 2e-4 * Y, 3e-3 + 2e-4 * X - 6e-4 * Y, 4e-4, -3e-4, 1e-4, 2e-4, 2e-4,
+        -6e-4;
+    return p;
+  };
+  const Shape shifted = shift_shape(at(0, 0), 6.0, -4.0);
+  const Shape exact = at(6.0, -4.0);
+  for (int k = 0; k < 12; ++k) EXPECT_NEAR(shifted[k], exact[k], 1e-15) << k;
+  // First order: gradients unchanged, u moved along them.
+  Shape a = Shape::Zero();
+  a.head<6>() << 0.5, 0.01, -0.02, 0.1, 0.003, 0.004;
+  const Shape b = shift_shape(a, 2.0, 2.0);
+  EXPECT_EQ(b[0], 0.5 + (0.01 * 2.0 + -0.02 * 2.0));
+  EXPECT_EQ(b[3], 0.1 + (0.003 * 2.0 + 0.004 * 2.0));
+  EXPECT_EQ(b.segment<2>(1), a.segment<2>(1));
+  EXPECT_EQ(b.tail<8>(), a.tail<8>());
+}
+
+// A smooth speckle image: Gaussian blobs (sigma 1.5-2.5 px) sampled exactly at the pixel
+// centres of g(x) = f(X(x)), no area sampling, so two images differ only by the motion: the
+// B-spline's own error stays far below the tolerances of the shape-function tests.
+cv::Mat gaussian_speckle(int n, const InverseMap& inverse) {
+  struct Blob {
+    double x, y, s, a;
+  };
+  std::mt19937_64 rng(17);
+  std::uniform_real_distribution<double> pos(-10.0, n + 10.0), sig(1.5, 2.5), amp(60.0, 120.0);
+  std::vector<Blob> blobs(static_cast<std::size_t>((n + 20) * (n + 20) / 14));
+  for (auto& b : blobs) b = {pos(rng), pos(rng), sig(rng), amp(rng)};
+  cv::Mat img(n, n, CV_64F);
+  for (int r = 0; r < n; ++r)
+    for (int c = 0; c < n; ++c) {
+      const Eigen::Vector2d X = inverse(Eigen::Vector2d(c, r));
+      double v = 40.0;
+      for (const auto& b : blobs) {
+        const double d2 = (X.x() - b.x) * (X.x() - b.x) + (X.y() - b.y) * (X.y() - b.y);
+        if (d2 < 25.0 * b.s * b.s) v += b.a * std::exp(-0.5 * d2 / (b.s * b.s));
+      }
+      img.at<double>(r, c) = v;
     }
-  EXPECT_EQ(checked, 81);
+  return img;
+}
+
+TEST(Icgn, QuadraticSubsetsFollowCurvedDisplacements) {
+  // x = X + u(X): u = 0.4 + k (X - c)^2 / 2, v = -0.3 + k (X - c)(Y - c) / 2 with k = 8e-4/px.
+  // Over a 31 px subset an affine shape misses the mean of the quadratic term (k/2 <dx^2> =
+  // 4e-4 * 80 = 0.032 px at the centre); the quadratic shape recovers u, v and the curvatures.
+  const int n = 112;
+  const double c = 56.0, k = 8e-4;
+  const auto u = [&](double X, double Y) {
+    return Eigen::Vector2d(0.4 + 0.5 * k * (X - c) * (X - c), -0.3 + 0.5 * k * (X - c) * (Y - c));
+  };
+  const cv::Mat ref = gaussian_speckle(n, identity());
+  const cv::Mat def = gaussian_speckle(n, [&](const Eigen::Vector2d& x) {
+    Eigen::Vector2d X = x;  // fixed point of X = x - u(X): |grad u| < 0.05 contracts
+    for (int i = 0; i < 60; ++i) X = x - u(X.x(), X.y());
+    return X;
+  });
+  const BSplineImage spline(def);
+  IcgnOptions o1, o2;
+  o2.order = 2;
+  const IcgnSolver affine(ref, spline, 15, o1), quadratic(ref, spline, 15, o2);
+  double worst1 = 0.0, worst2 = 0.0;
+  for (int y = 36; y <= 76; y += 20)
+    for (int x = 36; x <= 76; x += 20) {
+      const Eigen::Vector2d t = u(x, y);
+      const IcgnResult r1 = affine.solve(x, y, Shape::Zero());
+      const IcgnResult r2 = quadratic.solve(x, y, Shape::Zero());
+      ASSERT_TRUE(r1.ok && r2.ok);
+      EXPECT_TRUE(r2.converged);
+      worst1 = std::max(worst1, std::abs(r1.p[0] - t.x()));
+      worst2 = std::max({worst2, std::abs(r2.p[0] - t.x()), std::abs(r2.p[3] - t.y())});
+      EXPECT_NEAR(r2.p[1], k * (x - c), 1e-4);             // ux
+      EXPECT_NEAR(r2.p[4], 0.5 * k * (y - c), 1e-4);       // vx
+      EXPECT_NEAR(r2.p[5], 0.5 * k * (x - c), 1e-4);       // vy
+      EXPECT_NEAR(r2.p[6], k, 3e-5);                       // uxx
+      EXPECT_NEAR(r2.p[7], 0.0, 3e-5);                     // uxy
+      EXPECT_NEAR(r2.p[8], 0.0, 3e-5);                     // uyy
+      EXPECT_NEAR(r2.p[9], 0.0, 3e-5);                     // vxx
+      EXPECT_NEAR(r2.p[10], 0.5 * k, 3e-5);                // vxy
+      EXPECT_NEAR(r2.p[11], 0.0, 3e-5);                    // vyy
+      EXPECT_EQ(r1.p.tail<6>(), Shape::Zero().tail<6>());  // affine: no second-order terms
+    }
+  EXPECT_GT(worst1, 0.025);  // the affine subset's bias, 4e-4 <dx^2> = 0.032 px
+  EXPECT_LT(worst2, 1e-3);
 }
 
 TEST(BSpline, PrefilterDoesNotDependOnTheThreadCount) {

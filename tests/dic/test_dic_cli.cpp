@@ -176,6 +176,7 @@ TEST_F(DicCli, WritesHdf5CsvAndVtk) {
   EXPECT_EQ(h5::attr_number(h, "image_rows"), 72);
   EXPECT_EQ(h5::attr_number(h, "image_cols"), 80);
   EXPECT_EQ(h5::attr_string(h, "mode"), "incremental");
+  EXPECT_EQ(h5::attr_string(h, "shape_function"), "affine");
   EXPECT_EQ(h5::attr_string(h, "images"), p("ref.png") + "\n" + p("def.png") + "\n" + p("def.png"));
   const auto x = h5::read(h, "/x"), y = h5::read(h, "/y");
   ASSERT_EQ(x.size(), 15u);
@@ -437,6 +438,26 @@ TEST_F(DicCli, SearchRangeTooSmallFailsToFindALargeMotion) {
   RecordProperty("worst_error_px", std::to_string(worst));
 }
 
+TEST_F(DicCli, QuadraticShapeRecoversTheTranslationToo) {
+  // --shape quadratic on the translation pair: the same motion within the same bounds, and the
+  // choice recorded in the file.
+  translation_pair();
+  const CliRun r = granoscope("dic " + p("ref.png") + " " + p("def.png") + " -o " + p("q.h5") +
+                                  " --subset 21 --step 4 --strain-window 5 --shape quadratic",
+                              dir);
+  ASSERT_EQ(r.rc, 0) << r.err;
+  const fs::path h = dir / "q.h5";
+  EXPECT_EQ(h5::attr_string(h, "shape_function"), "quadratic");
+  const auto u = h5::read(h, "/u"), v = h5::read(h, "/v"), valid = h5::read(h, "/valid");
+  double worst = 0.0;
+  for (std::size_t k = 0; k < u.size(); ++k) {
+    ASSERT_EQ(valid[k], 1.0) << k;
+    worst = std::max({worst, std::abs(u[k] - 1.3), std::abs(v[k] - 0.4)});
+  }
+  EXPECT_LT(worst, 0.05);
+  RecordProperty("worst_displacement_error_px", std::to_string(worst));
+}
+
 TEST_F(DicCli, BadInputsGiveOneLineErrors) {
   translation_pair();
   expect_one_line_error(
@@ -458,6 +479,10 @@ TEST_F(DicCli, BadInputsGiveOneLineErrors) {
   expect_one_line_error(
       granoscope("dic " + p("ref.png") + " " + p("def.png") + " --subset 30 -o " + p("o.h5"), dir),
       "--subset: must be an odd number of px >= 5 (30)");
+  expect_one_line_error(
+      granoscope("dic " + p("ref.png") + " " + p("def.png") + " --shape cubic -o " + p("o.h5"),
+                 dir),
+      "--shape: must be affine or quadratic (cubic)");
   // Issue 15: a plane-fit window wider than the 15 x 13 POI grid gave all-NaN strains, exit 0.
   const auto wide = granoscope("dic " + p("ref.png") + " " + p("def.png") +
                                    " --subset 21 --step 4 --strain-window 15 -o " + p("o.h5"),
@@ -476,7 +501,7 @@ TEST_F(DicCli, HelpListsTheOptionsWithTheirDefaults) {
   for (const char* opt :
        {"--subset INT=31", "--step INT=2", "--roi TEXT", "--incremental", "--strain-window INT=15",
         "--strain TEXT=green", "--zncc-min FLOAT=0.9", "--search INT=30",
-        "--threads INT:INT in [0 - 1024]=0", "--no-csv", "--no-vtk"})
+        "--threads INT:INT in [0 - 1024]=0", "--no-csv", "--no-vtk", "--shape TEXT=affine"})
     EXPECT_NE(dic.out.find(opt), std::string::npos) << opt << "\n" << dic.out;
   const CliRun render = granoscope("render --help", dir);
   EXPECT_EQ(render.rc, 0);
