@@ -13,6 +13,7 @@
 #include "atomic_file.hpp"
 #include "commands.hpp"
 #include "dic_io.hpp"
+#include "dic_run.hpp"
 #include "dic_sequence.hpp"
 #include "errors.hpp"
 #include "hdf5_trajectory.hpp"
@@ -26,39 +27,14 @@ struct DicArgs {
   std::vector<std::string> images;
   std::string output;
   std::string roi;
-  int subset = 31;
-  int step = 2;
-  std::string shape = "affine";
-  int strain_window = 15;
-  std::string strain = "green";
-  double zncc_min = 0.9;
-  int search = 30;
-  int threads = 0;
-  bool incremental = false;
+  dic::DicRequest req;
   bool no_csv = false;
   bool no_vtk = false;
 };
 
-std::string size_str(const cv::Mat& m) {
-  return std::to_string(m.cols) + "x" + std::to_string(m.rows);
-}
-
 void run_dic(const DicArgs& a) {
   if (a.images.size() < 2) throw InputError("IMAGES", "need a reference and at least one image");
-  if (a.subset < 5 || a.subset % 2 == 0)
-    throw InputError("--subset", "must be an odd number of px >= 5", std::to_string(a.subset));
-  if (a.step < 1) throw InputError("--step", "must be >= 1 px", std::to_string(a.step));
-  if (a.shape != "affine" && a.shape != "quadratic")
-    throw InputError("--shape", "must be affine or quadratic", a.shape);
-  if (a.strain_window < 3 || a.strain_window % 2 == 0)
-    throw InputError("--strain-window", "must be an odd number of POIs >= 3",
-                     std::to_string(a.strain_window));
-  if (a.strain != "green" && a.strain != "small")
-    throw InputError("--strain", "must be green or small", a.strain);
-  if (!(a.zncc_min > -1.0 && a.zncc_min < 1.0))
-    throw InputError("--zncc-min", "must be in (-1, 1)", value_str(a.zncc_min));
-  if (a.search < 0) throw InputError("--search", "must be >= 0 px", std::to_string(a.search));
-
+  dic::check_request(a.req);  // before reading any image
   using Clock = std::chrono::steady_clock;
   const auto since = [](Clock::time_point t) {
     return std::chrono::duration<double>(Clock::now() - t).count();
@@ -66,72 +42,19 @@ void run_dic(const DicArgs& a) {
   const auto t_start = Clock::now();
   std::vector<cv::Mat> images;
   for (const auto& p : a.images) images.push_back(dic::read_grey_image(p));
-  const double seconds_read = since(t_start);
-  for (std::size_t k = 1; k < images.size(); ++k)
-    if (images[k].size() != images[0].size())
-      throw InputError(a.images[k], "image size differs from the reference",
-                       size_str(images[k]) + " vs " + size_str(images[0]));
-  for (std::size_t k = 0; k < images.size(); ++k)
-    if (dic::is_textureless(images[k]))
-      throw InputError(a.images[k], "image has no texture (uniform grey level)");
   cv::Mat roi;
-  if (!a.roi.empty()) {
-    roi = dic::read_grey_image(a.roi);
-    if (roi.size() != images[0].size())
-      throw InputError(a.roi, "ROI mask size differs from the images",
-                       size_str(roi) + " vs " + size_str(images[0]));
-  }
-  const int radius = a.subset / 2;
-  if (images[0].cols < a.subset || images[0].rows < a.subset)
-    throw InputError(a.images[0], "image smaller than one subset", size_str(images[0]));
-
-  dic::SequenceOptions opt;
-  opt.dic.radius = radius;
-  opt.dic.search = a.search;
-  opt.dic.icgn.order = a.shape == "quadratic" ? 2 : 1;
-  opt.dic.zncc_min = a.zncc_min;
-  opt.dic.threads = a.threads > 0 ? a.threads : omp_get_max_threads();
-  opt.step = a.step;
-  opt.strain_window_radius = a.strain_window / 2;
-  opt.incremental = a.incremental;
-
-  dic::PoiGrid grid;
-  try {
-    grid = dic::make_grid(images[0].rows, images[0].cols, radius, a.step, roi);
-  } catch (const std::invalid_argument& e) {
-    throw InputError(a.roi.empty() ? a.images[0] : a.roi, e.what());
-  }
-  // A plane-fit window wider than the grid fits nothing: every strain would be NaN.
-  if (a.strain_window > std::min(grid.nx, grid.ny))
-    throw InputError("--strain-window", "larger than the POI grid",
-                     std::to_string(a.strain_window) + " POIs; grid " + std::to_string(grid.nx) +
-                         " x " + std::to_string(grid.ny));
-  dic::SequenceResult result;
-  try {
-    result = dic::correlate_sequence(images, roi, opt);
-  } catch (const std::runtime_error& e) {
-    throw InputError(a.images[0], "correlation failed", e.what());
-  }
-
-  dic::DicRunInfo info;
-  info.images = a.images;
-  info.subset_px = a.subset;
-  info.step_px = a.step;
-  info.shape_function = a.shape;
-  info.strain_window_points = a.strain_window;
-  info.vsg_px = result.frames.front().strain.vsg_px;
-  info.incremental = a.incremental;
-  info.small_strain = a.strain == "small";
-  info.image_rows = images[0].rows;
-  info.image_cols = images[0].cols;
+  if (!a.roi.empty()) roi = dic::read_grey_image(a.roi);
+  const double seconds_read = since(t_start);
+  const dic::SequenceResult result = dic::run_dic(images, a.images, roi, a.roi, a.req);
+  const dic::DicRunInfo info = dic::run_info(a.req, a.images, result, images[0]);
+  const int threads = a.req.threads > 0 ? a.req.threads : omp_get_max_threads();
   const auto t_write = Clock::now();
   const std::filesystem::path out(a.output);
   // The HDF5, CSV and VTI files appear together or not at all.
   StagingDir staging(out.has_parent_path() ? out.parent_path() : std::filesystem::path("."));
   std::ostringstream report;  // printed once everything is in place
   staging.write([&] {
-    dic::write_dic_outputs(staging / out.filename(), result, info, !a.no_csv, !a.no_vtk,
-                           opt.dic.threads);
+    dic::write_dic_outputs(staging / out.filename(), result, info, !a.no_csv, !a.no_vtk, threads);
   });
   for (std::size_t k = 0; k < result.frames.size(); ++k) {
     std::size_t nvalid = 0;
@@ -153,9 +76,9 @@ void run_dic(const DicArgs& a) {
                 seconds_read, result.seconds_prefilter, result.seconds_seeds,
                 result.seconds_propagation, static_cast<double>(result.icgn_iterations) / pois,
                 result.seconds_strain, seconds_write, pois, seconds_total, pois / seconds_total,
-                opt.dic.threads);
+                threads);
   std::cout << timing;
-  std::cout << "wrote " << out.string() << " (subset " << a.subset << " px, step " << a.step
+  std::cout << "wrote " << out.string() << " (subset " << a.req.subset << " px, step " << a.req.step
             << " px, VSG " << info.vsg_px << " px)\n";
 }
 
@@ -248,22 +171,22 @@ void register_dic(CLI::App& app) {
       ->expected(2, -1);
   c->add_option("-o,--output", args->output, "output HDF5 file (CSV and .vti written beside)")
       ->required();
-  c->add_option("--subset", args->subset, "subset size, px (odd)")->capture_default_str();
-  c->add_option("--step", args->step, "POI spacing, px")->capture_default_str();
-  c->add_option("--shape", args->shape,
+  c->add_option("--subset", args->req.subset, "subset size, px (odd)")->capture_default_str();
+  c->add_option("--step", args->req.step, "POI spacing, px")->capture_default_str();
+  c->add_option("--shape", args->req.shape,
                 "subset shape function: affine (first order) or quadratic (second order)")
       ->capture_default_str();
   c->add_option("--roi", args->roi, "region-of-interest mask image (non-zero = inside)");
-  c->add_flag("--incremental", args->incremental,
+  c->add_flag("--incremental", args->req.incremental,
               "correlate each image with the previous one and accumulate (default: cumulative)");
-  c->add_option("--strain-window", args->strain_window, "strain plane-fit window, POIs (odd)")
+  c->add_option("--strain-window", args->req.strain_window, "strain plane-fit window, POIs (odd)")
       ->capture_default_str();
-  c->add_option("--strain", args->strain, "strain in CSV/VTK: green or small")
+  c->add_option("--strain", args->req.strain, "strain in CSV/VTK: green or small")
       ->capture_default_str();
-  c->add_option("--zncc-min", args->zncc_min, "POIs below this ZNCC are invalid")
+  c->add_option("--zncc-min", args->req.zncc_min, "POIs below this ZNCC are invalid")
       ->capture_default_str();
-  c->add_option("--search", args->search, "seed search half-width, px")->capture_default_str();
-  c->add_option("--threads", args->threads, "threads (0 = OpenMP default, at most 1024)")
+  c->add_option("--search", args->req.search, "seed search half-width, px")->capture_default_str();
+  c->add_option("--threads", args->req.threads, "threads (0 = OpenMP default, at most 1024)")
       ->capture_default_str()
       ->check(CLI::Range(0, 1024));
   c->add_flag("--no-csv", args->no_csv, "do not write CSV tables");

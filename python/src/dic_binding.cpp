@@ -1,0 +1,153 @@
+// granoscope.dic: subset DIC of an image sequence given as numpy arrays or file names, through
+// the CLI's own run (dic/dic_run.hpp): same options, same checks, same numbers.
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "bindings.hpp"
+#include "dic_run.hpp"
+#include "errors.hpp"
+#include "image_io.hpp"
+
+namespace py = pybind11;
+
+namespace gs::py_bind {
+namespace {
+
+// A grey image: a file name (read as the CLI reads it) or a 2-D numpy array of uint8, uint16,
+// float32 or float64 (viewed in place when C-contiguous).
+cv::Mat to_image(py::handle obj, const std::string& name, std::vector<py::object>& keep) {
+  if (py::isinstance<py::str>(obj) || py::hasattr(obj, "__fspath__")) {
+    const std::string path = py::str(py::module_::import("os").attr("fspath")(obj));
+    return dic::read_grey_image(path);
+  }
+  const auto dtype_map = [](const py::dtype& d) {
+    if (d.is(py::dtype::of<std::uint8_t>())) return CV_8U;
+    if (d.is(py::dtype::of<std::uint16_t>())) return CV_16U;
+    if (d.is(py::dtype::of<float>())) return CV_32F;
+    if (d.is(py::dtype::of<double>())) return CV_64F;
+    return -1;
+  };
+  py::array a = py::array::ensure(obj, py::array::c_style);
+  if (!a) throw InputError(name, "not an image (a file name or a 2-D numpy array)");
+  if (a.ndim() != 2)
+    throw InputError(name, "image must be a 2-D array", std::to_string(a.ndim()) + " dimensions");
+  const int type = dtype_map(a.dtype());
+  if (type < 0)
+    throw InputError(name, "image dtype must be uint8, uint16, float32 or float64",
+                     std::string(py::str(a.dtype())));
+  keep.push_back(a);
+  return cv::Mat(static_cast<int>(a.shape(0)), static_cast<int>(a.shape(1)), type,
+                 const_cast<void*>(a.data()));
+}
+
+py::array_t<double> field(const dic::SequenceResult& r,
+                          const std::vector<double>& (*get)(const dic::FrameResult&)) {
+  const auto nf = static_cast<py::ssize_t>(r.frames.size());
+  py::array_t<double> out(
+      {nf, static_cast<py::ssize_t>(r.grid.ny), static_cast<py::ssize_t>(r.grid.nx)});
+  double* p = out.mutable_data();
+  for (const auto& f : r.frames) p = std::copy(get(f).begin(), get(f).end(), p);
+  return out;
+}
+
+}  // namespace
+
+void bind_dic(py::module_& m) {
+  m.def(
+      "dic",
+      [](py::sequence images, int subset, int step, const std::string& shape, py::object roi,
+         bool incremental, int strain_window, const std::string& strain, double zncc_min,
+         int search, int threads) {
+        dic::DicRequest req;
+        req.subset = subset;
+        req.step = step;
+        req.shape = shape;
+        req.incremental = incremental;
+        req.strain_window = strain_window;
+        req.strain = strain;
+        req.zncc_min = zncc_min;
+        req.search = search;
+        req.threads = threads;
+        dic::check_request(req);
+        std::vector<py::object> keep;
+        std::vector<cv::Mat> mats;
+        std::vector<std::string> names;
+        for (std::size_t k = 0; k < images.size(); ++k) {
+          const py::object im = images[k];
+          names.push_back(py::isinstance<py::str>(im) || py::hasattr(im, "__fspath__")
+                              ? std::string(py::str(py::module_::import("os").attr("fspath")(im)))
+                              : "<image " + std::to_string(k) + ">");
+          mats.push_back(to_image(im, names.back(), keep));
+        }
+        cv::Mat roi_mat;
+        std::string roi_name = "<roi>";
+        if (!roi.is_none()) roi_mat = to_image(roi, roi_name, keep);
+        dic::SequenceResult r;
+        {
+          py::gil_scoped_release release;
+          r = dic::run_dic(mats, names, roi_mat, roi_name, req);
+        }
+        py::dict out;
+        std::vector<double> x(static_cast<std::size_t>(r.grid.nx)),
+            y(static_cast<std::size_t>(r.grid.ny));
+        for (int i = 0; i < r.grid.nx; ++i)
+          x[static_cast<std::size_t>(i)] = r.grid.x0 + i * r.grid.step;
+        for (int j = 0; j < r.grid.ny; ++j)
+          y[static_cast<std::size_t>(j)] = r.grid.y0 + j * r.grid.step;
+        out["x"] = py::array_t<double>(x.size(), x.data());
+        out["y"] = py::array_t<double>(y.size(), y.data());
+        using F = dic::FrameResult;
+        out["u"] = field(r, [](const F& f) -> const std::vector<double>& { return f.u; });
+        out["v"] = field(r, [](const F& f) -> const std::vector<double>& { return f.v; });
+        out["zncc"] = field(r, [](const F& f) -> const std::vector<double>& { return f.zncc; });
+        out["exx"] =
+            field(r, [](const F& f) -> const std::vector<double>& { return f.strain.exx; });
+        out["eyy"] =
+            field(r, [](const F& f) -> const std::vector<double>& { return f.strain.eyy; });
+        out["exy"] =
+            field(r, [](const F& f) -> const std::vector<double>& { return f.strain.exy; });
+        out["exx_small"] =
+            field(r, [](const F& f) -> const std::vector<double>& { return f.strain.sxx; });
+        out["eyy_small"] =
+            field(r, [](const F& f) -> const std::vector<double>& { return f.strain.syy; });
+        out["exy_small"] =
+            field(r, [](const F& f) -> const std::vector<double>& { return f.strain.sxy; });
+        const auto nf = static_cast<py::ssize_t>(r.frames.size());
+        py::array_t<bool> valid(
+            {nf, static_cast<py::ssize_t>(r.grid.ny), static_cast<py::ssize_t>(r.grid.nx)});
+        bool* v = valid.mutable_data();
+        for (const auto& f : r.frames)
+          for (const auto b : f.valid) *v++ = b != 0;
+        out["valid"] = valid;
+        out["vsg_px"] = r.frames.front().strain.vsg_px;
+        out["subset_px"] = subset;
+        out["step_px"] = step;
+        out["shape_function"] = shape;
+        const double pois =
+            static_cast<double>(r.grid.size()) * static_cast<double>(r.frames.size());
+        out["icgn_iterations_per_poi"] = static_cast<double>(r.icgn_iterations) / pois;
+        py::dict seconds;
+        seconds["prefilter"] = r.seconds_prefilter;
+        seconds["seeds"] = r.seconds_seeds;
+        seconds["propagation"] = r.seconds_propagation;
+        seconds["strain"] = r.seconds_strain;
+        out["seconds"] = seconds;
+        return out;
+      },
+      py::arg("images"), py::kw_only(), py::arg("subset") = 31, py::arg("step") = 2,
+      py::arg("shape") = "affine", py::arg("roi") = py::none(), py::arg("incremental") = false,
+      py::arg("strain_window") = 15, py::arg("strain") = "green", py::arg("zncc_min") = 0.9,
+      py::arg("search") = 30, py::arg("threads") = 0,
+      "Subset DIC of images[1:] against images[0] (file names or 2-D arrays: uint8, uint16, "
+      "float32, float64), as `granoscope dic`: returns x (nx,), y (ny,) POI coordinates (px) and "
+      "u, v (px, reference grid, NaN where invalid), zncc, valid, exx, eyy, exy (Green-Lagrange), "
+      "exx_small, eyy_small, exy_small of shape (frames, ny, nx), and vsg_px.");
+}
+
+}  // namespace gs::py_bind
