@@ -177,6 +177,22 @@ class Report:
         self.add("")
 
 
+def label_axes(ax, hline, xlabel, ylabel, title, **legend):
+    """A reference line at y = hline, labels, title and legend."""
+    ax.axhline(hline, color="k", lw=0.5)
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.set_title(title)
+    ax.legend(**legend)
+
+
+def save_figure(fig, out, name):
+    import matplotlib.pyplot as plt
+    fig.tight_layout()
+    fig.savefig(os.path.join(out, name), dpi=120)
+    plt.close(fig)
+
+
 def crossing(period, ratio, level=0.9):
     """period ordered from long to short. Returns (value, kind): kind '=' for an interpolated
     first crossing below `level`, '>' when the longest period is already below, '<' when the
@@ -370,9 +386,7 @@ def sample14b(runner, folder, subsets, rep, out, summary):
         a2.set_xlabel("x (px)")
         a2.set_ylabel("error (px)")
         a2.set_xlim(0, max(x0[-1], 2047))
-        fig.tight_layout()
-        fig.savefig(os.path.join(out, "sample14b_L5_u.png"), dpi=120)
-        plt.close(fig)
+        save_figure(fig, out, "sample14b_L5_u.png")
 
         fig, ax = plt.subplots(figsize=(8, 5))
         lam = np.linspace(60, 1400, 400)
@@ -383,15 +397,11 @@ def sample14b(runner, folder, subsets, rep, out, summary):
                 ax.plot(p["lam"], p["ratio"], mk, color=colr, lw=1,
                         label="S = %d, %s" % (s, ("L1", "L3", "L5")[idx - 1]))
             ax.plot(lam, np.sinc(s / lam), color=colr, lw=0.6, alpha=0.5)
-        ax.axhline(0.9, color="k", lw=0.5)
         ax.set_xscale("log")
-        ax.set_xlabel("local period λ (px)")
-        ax.set_ylabel("amplitude ratio measured/true")
-        ax.set_title("Sample 14b: amplitude ratio vs local period (thin: sinc(S/λ))")
-        ax.legend(fontsize=7, ncol=3)
-        fig.tight_layout()
-        fig.savefig(os.path.join(out, "sample14b_amplitude_ratio.png"), dpi=120)
-        plt.close(fig)
+        label_axes(ax, 0.9, "local period λ (px)", "amplitude ratio measured/true",
+                   "Sample 14b: amplitude ratio vs local period (thin: sinc(S/λ))",
+                   fontsize=7, ncol=3)
+        save_figure(fig, out, "sample14b_amplitude_ratio.png")
 
 
 # ---------------------------------------------------------------------------------------------
@@ -439,14 +449,9 @@ def sample3(runner, folder, subsets, rep, out, summary):
             sh = [f["shift"] for f in res[s]]
             ax.plot(sh, [f["bu"] for f in res[s]], "o-", color="C%d" % k, label="u, S = %d" % s)
             ax.plot(sh, [f["bv"] for f in res[s]], "s--", color="C%d" % k, label="v, S = %d" % s)
-        ax.axhline(0, color="k", lw=0.5)
-        ax.set_xlabel("imposed shift (px)")
-        ax.set_ylabel("bias = mean error (px)")
-        ax.set_title("Sample 3: interpolation bias vs sub-pixel shift")
-        ax.legend(fontsize=8, ncol=2)
-        fig.tight_layout()
-        fig.savefig(os.path.join(out, "sample3_bias.png"), dpi=120)
-        plt.close(fig)
+        label_axes(ax, 0.0, "imposed shift (px)", "bias = mean error (px)",
+                   "Sample 3: interpolation bias vs sub-pixel shift", fontsize=8, ncol=2)
+        save_figure(fig, out, "sample3_bias.png")
 
 
 # ---------------------------------------------------------------------------------------------
@@ -595,15 +600,11 @@ def stars(runner, folder1, folder2, subsets, rep, out, summary):
                 ax.plot(r[s]["per"], r[s]["ratio"], "-", color="C%d" % k, lw=1.2,
                         label="S = %d (row y = %.0f)" % (s, r[s]["yrow"]))
                 ax.plot(pp, np.sinc(s / pp), ":", color="C%d" % k, lw=1)
-            ax.axhline(0.9, color="k", lw=0.5)
             ax.set_ylim(-0.2, 1.15)
-            ax.set_xlabel("period p(x) (px)")
-            ax.set_ylabel("v_meas / v_true on the centre row")
-            ax.set_title("%s: amplitude ratio vs period (dotted: sinc(S/p))" % name)
-            ax.legend(fontsize=8, loc="lower right")
-        fig.tight_layout()
-        fig.savefig(os.path.join(out, "stars_amplitude_ratio.png"), dpi=120)
-        plt.close(fig)
+            label_axes(ax, 0.9, "period p(x) (px)", "v_meas / v_true on the centre row",
+                       "%s: amplitude ratio vs period (dotted: sinc(S/p))" % name, fontsize=8,
+                       loc="lower right")
+        save_figure(fig, out, "stars_amplitude_ratio.png")
 
 
 # ---------------------------------------------------------------------------------------------

@@ -18,7 +18,7 @@ struct DicRunInfo {
   int subset_px = 31;
   int step_px = 2;
   std::string shape_function = "affine";  // or "quadratic"
-  int strain_window_points = 15;  // 2m+1
+  int strain_window_points = 15;          // 2m+1
   double vsg_px = 0.0;
   bool incremental = false;
   bool small_strain = false;  // CSV/VTK exx, eyy, exy: small strain instead of Green–Lagrange

@@ -65,6 +65,7 @@ SequenceResult run_dic(const std::vector<cv::Mat>& images, const std::vector<std
   opt.step = a.step;
   opt.strain_window_radius = a.strain_window / 2;
   opt.incremental = a.incremental;
+  opt.dic.poll = a.poll;
 
   PoiGrid grid;
   try {

@@ -4,6 +4,7 @@
 // same one-line errors (naming the CLI's options) and give the same numbers.
 #pragma once
 
+#include <functional>
 #include <opencv2/core.hpp>
 #include <string>
 #include <vector>
@@ -23,6 +24,7 @@ struct DicRequest {
   int search = 30;               // px, >= 0
   int threads = 0;               // 0: OpenMP's default
   bool incremental = false;
+  std::function<void()> poll;  // see DicOptions::poll
 };
 
 /// Throws InputError naming the option (e.g. "--subset: must be an odd number of px >= 5 (30)").

@@ -61,6 +61,36 @@ Eigen::Matrix3d to_matrix(const P& p) {
 struct RowMoments {
   double x0 = 0.0, x1 = 0.0, y0 = 0.0, y1 = 0.0;  // sum q gx, sum q gx dx, sum q gy, sum q gy dx
 };
+// The reference subset of radius R centred at (x0, y0): grey levels and B-spline gradients as
+// contiguous arrays, row after row, in this thread's scratch buffer; and the sum of the grey
+// levels.
+struct SubsetArrays {
+  double* f;
+  double* gx;
+  double* gy;
+  double fsum;
+};
+SubsetArrays load_subset(const cv::Mat& ref, const cv::Mat& gx, const cv::Mat& gy, int x0, int y0,
+                         int R) {
+  const int side = 2 * R + 1;
+  const auto n = static_cast<std::size_t>(side) * static_cast<std::size_t>(side);
+  thread_local std::vector<double> scratch;
+  scratch.resize(3 * n);
+  SubsetArrays s{scratch.data(), scratch.data() + n, scratch.data() + 2 * n, 0.0};
+  for (int dy = -R, k = 0; dy <= R; ++dy) {
+    const double* fr = ref.ptr<double>(y0 + dy) + x0 - R;
+    const double* gxr = gx.ptr<double>(y0 + dy) + x0 - R;
+    const double* gyr = gy.ptr<double>(y0 + dy) + x0 - R;
+    for (int i = 0; i < side; ++i, ++k) {
+      s.f[k] = fr[i];
+      s.gx[k] = gxr[i];
+      s.gy[k] = gyr[i];
+      s.fsum += fr[i];
+    }
+  }
+  return s;
+}
+
 inline void add_row(Shape1& sum, const RowMoments& m, double dy) {
   sum[0] += m.x0;
   sum[1] += m.x1;
@@ -86,24 +116,11 @@ inline void add_row(Shape1& sum, const RowMoments& m, double dy) {
   const int side = 2 * R + 1;
   const auto n = static_cast<std::size_t>(side) * static_cast<std::size_t>(side);
   const double nd = static_cast<double>(n);
-  // Reference subset: f~, gx, gy as contiguous arrays (one scratch buffer per thread).
-  thread_local std::vector<double> scratch;
-  scratch.resize(3 * n);
-  double* const f = scratch.data();
-  double* const gxs = f + n;
-  double* const gys = gxs + n;
-  double fsum = 0.0;
-  for (int dy = -R, k = 0; dy <= R; ++dy) {
-    const double* fr = ref_.ptr<double>(y0 + dy) + x0 - R;
-    const double* gxr = gx_.ptr<double>(y0 + dy) + x0 - R;
-    const double* gyr = gy_.ptr<double>(y0 + dy) + x0 - R;
-    for (int i = 0; i < side; ++i, ++k) {
-      f[k] = fr[i];
-      gxs[k] = gxr[i];
-      gys[k] = gyr[i];
-      fsum += fr[i];
-    }
-  }
+  const SubsetArrays sub = load_subset(ref_, gx_, gy_, x0, y0, R);
+  double* const f = sub.f;
+  const double* const gxs = sub.gx;
+  const double* const gys = sub.gy;
+  const double fsum = sub.fsum;
   const double fmean = fsum / nd;
   // H from the moments of gx^2, gx gy, gy^2 over (1, dx, dy, dx^2, dx dy, dy^2); JF; JS.
   // h[q][.]: moments (1, dx, dy, dx^2, dx dy, dy^2) of q = gx^2, gx gy, gy^2.
@@ -334,23 +351,11 @@ constexpr double kCoef[12] = {1, 1, 1, 1, 1, 1, 0.5, 1, 0.5, 0.5, 1, 0.5};
   const int side = 2 * R + 1;
   const auto n = static_cast<std::size_t>(side) * static_cast<std::size_t>(side);
   const double nd = static_cast<double>(n);
-  thread_local std::vector<double> scratch;
-  scratch.resize(3 * n);
-  double* const f = scratch.data();
-  double* const gxs = f + n;
-  double* const gys = gxs + n;
-  double fsum = 0.0;
-  for (int dy = -R, k = 0; dy <= R; ++dy) {
-    const double* fr = ref_.ptr<double>(y0 + dy) + x0 - R;
-    const double* gxr = gx_.ptr<double>(y0 + dy) + x0 - R;
-    const double* gyr = gy_.ptr<double>(y0 + dy) + x0 - R;
-    for (int i = 0; i < side; ++i, ++k) {
-      f[k] = fr[i];
-      gxs[k] = gxr[i];
-      gys[k] = gyr[i];
-      fsum += fr[i];
-    }
-  }
+  const SubsetArrays sub = load_subset(ref_, gx_, gy_, x0, y0, R);
+  double* const f = sub.f;
+  const double* const gxs = sub.gx;
+  const double* const gys = sub.gy;
+  const double fsum = sub.fsum;
   const double fmean = fsum / nd;
   // Mq[q][i][j] = sum q dx^i dy^j (i + j <= 4) for q = gx^2, gx gy, gy^2; MF[c][i][j] = sum
   // g_c f~ dx^i dy^j and MS[c][i][j] = sum g_c dx^i dy^j (i + j <= 2).

@@ -28,7 +28,8 @@ struct IcgnOptions {
   int order = 1;
   int max_iterations = 20;
   /// Stop when sqrt(du^2 + dv^2 + R^2 (dux^2 + duy^2 + dvx^2 + dvy^2)
-  ///                + R^4 (duxx^2/4 + duxy^2 + duyy^2/4 + dvxx^2/4 + dvxy^2 + dvyy^2/4)) < tolerance
+  ///                + R^4 (duxx^2/4 + duxy^2 + duyy^2/4 + dvxx^2/4 + dvxy^2 + dvyy^2/4)) <
+  ///                tolerance
   /// (px), R = subset half-width: the largest displacement change over the subset.
   double tolerance = 1e-3;
   /// Threads that build the reference's B-spline and gradients in the constructor.

@@ -126,6 +126,7 @@ DicField correlate(const cv::Mat& reference, const cv::Mat& deformed, const PoiG
   const int dys[4] = {0, 0, 1, -1};
   std::vector<std::uint8_t> queued(n, 0);
   while (!front.empty()) {
+    if (options.poll) options.poll();
     // Next front: unsolved in-ROI neighbours of the valid POIs of this front, sorted.
     std::vector<int> next;
     for (const int idx : front) {

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <opencv2/core.hpp>
 #include <vector>
 
@@ -37,6 +38,9 @@ struct DicOptions {
   double zncc_min = 0.9;   // POIs below this are marked invalid and do not propagate
   int threads = 1;
   IcgnOptions icgn;
+  /// Called on the calling thread before each propagation front (and never inside a parallel
+  /// region); it may throw to abandon the correlation (the Python package: Ctrl-C).
+  std::function<void()> poll;
 };
 
 struct DicField {

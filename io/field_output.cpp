@@ -107,7 +107,6 @@ void write_vtk(const std::filesystem::path& path, Data& data) {
   w->SetFileName(out.temp_path().string().c_str());
   w->SetInputData(data);
   w->SetDataModeToBinary();
-  w->SetCompressionLevel(1);  // zlib level 1, as the HDF5 outputs: several times faster than 5
   if (w->Write() != 1 || w->GetErrorCode() != 0)
     throw InputError(path.string(), "cannot write VTK output",
                      vtkErrorCode::GetStringFromErrorCode(w->GetErrorCode()));

@@ -74,6 +74,12 @@ void bind_dic(py::module_& m) {
         req.zncc_min = zncc_min;
         req.search = search;
         req.threads = threads;
+        // Ctrl-C: between propagation fronts, take the GIL and look for a pending signal; its
+        // exception (KeyboardInterrupt) unwinds the correlation.
+        req.poll = [] {
+          py::gil_scoped_acquire gil;
+          if (PyErr_CheckSignals() != 0) throw py::error_already_set();
+        };
         dic::check_request(req);
         std::vector<py::object> keep;
         std::vector<cv::Mat> mats;

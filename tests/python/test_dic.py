@@ -1,4 +1,6 @@
 """granoscope.dic on numpy images gives the CLI's numbers on the same images, bit for bit."""
+import os
+
 import h5py
 import numpy as np
 import pytest
@@ -68,3 +70,36 @@ def test_dic_options_and_errors():
                step=8, strain_window=5, shape="quadratic")
     assert q["shape_function"] == "quadratic"
     np.testing.assert_allclose(q["u"][0][q["valid"][0]], 0.3, atol=0.02)
+
+
+def test_ctrl_c_interrupts_a_long_dic():
+    """A long gs.dic releases the GIL and stops at the next propagation front on SIGINT."""
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    from conftest import BUILD
+    code = r"""
+import signal, time
+signal.signal(signal.SIGINT, signal.default_int_handler)  # even when started with SIGINT ignored
+import numpy as np, granoscope as gs
+rng = np.random.default_rng(1)
+img = rng.integers(0, 256, size=(1200, 1200), dtype=np.uint8)  # white-noise speckle
+print("ready", flush=True)
+t0 = time.time()
+try:
+    gs.dic([img, img], subset=21, step=1, threads=1)
+    print("finished", time.time() - t0, flush=True)
+except KeyboardInterrupt:
+    print("interrupted", time.time() - t0, flush=True)
+"""
+    env = dict(os.environ, PYTHONPATH=os.path.join(BUILD, "python"))
+    p = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, text=True, env=env)
+    assert p.stdout.readline().strip() == "ready"
+    time.sleep(2.0)  # inside the correlation (1.4 million POIs: about a minute on one thread)
+    p.send_signal(signal.SIGINT)
+    out, _ = p.communicate(timeout=60)
+    word, seconds = out.split()
+    assert word == "interrupted"
+    assert float(seconds) < 10.0
