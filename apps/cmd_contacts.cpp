@@ -16,9 +16,11 @@
 #include "contact_rose.hpp"
 #include "errors.hpp"
 #include "fabric.hpp"
+#include "fabric_report.hpp"
 #include "field_output.hpp"
 #include "force_chains.hpp"
 #include "love_weber_stress.hpp"
+#include "rose_report.hpp"
 #include "wall_stress.hpp"
 
 namespace gs::cli {
@@ -37,19 +39,6 @@ std::vector<double> flat(const Eigen::Vector3d& x) {
   return {x.x(), x.y(), x.z()};
 }
 
-/// Contacts of the frame (branches) whose contact point lies in the selection.
-ga::ContactBranches selected(const Frame& f, const ga::ContactBranches& all,
-                             const SelectionArgs::Selection& sel, bool walls) {
-  ga::ContactBranches out;
-  for (const auto& b : all.branches) {
-    if (b.p2 < 0 && !walls) continue;
-    if (!sel.contains(f.contacts[static_cast<std::size_t>(b.contact)].point)) continue;
-    out.branches.push_back(b);
-    (b.p2 < 0 ? out.wall_contacts : out.particle_contacts) += 1;
-  }
-  return out;
-}
-
 // ---- fabric --------------------------------------------------------------------------------
 
 struct FabricArgs {
@@ -62,27 +51,9 @@ void run_fabric(const FabricArgs& a) {
   const Frame f = a.in.load();
   const double d50 = a.in.d50_of(f);
   const auto sel = a.sel.selection(a.in.input, f, d50);
-  const auto b = selected(f, ga::contact_branches(f), sel, false);
-  std::vector<Eigen::Vector3d> normals;
-  for (const auto& br : b.branches)
-    normals.push_back(f.contacts[static_cast<std::size_t>(br.contact)].normal);
-  Frame sub = f;  // particles (for N_p and the clump members) and clump bodies of the selection
-  sub.particles.clear();
-  sub.clumps.clear();
-  for (const auto& p : f.particles)
-    if (sel.contains(p.position)) sub.particles.push_back(p);
-  for (const auto& c : f.clumps)
-    if (sel.contains(c.position)) sub.clumps.push_back(c);
-  ga::Fabric fab;
-  try {
-    fab = ga::contact_fabric(normals, sub.particles.size(), f.two_d ? 2 : 3);
-  } catch (const std::invalid_argument& e) {
-    throw InputError(a.in.input, std::string(e.what()) + " (empty selection?)");
-  }
-  // Particle-orientation fabric D^p (seed 003 §4.3, eq 20–21): from the clump bodies when the
-  // frame has them (selected by centre of mass), else from the members (selected one by one).
-  const auto o = f.clumps.empty() ? ga::member_orientation_fabric(sub)
-                                  : ga::body_orientation_fabric(sub.clumps, fab.dim);
+  const ga::FabricReport rep = ga::fabric_report(a.in.input, f, sel);
+  const ga::Fabric& fab = rep.contacts;
+  const ga::OrientationFabric& o = rep.orientation;
   H5FieldFile h(a.output, "granoscope-fabric");
   h.attr("source", a.in.input);
   h.attr("frame", static_cast<long long>(a.in.frame_index()));
@@ -95,7 +66,7 @@ void run_fabric(const FabricArgs& a) {
   h.write("/D", flat(fab.D), {3, 3});
   h.write("/D_principal", flat(fab.D_principal));
   h.write("/D_directions", flat(fab.D_directions), {3, 3});
-  h.write("/view_axes", flat(view_axes(f, sel.slab)), {3, 3});
+  h.write("/view_axes", flat(rep.view_axes), {3, 3});
   h.group("/orientation");
   h.attr("bodies", static_cast<long long>(o.bodies), "/orientation");
   h.attr("D_norm", o.D_norm, "/orientation");
@@ -130,52 +101,23 @@ struct RoseArgs {
   FrameArgs in;
   SelectionArgs sel;
   std::string output, csv;
-  double bin_deg = 10.0;
-  std::vector<double> plane_normal, plane_axis;
-  bool three_d = false, walls = false;
-  std::vector<int> bins3d{18, 36};
+  ga::RoseSpec spec;
 };
 
 void run_rose(const RoseArgs& a) {
-  const double k = 360.0 / a.bin_deg;
-  if (!(a.bin_deg > 0.0) || !std::isfinite(a.bin_deg) || std::abs(k - std::round(k)) > 1e-9 ||
-      std::round(k) < 2)
-    throw InputError(a.in.input, "--bin-deg must divide 360 into 2 or more bins",
-                     value_str(a.bin_deg));
-  if (a.bins3d.size() != 2 || a.bins3d[0] < 1 || a.bins3d[1] < 1)
-    throw InputError(a.in.input, "--bins3d needs two counts >= 1");
+  ga::check_rose_spec(a.in.input, a.spec);  // before reading the frame
   const Frame f = a.in.load();
   const double d50 = a.in.d50_of(f);
   const auto sel = a.sel.selection(a.in.input, f, d50);
-  Eigen::Matrix3d axes = view_axes(f, sel.slab);
-  if (!a.plane_normal.empty() || !a.plane_axis.empty()) {
-    if (f.two_d) throw InputError(a.in.input, "--plane-* is for 3D frames (2D: the x-y plane)");
-    ga::Slab p;
-    p.thickness = 1.0;
-    p.normal = a.plane_normal.empty() ? Eigen::Vector3d(axes.row(2))
-                                      : Eigen::Vector3d(a.plane_normal.data());
-    p.axis1 =
-        a.plane_axis.empty() ? Eigen::Vector3d(axes.row(0)) : Eigen::Vector3d(a.plane_axis.data());
-    try {
-      axes = ga::slab_axes(p);
-    } catch (const std::invalid_argument& e) {
-      throw InputError(a.in.input, e.what());
-    }
-  }
-  const auto b = selected(f, ga::contact_branches(f), sel, a.walls);
-  std::vector<ga::RoseContact> rc;
-  for (const auto& br : b.branches) {
-    const Contact& c = f.contacts[static_cast<std::size_t>(br.contact)];
-    rc.push_back({c.normal, c.normal_force.norm(), c.shear_force.norm()});
-  }
-  if (rc.empty()) throw InputError(a.in.input, "no contact in the selection (empty selection)");
-  const auto r2 = ga::contact_rose_2d(rc, axes, static_cast<int>(std::round(k)));
+  const ga::RoseReport rep = ga::rose_report(a.in.input, f, sel, a.spec);
+  const ga::Rose& r2 = rep.rose2d;
+  const Eigen::Matrix3d& axes = rep.axes;
   H5FieldFile h(a.output, "granoscope-rose");
   h.attr("source", a.in.input);
   h.attr("frame", static_cast<long long>(a.in.frame_index()));
-  h.attr("walls", static_cast<long long>(a.walls ? 1 : 0));
+  h.attr("walls", static_cast<long long>(a.spec.walls ? 1 : 0));
   h.group("/rose2d");
-  h.attr("bin_deg", a.bin_deg, "/rose2d");
+  h.attr("bin_deg", a.spec.bin_deg, "/rose2d");
   h.attr("contacts", static_cast<long long>(r2.contacts), "/rose2d");
   h.attr("skipped", static_cast<long long>(r2.skipped), "/rose2d");
   h.write("/rose2d/axes", flat(axes), {3, 3});
@@ -184,9 +126,8 @@ void run_rose(const RoseArgs& a) {
   h.write("/rose2d/density", r2.density);
   h.write("/rose2d/mean_fn", r2.mean_fn);
   h.write("/rose2d/mean_fs", r2.mean_fs);
-  if (a.three_d) {
-    if (f.two_d) throw InputError(a.in.input, "--3d needs a 3D frame");
-    const auto r3 = ga::contact_rose_3d(rc, axes, a.bins3d[0], a.bins3d[1]);
+  if (rep.rose3d) {
+    const ga::Rose& r3 = *rep.rose3d;
     h.group("/rose3d");
     h.attr("n_theta", static_cast<long long>(r3.n_theta), "/rose3d");
     h.attr("n_phi", static_cast<long long>(r3.n_phi), "/rose3d");
@@ -206,8 +147,8 @@ void run_rose(const RoseArgs& a) {
                             {"mean_fs", 1, r2.mean_fs}});
   }
   std::cout << "rose: " << r2.contacts << " contacts in " << r2.count.size() << " bins of "
-            << a.bin_deg << " deg (" << r2.skipped << " normal to the plane skipped)"
-            << (a.three_d ? ", 3D equal-area histogram" : "") << "\n";
+            << a.spec.bin_deg << " deg (" << r2.skipped << " normal to the plane skipped)"
+            << (a.spec.three_d ? ", 3D equal-area histogram" : "") << "\n";
 }
 
 // ---- chains --------------------------------------------------------------------------------
@@ -228,7 +169,7 @@ void run_chains(const ChainArgs& a) {
   const Frame f = a.in.load();
   const double d50 = a.in.d50_of(f);
   const auto sel = a.sel.selection(a.in.input, f, d50);
-  const auto b = selected(f, ga::contact_branches(f), sel, a.walls);
+  const auto b = ga::selected_branches(f, ga::contact_branches(f), sel, a.walls);
   if (b.branches.empty())
     throw InputError(a.in.input, "no contact in the selection (empty selection)");
   ga::ChainOptions o;
@@ -399,15 +340,16 @@ void register_analyze_contacts(CLI::App& app) {
     a->in.add_to(*s, false);
     a->sel.add_to(*s);
     s->add_option("-o,--output", a->output, "output HDF5 (format granoscope-rose)")->required();
-    s->add_option("--bin-deg", a->bin_deg, "2D bin size in deg (default 10)");
-    s->add_option("--plane-normal", a->plane_normal,
+    s->add_option("--bin-deg", a->spec.bin_deg, "2D bin size in deg (default 10)");
+    s->add_option("--plane-normal", a->spec.plane_normal,
                   "plane of the 2D rose: normal x y z (default: the front view x-z, or the slab)")
         ->expected(3);
-    s->add_option("--plane-axis", a->plane_axis, "direction of angle 0 in the plane")->expected(3);
-    s->add_flag("--3d", a->three_d, "also the 3D histogram on equal-area bins");
-    s->add_option("--bins3d", a->bins3d, "3D bins: bands in cos(theta) and longitudes (18 36)")
+    s->add_option("--plane-axis", a->spec.plane_axis, "direction of angle 0 in the plane")
+        ->expected(3);
+    s->add_flag("--3d", a->spec.three_d, "also the 3D histogram on equal-area bins");
+    s->add_option("--bins3d", a->spec.bins3d, "3D bins: bands in cos(theta) and longitudes (18 36)")
         ->expected(2);
-    s->add_flag("--walls", a->walls, "include particle-wall contacts");
+    s->add_flag("--walls", a->spec.walls, "include particle-wall contacts");
     s->add_option("--csv", a->csv, "also write the 2D rose as CSV");
     s->callback([a] { run_rose(*a); });
   }

@@ -4,6 +4,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <stdexcept>
 #include <vector>
 
@@ -61,34 +62,40 @@ Eigen::Matrix3d to_matrix(const P& p) {
 struct RowMoments {
   double x0 = 0.0, x1 = 0.0, y0 = 0.0, y1 = 0.0;  // sum q gx, sum q gx dx, sum q gy, sum q gy dx
 };
-// The reference subset of radius R centred at (x0, y0): grey levels and B-spline gradients as
-// contiguous arrays, row after row, in this thread's scratch buffer; and the sum of the grey
-// levels.
+// The reference subset of radius R centred at (x0, y0), none when it is not inside the image:
+// grey levels and B-spline gradients as contiguous arrays, row after row, in this thread's
+// scratch buffer; the pixel count and the mean grey level.
 struct SubsetArrays {
   double* f;
-  double* gx;
-  double* gy;
-  double fsum;
+  const double* gx;
+  const double* gy;
+  double n;
+  double fmean;
 };
-SubsetArrays load_subset(const cv::Mat& ref, const cv::Mat& gx, const cv::Mat& gy, int x0, int y0,
-                         int R) {
+std::optional<SubsetArrays> load_subset(const cv::Mat& ref, const cv::Mat& gx, const cv::Mat& gy,
+                                        int x0, int y0, int R) {
+  if (x0 - R < 0 || y0 - R < 0 || x0 + R >= ref.cols || y0 + R >= ref.rows) return std::nullopt;
   const int side = 2 * R + 1;
   const auto n = static_cast<std::size_t>(side) * static_cast<std::size_t>(side);
   thread_local std::vector<double> scratch;
   scratch.resize(3 * n);
-  SubsetArrays s{scratch.data(), scratch.data() + n, scratch.data() + 2 * n, 0.0};
+  double* const f = scratch.data();
+  double* const gxs = f + n;
+  double* const gys = gxs + n;
+  double fsum = 0.0;
   for (int dy = -R, k = 0; dy <= R; ++dy) {
     const double* fr = ref.ptr<double>(y0 + dy) + x0 - R;
     const double* gxr = gx.ptr<double>(y0 + dy) + x0 - R;
     const double* gyr = gy.ptr<double>(y0 + dy) + x0 - R;
     for (int i = 0; i < side; ++i, ++k) {
-      s.f[k] = fr[i];
-      s.gx[k] = gxr[i];
-      s.gy[k] = gyr[i];
-      s.fsum += fr[i];
+      f[k] = fr[i];
+      gxs[k] = gxr[i];
+      gys[k] = gyr[i];
+      fsum += fr[i];
     }
   }
-  return s;
+  const double nd = static_cast<double>(n);
+  return SubsetArrays{f, gxs, gys, nd, fsum / nd};
 }
 
 inline void add_row(Shape1& sum, const RowMoments& m, double dy) {
@@ -111,17 +118,10 @@ inline void add_row(Shape1& sum, const RowMoments& m, double dy) {
                                                                 const Shape& guess) const {
   IcgnResult res;
   res.p = guess;
+  const auto sub = load_subset(ref_, gx_, gy_, x0, y0, radius_);
+  if (!sub) return res;  // the subset is not inside the reference image
+  const auto [f, gxs, gys, nd, fmean] = *sub;
   const int R = radius_;
-  if (x0 - R < 0 || y0 - R < 0 || x0 + R >= ref_.cols || y0 + R >= ref_.rows) return res;
-  const int side = 2 * R + 1;
-  const auto n = static_cast<std::size_t>(side) * static_cast<std::size_t>(side);
-  const double nd = static_cast<double>(n);
-  const SubsetArrays sub = load_subset(ref_, gx_, gy_, x0, y0, R);
-  double* const f = sub.f;
-  const double* const gxs = sub.gx;
-  const double* const gys = sub.gy;
-  const double fsum = sub.fsum;
-  const double fmean = fsum / nd;
   // H from the moments of gx^2, gx gy, gy^2 over (1, dx, dy, dx^2, dx dy, dy^2); JF; JS.
   // h[q][.]: moments (1, dx, dy, dx^2, dx dy, dy^2) of q = gx^2, gx gy, gy^2.
   double h[3][6] = {};
@@ -346,17 +346,10 @@ constexpr double kCoef[12] = {1, 1, 1, 1, 1, 1, 0.5, 1, 0.5, 0.5, 1, 0.5};
   using Vec12 = Eigen::Matrix<double, 12, 1>;
   IcgnResult res;
   res.p = guess;
+  const auto sub = load_subset(ref_, gx_, gy_, x0, y0, radius_);
+  if (!sub) return res;  // the subset is not inside the reference image
+  const auto [f, gxs, gys, nd, fmean] = *sub;
   const int R = radius_;
-  if (x0 - R < 0 || y0 - R < 0 || x0 + R >= ref_.cols || y0 + R >= ref_.rows) return res;
-  const int side = 2 * R + 1;
-  const auto n = static_cast<std::size_t>(side) * static_cast<std::size_t>(side);
-  const double nd = static_cast<double>(n);
-  const SubsetArrays sub = load_subset(ref_, gx_, gy_, x0, y0, R);
-  double* const f = sub.f;
-  const double* const gxs = sub.gx;
-  const double* const gys = sub.gy;
-  const double fsum = sub.fsum;
-  const double fmean = fsum / nd;
   // Mq[q][i][j] = sum q dx^i dy^j (i + j <= 4) for q = gx^2, gx gy, gy^2; MF[c][i][j] = sum
   // g_c f~ dx^i dy^j and MS[c][i][j] = sum g_c dx^i dy^j (i + j <= 2).
   double Mq[3][5][5] = {};

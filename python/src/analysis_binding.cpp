@@ -4,15 +4,20 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <optional>
 #include <stdexcept>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "bindings.hpp"
 #include "errors.hpp"
 #include "fabric.hpp"
+#include "fabric_report.hpp"
 #include "grain_size.hpp"
 #include "love_weber_stress.hpp"
+#include "rose_report.hpp"
+#include "selection.hpp"
 #include "snapshot.hpp"
 #include "tensor_invariants.hpp"
 
@@ -20,6 +25,36 @@ namespace py = pybind11;
 namespace ga = gs::analysis;
 
 namespace gs::py_bind {
+namespace {
+
+using OptVec = std::optional<std::vector<double>>;
+constexpr const char* kFrame = "<frame>";  // how messages name a frame given from Python
+
+// The selection the CLI's --slab* / --region / --d50 options would make on this frame.
+ga::Selection selection_of(const Frame& f, bool slab, const OptVec& slab_origin,
+                           const OptVec& slab_normal, const OptVec& slab_axis,
+                           std::optional<double> slab_thickness, std::optional<double> slab_d50,
+                           const OptVec& region, std::optional<double> d50) {
+  ga::SelectionSpec spec;
+  spec.slab = slab;
+  spec.slab_origin = slab_origin.value_or(std::vector<double>{});
+  spec.slab_normal = slab_normal.value_or(std::vector<double>{});
+  spec.slab_axis = slab_axis.value_or(std::vector<double>{});
+  spec.slab_thickness = slab_thickness;
+  spec.slab_d50 = slab_d50;
+  spec.region = region.value_or(std::vector<double>{});
+  double d = 0.0;
+  if (d50) {
+    ga::require_positive(kFrame, "--d50", *d50);
+    d = *d50;
+  } else {
+    if (f.particles.empty()) throw InputError(kFrame, "the frame has no particles");
+    d = ga::d50(f);
+  }
+  return ga::make_selection(kFrame, f, d, spec);
+}
+
+}  // namespace
 
 void bind_analysis(py::module_& m) {
   m.def(
@@ -28,21 +63,14 @@ void bind_analysis(py::module_& m) {
 
   m.def(
       "fabric",
-      [](const Frame& f) {
-        // `granoscope analyze fabric` over the whole frame (particle-particle contacts).
-        const ga::ContactBranches b = ga::contact_branches(f);
-        std::vector<Eigen::Vector3d> normals;
-        for (const auto& br : b.branches)
-          if (br.p2 >= 0)
-            normals.push_back(f.contacts[static_cast<std::size_t>(br.contact)].normal);
-        ga::Fabric fab;
-        try {
-          fab = ga::contact_fabric(normals, f.particles.size(), f.two_d ? 2 : 3);
-        } catch (const std::invalid_argument& e) {
-          throw InputError("<frame>", e.what());
-        }
-        const auto o = f.clumps.empty() ? ga::member_orientation_fabric(f)
-                                        : ga::body_orientation_fabric(f.clumps, fab.dim);
+      [](const Frame& f, bool slab, OptVec slab_origin, OptVec slab_normal, OptVec slab_axis,
+         std::optional<double> slab_thickness, std::optional<double> slab_d50, OptVec region,
+         std::optional<double> d50) {
+        const ga::Selection sel = selection_of(f, slab, slab_origin, slab_normal, slab_axis,
+                                               slab_thickness, slab_d50, region, d50);
+        const ga::FabricReport r = ga::fabric_report(kFrame, f, sel);
+        const ga::Fabric& fab = r.contacts;
+        const ga::OrientationFabric& o = r.orientation;
         py::dict orientation;
         orientation["source"] = ga::orientation_source_name(o.source);
         orientation["bodies"] = o.bodies;
@@ -62,13 +90,69 @@ void bind_analysis(py::module_& m) {
         out["D_norm"] = fab.D_norm;
         out["D_principal"] = fab.D_principal;
         out["D_directions"] = fab.D_directions;
+        out["view_axes"] = r.view_axes;
         out["orientation"] = orientation;
         return out;
       },
-      py::arg("frame"),
+      py::arg("frame"), py::kw_only(), py::arg("slab") = false, py::arg("slab_origin") = py::none(),
+      py::arg("slab_normal") = py::none(), py::arg("slab_axis") = py::none(),
+      py::arg("slab_thickness") = py::none(), py::arg("slab_d50") = py::none(),
+      py::arg("region") = py::none(), py::arg("d50") = py::none(),
       "Contact-normal fabric M_ij, coordination omega, Kanatani anisotropy D_ij (seed 003 eq "
-      "18-21) and the clump orientation fabric, as `granoscope analyze fabric` without a "
-      "selection.");
+      "18-21) and the clump orientation fabric, as `granoscope analyze fabric` (the selection "
+      "keywords are its --slab* and --region options; lengths in m, slab_d50 in d50).");
+
+  m.def(
+      "rose",
+      [](const Frame& f, double bin_deg, OptVec plane_normal, OptVec plane_axis, bool three_d,
+         std::vector<int> bins3d, bool walls, bool slab, OptVec slab_origin, OptVec slab_normal,
+         OptVec slab_axis, std::optional<double> slab_thickness, std::optional<double> slab_d50,
+         OptVec region, std::optional<double> d50) {
+        ga::RoseSpec spec;
+        spec.bin_deg = bin_deg;
+        spec.plane_normal = plane_normal.value_or(std::vector<double>{});
+        spec.plane_axis = plane_axis.value_or(std::vector<double>{});
+        spec.three_d = three_d;
+        spec.bins3d = bins3d;
+        spec.walls = walls;
+        ga::check_rose_spec(kFrame, spec);
+        const ga::Selection sel = selection_of(f, slab, slab_origin, slab_normal, slab_axis,
+                                               slab_thickness, slab_d50, region, d50);
+        const ga::RoseReport r = ga::rose_report(kFrame, f, sel, spec);
+        const auto rose = [](const ga::Rose& x) {
+          py::dict d;
+          d["count"] = x.count;
+          d["density"] = x.density;
+          d["mean_fn"] = x.mean_fn;
+          d["mean_fs"] = x.mean_fs;
+          d["contacts"] = x.contacts;
+          d["skipped"] = x.skipped;
+          if (x.dim == 2) {
+            d["angle_deg"] = x.angle_deg;
+            d["bin_rad"] = x.bin_size;
+          } else {
+            d["direction"] = x.direction;
+            d["solid_angle"] = x.bin_size;
+            d["n_theta"] = x.n_theta;
+            d["n_phi"] = x.n_phi;
+          }
+          return d;
+        };
+        py::dict out;
+        out["axes"] = r.axes;
+        out["rose2d"] = rose(r.rose2d);
+        if (r.rose3d) out["rose3d"] = rose(*r.rose3d);
+        return out;
+      },
+      py::arg("frame"), py::kw_only(), py::arg("bin_deg") = 10.0,
+      py::arg("plane_normal") = py::none(), py::arg("plane_axis") = py::none(),
+      py::arg("three_d") = false, py::arg("bins3d") = std::vector<int>{18, 36},
+      py::arg("walls") = false, py::arg("slab") = false, py::arg("slab_origin") = py::none(),
+      py::arg("slab_normal") = py::none(), py::arg("slab_axis") = py::none(),
+      py::arg("slab_thickness") = py::none(), py::arg("slab_d50") = py::none(),
+      py::arg("region") = py::none(), py::arg("d50") = py::none(),
+      "Polar histograms of contact normals with the mean |Fn| and |Fs| per bin, as `granoscope "
+      "analyze rose` (its /rose2d and /rose3d datasets; axes = rows e1, e2, n of the plane).");
 
   m.def(
       "stress_invariants",

@@ -39,3 +39,46 @@ def test_stress_invariants_by_hand():
     assert iso["q"] == pytest.approx(0.0, abs=1e-9) and iso["p"] == pytest.approx(50e3)
     with pytest.raises(gs.Error, match="^dim: must be 2 or 3 \\(4\\)$"):
         gs.stress_invariants(np.eye(3), dim=4)
+
+
+def test_fabric_and_rose_with_a_selection_equal_the_cli(cli, tmp_path):
+    """The selection keywords are the CLI's --slab* / --region options, same numbers."""
+    f = gs.Frame.from_arrays(**packing(n=160, seed=7))
+    gs.save(tmp_path / "p.h5", f)
+    region = [0.001, 0.001, 0.001, 0.009, 0.009, 0.009]
+    rc, _, err = cli("analyze", "fabric", tmp_path / "p.h5", "-o", tmp_path / "fab.h5",
+                     "--region", *region)
+    assert rc == 0, err
+    py = gs.fabric(f, region=region)
+    with h5py.File(tmp_path / "fab.h5", "r") as h:
+        assert h.attrs["omega"] == py["omega"] and h.attrs["particles"] == py["particles"]
+        np.testing.assert_array_equal(h["D"][()], py["D"])
+        np.testing.assert_array_equal(h["view_axes"][()], py["view_axes"])
+    assert py["particles"] < f.n_particles  # the region did select
+    args = ["--slab", "--slab-d50", 3, "--bin-deg", 15, "--3d", "--bins3d", 6, 12]
+    rc, _, err = cli("analyze", "rose", tmp_path / "p.h5", "-o", tmp_path / "rose.h5", *args)
+    assert rc == 0, err
+    r = gs.rose(f, slab=True, slab_d50=3, bin_deg=15, three_d=True, bins3d=(6, 12))
+    with h5py.File(tmp_path / "rose.h5", "r") as h:
+        for key in ("angle_deg", "count", "density", "mean_fn", "mean_fs"):
+            np.testing.assert_array_equal(h["rose2d/" + key][()], r["rose2d"][key], err_msg=key)
+        np.testing.assert_array_equal(h["rose2d/axes"][()], r["axes"])
+        assert h["rose2d"].attrs["contacts"] == r["rose2d"]["contacts"]
+        for key in ("direction", "count", "mean_fn"):
+            np.testing.assert_array_equal(h["rose3d/" + key][()], r["rose3d"][key], err_msg=key)
+    # every contact counted once in the 2D rose (those normal to the plane skipped)
+    assert sum(r["rose2d"]["count"]) + r["rose2d"]["skipped"] == r["rose2d"]["contacts"]
+
+
+def test_contact_analysis_errors_are_the_cli_lines():
+    f = gs.Frame.from_arrays(**packing())
+    with pytest.raises(gs.Error, match=r"^<frame>: --bin-deg must divide 360 into 2 or more bins \(7\)$"):
+        gs.rose(f, bin_deg=7)
+    with pytest.raises(gs.Error, match="--region needs finite x0 y0 z0 x1 y1 z1"):
+        gs.fabric(f, region=[0, 0, 0, -1, 1, 1])
+    with pytest.raises(gs.Error, match="--region needs 6 numbers"):
+        gs.fabric(f, region=[0, 0, 0])
+    with pytest.raises(gs.Error, match="^<frame>: --d50 must be a finite number > 0"):
+        gs.fabric(f, slab=True, d50=-1.0)
+    with pytest.raises(gs.Error, match="no contact in the selection"):
+        gs.rose(f, region=[1, 1, 1, 2, 2, 2])
