@@ -98,6 +98,23 @@ std::optional<SubsetArrays> load_subset(const cv::Mat& ref, const cv::Mat& gx, c
   return SubsetArrays{f, gxs, gys, nd, fsum / nd};
 }
 
+// Four samples g of the deformed subset at (xs, ys), the reference gradients of the same four
+// pixels, and the subset sums of g, g^2 and f~ g updated (both IC-GN orders, inner loop).
+using v4d = BSplineImage::v4d;
+[[gnu::always_inline]] inline void sample4(const BSplineImage& def, const double (&xs)[4],
+                                           const double (&ys)[4], const double* f, const double* gx,
+                                           const double* gy, v4d& g, v4d& gxv, v4d& gyv, v4d& vsum,
+                                           v4d& vsq, v4d& vfg) {
+  def.value4(xs, ys, g);
+  v4d fv;
+  __builtin_memcpy(&fv, f, sizeof fv);
+  __builtin_memcpy(&gxv, gx, sizeof gxv);
+  __builtin_memcpy(&gyv, gy, sizeof gyv);
+  vsum += g;
+  vsq += g * g;
+  vfg += fv * g;
+}
+
 inline void add_row(Shape1& sum, const RowMoments& m, double dy) {
   sum[0] += m.x0;
   sum[1] += m.x1;
@@ -194,7 +211,6 @@ inline void add_row(Shape1& sum, const RowMoments& m, double dy) {
                          y0 + W(1, 2) + W(1, 0) * cx + W(1, 1) * cy))
           return res;
     // Four pixels at a time in 4-vectors (the accumulators too), the row's remainder one by one.
-    using v4d = BSplineImage::v4d;
     v4d vsum{}, vsq{}, vfg{};
     double gsum = 0.0, gsq = 0.0, fg = 0.0;
     Shape1 JG = Shape1::Zero();
@@ -211,15 +227,8 @@ inline void add_row(Shape1& sum, const RowMoments& m, double dy) {
           xs[i] = bx + W(0, 0) * dxv[i];
           ys[i] = by + W(1, 0) * dxv[i];
         }
-        v4d g;
-        def_.value4(xs, ys, g);
-        v4d fv, gxv, gyv;
-        __builtin_memcpy(&fv, f + k, sizeof fv);
-        __builtin_memcpy(&gxv, gxs + k, sizeof gxv);
-        __builtin_memcpy(&gyv, gys + k, sizeof gyv);
-        vsum += g;
-        vsq += g * g;
-        vfg += fv * g;
+        v4d g, gxv, gyv;
+        sample4(def_, xs, ys, f + k, gxs + k, gys + k, g, gxv, gyv, vsum, vsq, vfg);
         const v4d gxg = gxv * g;
         const v4d gyg = gyv * g;
         mx0 += gxg;
@@ -427,7 +436,6 @@ constexpr double kCoef[12] = {1, 1, 1, 1, 1, 1, 0.5, 1, 0.5, 0.5, 1, 0.5};
                  def_.inside(c[0] + c[1] * dx + c[2] * dx * dx, c[3] + c[4] * dx + c[5] * dx * dx);
     }
     if (!inside) return res;
-    using v4d = BSplineImage::v4d;
     v4d vsum{}, vsq{}, vfg{};
     double gsum = 0.0, gsq = 0.0, fg = 0.0;
     double MG[2][3][3] = {};
@@ -445,15 +453,8 @@ constexpr double kCoef[12] = {1, 1, 1, 1, 1, 1, 0.5, 1, 0.5, 0.5, 1, 0.5};
           xs[i] = c[0] + c[1] * dxv[i] + c[2] * dxv[i] * dxv[i];
           ys[i] = c[3] + c[4] * dxv[i] + c[5] * dxv[i] * dxv[i];
         }
-        v4d g;
-        def_.value4(xs, ys, g);
-        v4d fv, gxv, gyv;
-        __builtin_memcpy(&fv, f + k, sizeof fv);
-        __builtin_memcpy(&gxv, gxs + k, sizeof gxv);
-        __builtin_memcpy(&gyv, gys + k, sizeof gyv);
-        vsum += g;
-        vsq += g * g;
-        vfg += fv * g;
+        v4d g, gxv, gyv;
+        sample4(def_, xs, ys, f + k, gxs + k, gys + k, g, gxv, gyv, vsum, vsq, vfg);
         const v4d gg[2] = {gxv * g, gyv * g};
         for (int a = 0; a < 2; ++a) {
           mx[a][0] += gg[a];
