@@ -7,6 +7,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "errors.hpp"
+
 namespace gs::analysis {
 namespace {
 
@@ -78,6 +80,21 @@ ForceChains force_chains(const Frame& frame, const ContactBranches& branches,
   fc.chains = size.size();
   fc.largest_chain = size.empty() ? 0 : *std::max_element(size.begin(), size.end());
   return fc;
+}
+
+void check_chain_options(const std::string& file, const ChainOptions& o) {
+  if (o.threshold_n != -1.0 && !(o.threshold_n >= 0.0 && std::isfinite(o.threshold_n)))
+    throw InputError(file, "--threshold must be a force >= 0 in N", value_str(o.threshold_n));
+  if (!(o.mean_factor >= 0.0) || !std::isfinite(o.mean_factor))
+    throw InputError(file, "--mean-factor must be >= 0", value_str(o.mean_factor));
+}
+
+ForceChains force_chains_in(const std::string& file, const Frame& frame, const Selection& sel,
+                            const ChainOptions& options) {
+  check_chain_options(file, options);
+  const auto b = selected_branches(frame, contact_branches(frame), sel, options.walls);
+  if (b.branches.empty()) throw InputError(file, "no contact in the selection (empty selection)");
+  return force_chains(frame, b, options);
 }
 
 }  // namespace gs::analysis

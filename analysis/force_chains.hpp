@@ -7,9 +7,11 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "love_weber_stress.hpp"
+#include "selection.hpp"
 #include "snapshot.hpp"
 
 namespace gs::analysis {
@@ -34,5 +36,14 @@ struct ForceChains {
 /// forces, the threshold and the chains. Throws std::invalid_argument on a bad threshold.
 ForceChains force_chains(const Frame& frame, const ContactBranches& branches,
                          const ChainOptions& options);
+
+/// Throws InputError naming `file` and the option (--threshold, --mean-factor) when `options`
+/// is invalid (threshold_n -1 = unset).
+void check_chain_options(const std::string& file, const ChainOptions& options);
+
+/// `analyze chains` as one call (CLI and Python): the chains of the contacts whose point lies
+/// in `sel`. Throws InputError naming `file`: bad options, no contact in the selection.
+ForceChains force_chains_in(const std::string& file, const Frame& frame, const Selection& sel,
+                            const ChainOptions& options);
 
 }  // namespace gs::analysis

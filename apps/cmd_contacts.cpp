@@ -162,21 +162,15 @@ struct ChainArgs {
 };
 
 void run_chains(const ChainArgs& a) {
-  if (a.threshold != -1.0 && !(a.threshold >= 0.0 && std::isfinite(a.threshold)))
-    throw InputError(a.in.input, "--threshold must be a force >= 0 in N", value_str(a.threshold));
-  if (!(a.mean_factor >= 0.0) || !std::isfinite(a.mean_factor))
-    throw InputError(a.in.input, "--mean-factor must be >= 0", value_str(a.mean_factor));
-  const Frame f = a.in.load();
-  const double d50 = a.in.d50_of(f);
-  const auto sel = a.sel.selection(a.in.input, f, d50);
-  const auto b = ga::selected_branches(f, ga::contact_branches(f), sel, a.walls);
-  if (b.branches.empty())
-    throw InputError(a.in.input, "no contact in the selection (empty selection)");
   ga::ChainOptions o;
   o.threshold_n = a.threshold;
   o.mean_factor = a.mean_factor;
   o.walls = a.walls;
-  const auto fc = ga::force_chains(f, b, o);
+  ga::check_chain_options(a.in.input, o);  // before reading the frame
+  const Frame f = a.in.load();
+  const double d50 = a.in.d50_of(f);
+  const auto sel = a.sel.selection(a.in.input, f, d50);
+  const auto fc = ga::force_chains_in(a.in.input, f, sel, o);
   H5FieldFile h(a.output, "granoscope-chains");
   h.attr("source", a.in.input);
   h.attr("frame", static_cast<long long>(a.in.frame_index()));

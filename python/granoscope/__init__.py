@@ -16,10 +16,11 @@ See docs/python.md.
 import os as _os
 
 from . import _granoscope as _c
-from ._granoscope import Error, Frame, Trajectory, d50, dic, fabric, rose, stress_invariants
+from ._granoscope import (Error, Frame, Trajectory, chains, d50, dic, fabric, rose,
+                          stress_invariants)
 
-__all__ = ["Error", "FileNotFound", "Frame", "Trajectory", "open", "save", "d50", "dic",
-           "fabric", "rose", "stress_invariants", "__version__"]
+__all__ = ["Error", "FileNotFound", "Frame", "Trajectory", "open", "save", "chains", "d50",
+           "dic", "fabric", "rose", "stress_invariants", "__version__"]
 
 __version__ = _c.code_version().split()[-1]
 

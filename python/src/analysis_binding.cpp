@@ -14,6 +14,7 @@
 #include "errors.hpp"
 #include "fabric.hpp"
 #include "fabric_report.hpp"
+#include "force_chains.hpp"
 #include "grain_size.hpp"
 #include "love_weber_stress.hpp"
 #include "rose_report.hpp"
@@ -153,6 +154,45 @@ void bind_analysis(py::module_& m) {
       py::arg("region") = py::none(), py::arg("d50") = py::none(),
       "Polar histograms of contact normals with the mean |Fn| and |Fs| per bin, as `granoscope "
       "analyze rose` (its /rose2d and /rose3d datasets; axes = rows e1, e2, n of the plane).");
+
+  m.def(
+      "chains",
+      [](const Frame& f, std::optional<double> threshold, double mean_factor, bool walls, bool slab,
+         OptVec slab_origin, OptVec slab_normal, OptVec slab_axis,
+         std::optional<double> slab_thickness, std::optional<double> slab_d50, OptVec region,
+         std::optional<double> d50) {
+        ga::ChainOptions o;
+        o.threshold_n = threshold.value_or(-1.0);
+        o.mean_factor = mean_factor;
+        o.walls = walls;
+        ga::check_chain_options(kFrame, o);
+        const ga::Selection sel = selection_of(f, slab, slab_origin, slab_normal, slab_axis,
+                                               slab_thickness, slab_d50, region, d50);
+        const ga::ForceChains c = ga::force_chains_in(kFrame, f, sel, o);
+        py::dict out;
+        out["a"] = c.a;
+        out["b"] = c.b;
+        out["fn"] = c.fn;
+        out["fs"] = c.fs;
+        out["strong"] = std::vector<bool>(c.strong.begin(), c.strong.end());
+        out["chain"] = c.chain;
+        out["mean_fn"] = c.mean_fn;
+        out["max_fn"] = c.max_fn;
+        out["threshold"] = c.threshold;
+        out["strong_count"] = c.strong_count;
+        out["chains"] = c.chains;
+        out["largest_chain"] = c.largest_chain;
+        out["view_axes"] = ga::view_axes(f, sel.slab);
+        return out;
+      },
+      py::arg("frame"), py::kw_only(), py::arg("threshold") = py::none(),
+      py::arg("mean_factor") = 1.0, py::arg("walls") = false, py::arg("slab") = false,
+      py::arg("slab_origin") = py::none(), py::arg("slab_normal") = py::none(),
+      py::arg("slab_axis") = py::none(), py::arg("slab_thickness") = py::none(),
+      py::arg("slab_d50") = py::none(), py::arg("region") = py::none(), py::arg("d50") = py::none(),
+      "Strong-force network as `granoscope analyze chains`: per contact segment its ends a, b "
+      "(m), |Fn|, |Fs| (N), strong flag and chain id (-1: not a strong particle contact); the "
+      "threshold (N; default mean |Fn| x mean_factor), counts of strong contacts and chains.");
 
   m.def(
       "stress_invariants",

@@ -82,3 +82,25 @@ def test_contact_analysis_errors_are_the_cli_lines():
         gs.fabric(f, slab=True, d50=-1.0)
     with pytest.raises(gs.Error, match="no contact in the selection"):
         gs.rose(f, region=[1, 1, 1, 2, 2, 2])
+
+
+def test_chains_equal_the_cli(cli, tmp_path):
+    f = gs.Frame.from_arrays(**packing(n=160, seed=11))
+    gs.save(tmp_path / "p.h5", f)
+    rc, _, err = cli("analyze", "chains", tmp_path / "p.h5", "-o", tmp_path / "c.h5",
+                     "--mean-factor", 1.5, "--slab", "--slab-d50", 4)
+    assert rc == 0, err
+    c = gs.chains(f, mean_factor=1.5, slab=True, slab_d50=4)
+    with h5py.File(tmp_path / "c.h5", "r") as h:
+        for key in ("mean_fn", "max_fn", "threshold"):
+            assert h.attrs[key] == c[key], key
+        assert h.attrs["strong"] == c["strong_count"] and h.attrs["chains"] == c["chains"]
+        np.testing.assert_array_equal(h["segments/a"][()], c["a"])
+        np.testing.assert_array_equal(h["segments/fn"][()], c["fn"])
+        np.testing.assert_array_equal(h["segments/strong"][()].astype(bool), c["strong"])
+        np.testing.assert_array_equal(h["segments/chain"][()], c["chain"])
+    # by hand: strong = |Fn| above 1.5 x the mean over the selected contacts
+    assert c["threshold"] == pytest.approx(1.5 * np.mean(c["fn"]), rel=1e-14)
+    np.testing.assert_array_equal(c["strong"], np.asarray(c["fn"]) > c["threshold"])
+    with pytest.raises(gs.Error, match=r"^<frame>: --threshold must be a force >= 0 in N \(-2\)$"):
+        gs.chains(f, threshold=-2.0)
