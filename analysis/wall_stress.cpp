@@ -8,6 +8,9 @@
 #include <stdexcept>
 #include <unordered_map>
 
+#include "errors.hpp"
+#include "selection.hpp"
+
 namespace gs::analysis {
 namespace {
 
@@ -166,6 +169,25 @@ WallLoads wall_loads(const Frame& frame, const ContactBranches& branches, const 
     out.G += (p.mass > 0.0 ? p.mass : opt.particle_density * vol) * opt.gravity;
   }
   return out;
+}
+
+WallReport wall_report(const std::string& file, const Frame& frame, double d50,
+                       const WallSpec& spec) {
+  WallReport r;
+  r.options.up = spec.up;
+  r.options.bin = length_option(file, "--bin", spec.bin, spec.bin_d50, 5.0, d50);
+  if (spec.width) require_positive(file, "--width", *spec.width);
+  r.options.width = spec.width.value_or(0.0);
+  require_positive(file, "--gravity", spec.gravity);
+  require_positive(file, "--particle-density", spec.particle_density);
+  r.options.gravity = spec.gravity;
+  r.options.particle_density = spec.particle_density;
+  try {
+    r.loads = wall_loads(frame, contact_branches(frame), r.options);
+  } catch (const std::invalid_argument& e) {
+    throw InputError(file, e.what());
+  }
+  return r;
 }
 
 }  // namespace gs::analysis

@@ -21,6 +21,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -59,5 +60,23 @@ struct WallLoads {
 /// Throws std::invalid_argument for a bad bin, width, up vector or no wall contact.
 WallLoads wall_loads(const Frame& frame, const ContactBranches& branches,
                      const WallOptions& options);
+
+/// The options of `analyze walls` as given: the bin in m or in d50 (default 5 d50), the
+/// width when given.
+struct WallSpec {
+  Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
+  std::optional<double> bin, bin_d50, width;  // m, d50, m
+  double gravity = 9.81, particle_density = 2650.0;
+};
+
+struct WallReport {
+  WallOptions options;  // as resolved (bin in m)
+  WallLoads loads;
+};
+
+/// `analyze walls` as one call (CLI and Python). Throws InputError naming `file` and the
+/// option (--bin, --width, --gravity, --particle-density) or the problem (no wall contact).
+WallReport wall_report(const std::string& file, const Frame& frame, double d50,
+                       const WallSpec& spec);
 
 }  // namespace gs::analysis

@@ -230,21 +230,16 @@ struct WallArgs {
 void run_walls(const WallArgs& a) {
   const Frame f = a.in.load();
   const double d50 = a.in.d50_of(f);
-  ga::WallOptions o;
-  o.up = Eigen::Vector3d(a.up[0], a.up[1], a.up[2]);
-  o.bin = length_option(a.in.input, "--bin", a.bin, a.bin_d50, 5.0, d50);
-  if (a.width) require_positive(a.in.input, "--width", *a.width);
-  o.width = a.width.value_or(0.0);
-  require_positive(a.in.input, "--gravity", a.gravity);
-  require_positive(a.in.input, "--particle-density", a.particle_density);
-  o.gravity = a.gravity;
-  o.particle_density = a.particle_density;
-  ga::WallLoads w;
-  try {
-    w = ga::wall_loads(f, ga::contact_branches(f), o);
-  } catch (const std::invalid_argument& e) {
-    throw InputError(a.in.input, e.what());
-  }
+  ga::WallSpec spec;
+  spec.up = Eigen::Vector3d(a.up[0], a.up[1], a.up[2]);
+  spec.bin = a.bin;
+  spec.bin_d50 = a.bin_d50;
+  spec.width = a.width;
+  spec.gravity = a.gravity;
+  spec.particle_density = a.particle_density;
+  const ga::WallReport rep = ga::wall_report(a.in.input, f, d50, spec);
+  const ga::WallOptions& o = rep.options;
+  const ga::WallLoads& w = rep.loads;
   H5FieldFile h(a.output, "granoscope-walls");
   h.attr("source", a.in.input);
   h.attr("frame", static_cast<long long>(a.in.frame_index()));

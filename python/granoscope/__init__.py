@@ -17,10 +17,10 @@ import os as _os
 
 from . import _granoscope as _c
 from ._granoscope import (Error, Frame, Trajectory, chains, d50, dic, fabric, rose,
-                          stress_invariants)
+                          stress_invariants, walls)
 
 __all__ = ["Error", "FileNotFound", "Frame", "Trajectory", "open", "save", "chains", "d50",
-           "dic", "fabric", "rose", "stress_invariants", "__version__"]
+           "dic", "fabric", "rose", "stress_invariants", "walls", "__version__"]
 
 __version__ = _c.code_version().split()[-1]
 

@@ -21,6 +21,7 @@
 #include "selection.hpp"
 #include "snapshot.hpp"
 #include "tensor_invariants.hpp"
+#include "wall_stress.hpp"
 
 namespace py = pybind11;
 namespace ga = gs::analysis;
@@ -30,6 +31,16 @@ namespace {
 
 using OptVec = std::optional<std::vector<double>>;
 constexpr const char* kFrame = "<frame>";  // how messages name a frame given from Python
+
+// d50 as the CLI's --d50 option gives it, else the frame's.
+double frame_d50(const Frame& f, std::optional<double> d50) {
+  if (d50) {
+    ga::require_positive(kFrame, "--d50", *d50);
+    return *d50;
+  }
+  if (f.particles.empty()) throw InputError(kFrame, "the frame has no particles");
+  return ga::d50(f);
+}
 
 // The selection the CLI's --slab* / --region / --d50 options would make on this frame.
 ga::Selection selection_of(const Frame& f, bool slab, const OptVec& slab_origin,
@@ -44,15 +55,7 @@ ga::Selection selection_of(const Frame& f, bool slab, const OptVec& slab_origin,
   spec.slab_thickness = slab_thickness;
   spec.slab_d50 = slab_d50;
   spec.region = region.value_or(std::vector<double>{});
-  double d = 0.0;
-  if (d50) {
-    ga::require_positive(kFrame, "--d50", *d50);
-    d = *d50;
-  } else {
-    if (f.particles.empty()) throw InputError(kFrame, "the frame has no particles");
-    d = ga::d50(f);
-  }
-  return ga::make_selection(kFrame, f, d, spec);
+  return ga::make_selection(kFrame, f, frame_d50(f, d50), spec);
 }
 
 }  // namespace
@@ -193,6 +196,60 @@ void bind_analysis(py::module_& m) {
       "Strong-force network as `granoscope analyze chains`: per contact segment its ends a, b "
       "(m), |Fn|, |Fs| (N), strong flag and chain id (-1: not a strong particle contact); the "
       "threshold (N; default mean |Fn| x mean_factor), counts of strong contacts and chains.");
+
+  m.def(
+      "walls",
+      [](const Frame& f, std::vector<double> up, std::optional<double> bin,
+         std::optional<double> bin_d50, std::optional<double> width, double gravity,
+         double particle_density, std::optional<double> d50) {
+        if (up.size() != 3) throw InputError(kFrame, "--up needs 3 numbers");
+        ga::WallSpec spec;
+        spec.up = Eigen::Vector3d(up[0], up[1], up[2]);
+        spec.bin = bin;
+        spec.bin_d50 = bin_d50;
+        spec.width = width;
+        spec.gravity = gravity;
+        spec.particle_density = particle_density;
+        const ga::WallReport r = ga::wall_report(kFrame, f, frame_d50(f, d50), spec);
+        const ga::WallLoads& w = r.loads;
+        py::list walls;
+        for (const auto& l : w.walls) {
+          py::dict d;
+          d["id"] = l.id;
+          d["role"] = l.role;
+          d["inferred"] = l.inferred;
+          d["contacts"] = l.contacts;
+          d["N"] = l.N;
+          d["T"] = l.T;
+          d["phi_w_deg"] = l.phi_deg;
+          d["width"] = l.width;
+          d["force"] = l.force;
+          d["recorded_force"] = l.recorded;
+          d["normal"] = l.normal;
+          d["axis"] = l.axis;
+          d["position"] = l.position;
+          d["sigma_n"] = l.sigma_n;
+          d["tau"] = l.tau;
+          d["count"] = l.count;
+          walls.append(d);
+        }
+        py::dict out;
+        out["P"] = w.P;
+        out["T"] = w.T;
+        out["N"] = w.N;
+        out["G"] = w.G;
+        out["phi_w_deg"] = w.phi_deg;
+        out["bin"] = r.options.bin;
+        out["up"] = Eigen::Vector3d(r.options.up.normalized());
+        out["walls"] = walls;
+        return out;
+      },
+      py::arg("frame"), py::kw_only(), py::arg("up") = std::vector<double>{0.0, 0.0, 1.0},
+      py::arg("bin") = py::none(), py::arg("bin_d50") = py::none(), py::arg("width") = py::none(),
+      py::arg("gravity") = 9.81, py::arg("particle_density") = 2650.0, py::arg("d50") = py::none(),
+      "Wall stresses as `granoscope analyze walls` (seed 004 §5.3.1): per wall its role, N, T "
+      "(N), phi_w, and the profiles sigma_n, tau (Pa) at bin centres `position` (m along "
+      "`axis`); resultants P, T, N, G (N) and phi_w.");
 
   m.def(
       "stress_invariants",

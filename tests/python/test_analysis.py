@@ -1,4 +1,6 @@
 """Analyses from Python give the CLI's numbers on the same input."""
+import os
+
 import h5py
 import numpy as np
 import pytest
@@ -104,3 +106,27 @@ def test_chains_equal_the_cli(cli, tmp_path):
     np.testing.assert_array_equal(c["strong"], np.asarray(c["fn"]) > c["threshold"])
     with pytest.raises(gs.Error, match=r"^<frame>: --threshold must be a force >= 0 in N \(-2\)$"):
         gs.chains(f, threshold=-2.0)
+
+
+def test_walls_equal_the_cli(cli, source_dir, tmp_path):
+    """The YADE oedometer scene (883 spheres between six walls), 1000 steps, last frame."""
+    scene = os.path.join(source_dir, "data", "scenes", "oedometer_yade.toml")
+    rc, _, err = cli("simulate", scene, "--steps", 1000, "-q", "-o", tmp_path / "run")
+    assert rc == 0, err
+    run = tmp_path / "run" / "oedometer_yade.h5"
+    rc, _, err = cli("analyze", "walls", run, "-o", tmp_path / "w.h5", "--bin-d50", 3)
+    assert rc == 0, err
+    w = gs.walls(gs.open(run)[-1], bin_d50=3)
+    with h5py.File(tmp_path / "w.h5", "r") as h:
+        for key in ("P", "T", "N", "G", "phi_w_deg", "bin"):
+            assert h.attrs[key] == w[key] or (np.isnan(h.attrs[key]) and np.isnan(w[key])), key
+        assert len(h["walls"]) == len(w["walls"]) > 0
+        for k, wall in enumerate(w["walls"]):
+            g = h["walls/%d" % k]
+            role = g.attrs["role"]
+            assert (role.decode() if isinstance(role, bytes) else role) == wall["role"]
+            assert g.attrs["contacts"] == wall["contacts"] > 0
+            np.testing.assert_array_equal(g["sigma_n"][()], wall["sigma_n"])
+            np.testing.assert_array_equal(g["force"][()], wall["force"])
+    with pytest.raises(gs.Error, match=r"^<frame>: --gravity must be a finite number > 0 \(0\)$"):
+        gs.walls(gs.open(run)[-1], gravity=0.0)
