@@ -25,6 +25,7 @@
 #include "love_weber_stress.hpp"
 #include "rev_cells.hpp"
 #include "shear_zone.hpp"
+#include "specimen_stress.hpp"
 #include "tensor_invariants.hpp"
 
 namespace gs::cli {
@@ -413,29 +414,6 @@ Eigen::Matrix3d matrix9(const std::string& file, const char* name, const std::ve
   return m;
 }
 
-/// Least-squares deformation gradient of the matched particles: x - <x> = F (X - <X>).
-Eigen::Matrix3d fit_gradient(const Frame& f, const Frame& to, const std::string& file) {
-  const FrameMotion m = motion_between(f, to, file);
-  const int dim = f.two_d ? 2 : 3;
-  Eigen::Vector3d xm = Eigen::Vector3d::Zero(), um = Eigen::Vector3d::Zero();
-  for (std::size_t k = 0; k < m.x.size(); ++k) xm += m.x[k], um += m.u[k];
-  xm /= static_cast<double>(m.x.size());
-  um /= static_cast<double>(m.x.size());
-  Eigen::Matrix3d a = Eigen::Matrix3d::Zero(), b = Eigen::Matrix3d::Zero();
-  for (std::size_t k = 0; k < m.x.size(); ++k) {
-    const Eigen::Vector3d dx = m.x[k] - xm, du = m.u[k] - um;
-    a.noalias() += dx * dx.transpose();
-    b.noalias() += du * dx.transpose();
-  }
-  Eigen::Matrix3d F = Eigen::Matrix3d::Identity();
-  const auto block = a.topLeftCorner(dim, dim);
-  Eigen::FullPivLU<Eigen::MatrixXd> lu(block);
-  if (m.x.size() < static_cast<std::size_t>(dim + 1) || lu.rank() < dim)
-    throw InputError(file, "deformation gradient: matched particles are degenerate (coplanar)");
-  F.topLeftCorner(dim, dim) += b.topLeftCorner(dim, dim) * lu.inverse();
-  return F;
-}
-
 void run_invariants(const InvArgs& a) {
   const bool direct = !a.stress.empty() || !a.gradient.empty();
   if (a.in.input.empty() && !direct)
@@ -451,31 +429,19 @@ void run_invariants(const InvArgs& a) {
   if (!a.in.input.empty()) {
     const Frame f = a.in.load();
     dim = f.two_d ? 2 : 3;
-    const auto b = ga::contact_branches(f);
     if (!has_sigma) {
-      auto box = a.sel.make_region(a.in.input);
-      if (!box && f.domain.periodic) {  // the whole cell: every (minimum-image) branch in full
-        try {
-          sigma = ga::periodic_cell_stress(f, b);
-        } catch (const std::invalid_argument& e) {
-          throw InputError(a.in.input, e.what());
-        }
-        const Eigen::Matrix3d& c = f.domain.cell;
-        volume = std::abs(f.two_d ? c.topLeftCorner<2, 2>().determinant() : c.determinant());
-      } else {
-        if (!box) box = particle_bounds(f);
-        if (f.two_d) box->first.z() = -0.5, box->second.z() = 0.5;  // per unit depth: N/m
-        volume = (box->second - box->first).prod();
-        sigma = ga::love_weber_stress(b.branches, box->first, box->second);
-      }
+      const ga::SpecimenStress st =
+          ga::specimen_stress(a.in.input, f, a.sel.make_region(a.in.input));
+      sigma = st.sigma;
+      volume = st.volume;
       has_sigma = true;
-      if (b.wall_contacts > 0) {
-        boundary = ga::boundary_stress(f, b, volume);
+      if (st.boundary_eq14) {
+        boundary = *st.boundary_eq14;
         has_boundary = true;
       }
     }
     if (!has_F && a.in.to) {
-      F = fit_gradient(f, *a.in.load_to(), a.in.input);
+      F = ga::fit_deformation_gradient(a.in.input, f, *a.in.load_to());
       has_F = true;
     }
   }

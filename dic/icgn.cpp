@@ -353,12 +353,12 @@ constexpr double kCoef[12] = {1, 1, 1, 1, 1, 1, 0.5, 1, 0.5, 0.5, 1, 0.5};
 [[gnu::always_inline]] inline IcgnResult IcgnSolver::solve_impl2(int x0, int y0,
                                                                  const Shape& guess) const {
   using Vec12 = Eigen::Matrix<double, 12, 1>;
+  const int R = radius_;
   IcgnResult res;
   res.p = guess;
-  const auto sub = load_subset(ref_, gx_, gy_, x0, y0, radius_);
+  const auto sub = load_subset(ref_, gx_, gy_, x0, y0, R);
   if (!sub) return res;  // the subset is not inside the reference image
   const auto [f, gxs, gys, nd, fmean] = *sub;
-  const int R = radius_;
   // Mq[q][i][j] = sum q dx^i dy^j (i + j <= 4) for q = gx^2, gx gy, gy^2; MF[c][i][j] = sum
   // g_c f~ dx^i dy^j and MS[c][i][j] = sum g_c dx^i dy^j (i + j <= 2).
   double Mq[3][5][5] = {};

@@ -16,11 +16,11 @@ See docs/python.md.
 import os as _os
 
 from . import _granoscope as _c
-from ._granoscope import (Error, Frame, Trajectory, chains, d50, dic, fabric, rose,
-                          stress_invariants, walls)
+from ._granoscope import (Error, Frame, Trajectory, chains, d50, dic, fabric, invariants,
+                          rose, stress_invariants, walls)
 
 __all__ = ["Error", "FileNotFound", "Frame", "Trajectory", "open", "save", "chains", "d50",
-           "dic", "fabric", "rose", "stress_invariants", "walls", "__version__"]
+           "dic", "fabric", "invariants", "rose", "stress_invariants", "walls", "__version__"]
 
 __version__ = _c.code_version().split()[-1]
 

@@ -20,6 +20,7 @@
 #include "rose_report.hpp"
 #include "selection.hpp"
 #include "snapshot.hpp"
+#include "specimen_stress.hpp"
 #include "tensor_invariants.hpp"
 #include "wall_stress.hpp"
 
@@ -250,6 +251,79 @@ void bind_analysis(py::module_& m) {
       "Wall stresses as `granoscope analyze walls` (seed 004 §5.3.1): per wall its role, N, T "
       "(N), phi_w, and the profiles sigma_n, tau (Pa) at bin centres `position` (m along "
       "`axis`); resultants P, T, N, G (N) and phi_w.");
+
+  m.def(
+      "invariants",
+      [](std::optional<Frame> frame, std::optional<Frame> to, OptVec region,
+         std::optional<Eigen::Matrix3d> stress, std::optional<Eigen::Matrix3d> gradient) {
+        // `granoscope analyze invariants`: a given stress / gradient wins over the frame's.
+        int dim = frame && frame->two_d ? 2 : 3;
+        py::dict out;
+        std::optional<Eigen::Matrix3d> sigma = stress, F = gradient;
+        if (sigma && !sigma->allFinite())
+          throw InputError(kFrame, "--stress must be 9 finite numbers");
+        if (F && !F->allFinite()) throw InputError(kFrame, "--gradient must be 9 finite numbers");
+        py::dict sd;
+        if (frame && !sigma) {
+          ga::SelectionSpec spec;
+          spec.region = region.value_or(std::vector<double>{});
+          const ga::SpecimenStress st =
+              ga::specimen_stress(kFrame, *frame, spec.make_region(kFrame));
+          sigma = st.sigma;
+          sd["volume"] = st.volume;
+          if (st.boundary_eq14) sd["boundary_eq14"] = *st.boundary_eq14;
+        }
+        if (frame && to && !F) F = ga::fit_deformation_gradient(kFrame, *frame, *to);
+        if (!sigma && !F) throw InputError(kFrame, "nothing to evaluate");
+        if (sigma) {
+          const ga::StressInvariants s = ga::stress_invariants(*sigma, dim);
+          sd["tensor"] = *sigma;
+          sd["p"] = s.p;
+          sd["q"] = s.q;
+          sd["eta"] = s.eta;
+          sd["b"] = s.b;
+          sd["lode_deg"] = s.lode_deg;
+          sd["phi_mob_deg"] = s.phi_mob_deg;
+          sd["j2d"] = s.j2d;
+          sd["j3d"] = s.j3d;
+          sd["asymmetry"] = s.asymmetry;
+          sd["principal"] = s.principal;
+          sd["directions"] = s.directions;
+          out["stress"] = sd;
+        }
+        if (F) {
+          ga::StrainInvariants e;
+          try {
+            e = ga::strain_invariants(*F);
+          } catch (const std::invalid_argument& x) {
+            throw InputError(kFrame, x.what());
+          }
+          py::dict ed;
+          ed["F"] = *F;
+          ed["U"] = e.U;
+          ed["R"] = e.R;
+          ed["biot"] = e.biot;
+          ed["Fv"] = e.Fv;
+          ed["Fd"] = e.Fd;
+          ed["directions"] = e.directions;
+          ed["principal"] = e.principal;
+          ed["J"] = e.J;
+          ed["eps_v"] = e.eps_v;
+          ed["eps_q"] = e.eps_q;
+          ed["b_eps"] = e.b_eps;
+          ed["b_stretch"] = e.b_stretch;
+          ed["lode_deg"] = e.lode_deg;
+          out["strain"] = ed;
+        }
+        return out;
+      },
+      py::arg("frame") = py::none(), py::kw_only(), py::arg("to") = py::none(),
+      py::arg("region") = py::none(), py::arg("stress") = py::none(),
+      py::arg("gradient") = py::none(),
+      "As `granoscope analyze invariants`: the specimen stress of `frame` (Love-Weber over "
+      "`region`, the periodic cell or the particles' box; with wall contacts also seed 003 eq "
+      "14) or a given `stress`, and its invariants; the deformation gradient fitted from "
+      "`frame` to `to` (or a given `gradient`) and its invariants (seed 003 eqs 2, 11, 12).");
 
   m.def(
       "stress_invariants",

@@ -130,3 +130,35 @@ def test_walls_equal_the_cli(cli, source_dir, tmp_path):
             np.testing.assert_array_equal(g["force"][()], wall["force"])
     with pytest.raises(gs.Error, match=r"^<frame>: --gravity must be a finite number > 0 \(0\)$"):
         gs.walls(gs.open(run)[-1], gravity=0.0)
+
+
+def test_invariants_equal_the_cli(cli, source_dir, tmp_path):
+    """Specimen stress (with the walls' eq 14) and the fitted F between two frames."""
+    scene = os.path.join(source_dir, "data", "scenes", "oedometer_yade.toml")
+    rc, _, err = cli("simulate", scene, "--steps", 2000, "-q", "-o", tmp_path / "run")
+    assert rc == 0, err
+    run = tmp_path / "run" / "oedometer_yade.h5"
+    rc, _, err = cli("analyze", "invariants", run, "--frame", 0, "--to", -1, "-o",
+                     tmp_path / "i.h5")
+    assert rc == 0, err
+    t = gs.open(run)
+    py = gs.invariants(t[0], to=t[-1])
+    with h5py.File(tmp_path / "i.h5", "r") as h:
+        np.testing.assert_array_equal(h["stress/tensor"][()], py["stress"]["tensor"])
+        assert ("boundary_eq14" in h["stress"]) == ("boundary_eq14" in py["stress"])
+        for key in ("p", "q", "volume"):
+            assert h["stress"].attrs[key] == py["stress"][key], key
+        np.testing.assert_array_equal(h["strain/F"][()], py["strain"]["F"])
+        assert h["strain"].attrs["eps_v"] == py["strain"]["eps_v"]
+    # the last frame, with contacts on the walls: seed 003 eq 14 as well
+    rc, _, err = cli("analyze", "invariants", run, "-o", tmp_path / "j.h5")
+    assert rc == 0, err
+    last = gs.invariants(t[-1])["stress"]
+    with h5py.File(tmp_path / "j.h5", "r") as h:
+        np.testing.assert_array_equal(h["stress/tensor"][()], last["tensor"])
+        np.testing.assert_array_equal(h["stress/boundary_eq14"][()], last["boundary_eq14"])
+    # a given tensor: its invariants, no frame needed
+    s = gs.invariants(stress=np.diag([2.0, 1.0, 1.0]))["stress"]
+    assert s["q"] == pytest.approx(1.0) and s["p"] == pytest.approx(4.0 / 3.0)
+    with pytest.raises(gs.Error, match="^<frame>: nothing to evaluate$"):
+        gs.invariants()
