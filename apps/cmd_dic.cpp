@@ -1,5 +1,4 @@
 // `granoscope dic REF IMG... -o dic.h5`: subset DIC of an image sequence (dic/).
-#include <omp.h>
 
 #include <CLI/CLI.hpp>
 #include <chrono>
@@ -47,7 +46,7 @@ void run_dic(const DicArgs& a) {
   const double seconds_read = since(t_start);
   const dic::SequenceResult result = dic::run_dic(images, a.images, roi, a.roi, a.req);
   const dic::DicRunInfo info = dic::run_info(a.req, a.images, result, images[0]);
-  const int threads = a.req.threads > 0 ? a.req.threads : omp_get_max_threads();
+  const int threads = dic::resolved_threads(a.req);
   const auto t_write = Clock::now();
   const std::filesystem::path out(a.output);
   // The HDF5, CSV and VTI files appear together or not at all.

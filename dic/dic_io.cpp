@@ -17,25 +17,45 @@
 namespace gs::dic {
 namespace {
 
-using Getter = std::function<const std::vector<double>&(const FrameResult&)>;
+using Column = DicColumn;
 
-struct Column {
-  const char* name;
-  Getter get;
-};
-
+// exx, eyy, exy of the CSV and VTK outputs (named so in both modes): Green–Lagrange, or small
+// strain with --strain small.
 std::vector<Column> strain_columns(bool small) {
-  if (small)
-    return {
-        {"exx", [](const FrameResult& f) -> const std::vector<double>& { return f.strain.sxx; }},
-        {"eyy", [](const FrameResult& f) -> const std::vector<double>& { return f.strain.syy; }},
-        {"exy", [](const FrameResult& f) -> const std::vector<double>& { return f.strain.sxy; }}};
-  return {{"exx", [](const FrameResult& f) -> const std::vector<double>& { return f.strain.exx; }},
-          {"eyy", [](const FrameResult& f) -> const std::vector<double>& { return f.strain.eyy; }},
-          {"exy", [](const FrameResult& f) -> const std::vector<double>& { return f.strain.exy; }}};
+  const auto& c = dic_columns();
+  const std::size_t first = small ? 6 : 3;
+  return {{"exx", c[first].get}, {"eyy", c[first + 1].get}, {"exy", c[first + 2].get}};
 }
 
 }  // namespace
+
+const std::vector<DicColumn>& dic_columns() {
+  using F = FrameResult;
+  using V = std::vector<double>;
+  static const std::vector<DicColumn> columns{
+      {"u", [](const F& f) -> const V& { return f.u; }},
+      {"v", [](const F& f) -> const V& { return f.v; }},
+      {"zncc", [](const F& f) -> const V& { return f.zncc; }},
+      {"exx", [](const F& f) -> const V& { return f.strain.exx; }},
+      {"eyy", [](const F& f) -> const V& { return f.strain.eyy; }},
+      {"exy", [](const F& f) -> const V& { return f.strain.exy; }},
+      {"exx_small", [](const F& f) -> const V& { return f.strain.sxx; }},
+      {"eyy_small", [](const F& f) -> const V& { return f.strain.syy; }},
+      {"exy_small", [](const F& f) -> const V& { return f.strain.sxy; }}};
+  return columns;
+}
+
+std::vector<double> grid_x(const PoiGrid& g) {
+  std::vector<double> x(static_cast<std::size_t>(g.nx));
+  for (int i = 0; i < g.nx; ++i) x[static_cast<std::size_t>(i)] = g.x0 + i * g.step;
+  return x;
+}
+
+std::vector<double> grid_y(const PoiGrid& g) {
+  std::vector<double> y(static_cast<std::size_t>(g.ny));
+  for (int j = 0; j < g.ny; ++j) y[static_cast<std::size_t>(j)] = g.y0 + j * g.step;
+  return y;
+}
 
 void write_dic_hdf5(const std::filesystem::path& path, const SequenceResult& result,
                     const DicRunInfo& info) {
@@ -54,28 +74,12 @@ void write_dic_hdf5(const std::filesystem::path& path, const SequenceResult& res
   for (const auto& s : info.images) images += (images.empty() ? "" : "\n") + s;
   h.attr("images", images);
   const PoiGrid& g = result.grid;
-  std::vector<double> xs(static_cast<std::size_t>(g.nx)), ys(static_cast<std::size_t>(g.ny));
-  for (int i = 0; i < g.nx; ++i) xs[static_cast<std::size_t>(i)] = g.x0 + i * g.step;
-  for (int j = 0; j < g.ny; ++j) ys[static_cast<std::size_t>(j)] = g.y0 + j * g.step;
-  h.write("/x", xs);
-  h.write("/y", ys);
+  h.write("/x", grid_x(g));
+  h.write("/y", grid_y(g));
   const auto ny = static_cast<std::size_t>(g.ny), nx = static_cast<std::size_t>(g.nx);
   h.write("/roi", std::vector<std::uint8_t>(g.in_roi), {ny, nx});
   const std::vector<std::size_t> dims{result.frames.size(), ny, nx};
-  const std::vector<Column> cols{
-      {"u", [](const FrameResult& f) -> const std::vector<double>& { return f.u; }},
-      {"v", [](const FrameResult& f) -> const std::vector<double>& { return f.v; }},
-      {"zncc", [](const FrameResult& f) -> const std::vector<double>& { return f.zncc; }},
-      {"exx", [](const FrameResult& f) -> const std::vector<double>& { return f.strain.exx; }},
-      {"eyy", [](const FrameResult& f) -> const std::vector<double>& { return f.strain.eyy; }},
-      {"exy", [](const FrameResult& f) -> const std::vector<double>& { return f.strain.exy; }},
-      {"exx_small",
-       [](const FrameResult& f) -> const std::vector<double>& { return f.strain.sxx; }},
-      {"eyy_small",
-       [](const FrameResult& f) -> const std::vector<double>& { return f.strain.syy; }},
-      {"exy_small",
-       [](const FrameResult& f) -> const std::vector<double>& { return f.strain.sxy; }}};
-  for (const auto& c : cols) {
+  for (const auto& c : dic_columns()) {
     std::vector<double> all;
     for (const auto& f : result.frames) all.insert(all.end(), c.get(f).begin(), c.get(f).end());
     h.write(std::string("/") + c.name, all, dims);

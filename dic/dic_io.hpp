@@ -26,6 +26,18 @@ struct DicRunInfo {
   int image_cols = 0;
 };
 
+/// A per-POI field of every frame, by its dataset name in the HDF5 file.
+struct DicColumn {
+  const char* name;
+  const std::vector<double>& (*get)(const FrameResult&);
+};
+/// The HDF5 file's per-frame fields, in order: u, v, zncc, exx, eyy, exy (Green–Lagrange),
+/// exx_small, eyy_small, exy_small (the Python package returns the same).
+const std::vector<DicColumn>& dic_columns();
+/// POI coordinates (px) along x (nx values) and y (ny values): the HDF5 file's /x and /y.
+std::vector<double> grid_x(const PoiGrid& g);
+std::vector<double> grid_y(const PoiGrid& g);
+
 /// Writes the HDF5 file. Throws gs::InputError naming the file on failure.
 void write_dic_hdf5(const std::filesystem::path& path, const SequenceResult& result,
                     const DicRunInfo& info);

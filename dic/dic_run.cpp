@@ -16,6 +16,10 @@ std::string size_str(const cv::Mat& m) {
 
 }  // namespace
 
+int resolved_threads(const DicRequest& request) {
+  return request.threads > 0 ? request.threads : omp_get_max_threads();
+}
+
 void check_request(const DicRequest& a) {
   if (a.subset < 5 || a.subset % 2 == 0)
     throw InputError("--subset", "must be an odd number of px >= 5", std::to_string(a.subset));
@@ -61,7 +65,7 @@ SequenceResult run_dic(const std::vector<cv::Mat>& images, const std::vector<std
   opt.dic.search = a.search;
   opt.dic.icgn.order = a.shape == "quadratic" ? 2 : 1;
   opt.dic.zncc_min = a.zncc_min;
-  opt.dic.threads = a.threads > 0 ? a.threads : omp_get_max_threads();
+  opt.dic.threads = resolved_threads(a);
   opt.step = a.step;
   opt.strain_window_radius = a.strain_window / 2;
   opt.incremental = a.incremental;

@@ -27,6 +27,9 @@ struct DicRequest {
   std::function<void()> poll;  // see DicOptions::poll
 };
 
+/// The thread count a request runs on (threads, or OpenMP's default for 0).
+int resolved_threads(const DicRequest& request);
+
 /// Throws InputError naming the option (e.g. "--subset: must be an odd number of px >= 5 (30)").
 void check_request(const DicRequest& request);
 

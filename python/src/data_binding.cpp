@@ -9,6 +9,7 @@
 #include <pybind11/stl/filesystem.h>
 
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <sstream>
@@ -59,9 +60,10 @@ py::array eigen_view(py::handle owner, Eigen::PlainObjectBase<Derived>& x) {
 }
 
 // Rows of a float64 (n, k) array (k = 0: 1-D) as a contiguous copy, checking the shape.
-py::array_t<double, py::array::c_style | py::array::forcecast> rows(py::handle a, const char* name,
-                                                                    py::ssize_t n, py::ssize_t k) {
-  auto arr = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(a);
+template <class T = double>
+py::array_t<T, py::array::c_style | py::array::forcecast> rows(py::handle a, const char* name,
+                                                               py::ssize_t n, py::ssize_t k) {
+  auto arr = py::array_t<T, py::array::c_style | py::array::forcecast>::ensure(a);
   if (!arr) throw InputError("<arrays>", std::string(name) + " is not a numeric array");
   const bool ok = k == 0 ? (arr.ndim() == 1 && arr.shape(0) == n)
                          : (arr.ndim() == 2 && arr.shape(0) == n && arr.shape(1) == k);
@@ -114,21 +116,30 @@ Frame frame_from_arrays(py::handle positions, py::handle radii, py::object veloc
     const auto v = rows(a, name, n, 0);
     for (py::ssize_t i = 0; i < n; ++i) set(f.particles[static_cast<std::size_t>(i)], v.at(i));
   };
-  scalar(ids, "ids", [](Particle& p, double x) { p.id = static_cast<std::int64_t>(x); });
   scalar(masses, "masses", [](Particle& p, double x) { p.mass = x; });
-  scalar(clump_ids, "clump_ids",
-         [](Particle& p, double x) { p.clump_id = static_cast<std::int64_t>(x); });
-  scalar(material_ids, "material_ids",
-         [](Particle& p, double x) { p.material_id = static_cast<std::int32_t>(x); });
+  // Integer fields as int64, never through double (ids above 2^53 stay exact).
+  const auto integer = [&](py::object a, const char* name, auto set) {
+    if (a.is_none()) return;
+    const auto v = rows<std::int64_t>(a, name, n, 0);
+    for (py::ssize_t i = 0; i < n; ++i) set(f.particles[static_cast<std::size_t>(i)], v.at(i));
+  };
+  integer(ids, "ids", [](Particle& p, std::int64_t x) { p.id = x; });
+  integer(clump_ids, "clump_ids", [](Particle& p, std::int64_t x) { p.clump_id = x; });
+  integer(material_ids, "material_ids", [](Particle& p, std::int64_t x) {
+    if (x < 0 || x > std::numeric_limits<std::int32_t>::max())
+      throw InputError("<arrays>", "material_ids must be in 0..2^31-1", std::to_string(x));
+    p.material_id = static_cast<std::int32_t>(x);
+  });
   if (!contact_ids.is_none()) {
-    auto c = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(contact_ids);
+    auto c =
+        py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>::ensure(contact_ids);
     if (!c || c.ndim() != 2 || c.shape(1) != 2)
       throw InputError("<arrays>", "contact_ids must be an (M, 2) array");
     const py::ssize_t m = c.shape(0);
     f.contacts.resize(static_cast<std::size_t>(m));
     for (py::ssize_t k = 0; k < m; ++k) {
-      f.contacts[static_cast<std::size_t>(k)].id1 = static_cast<std::int64_t>(c.at(k, 0));
-      f.contacts[static_cast<std::size_t>(k)].id2 = static_cast<std::int64_t>(c.at(k, 1));
+      f.contacts[static_cast<std::size_t>(k)].id1 = c.at(k, 0);
+      f.contacts[static_cast<std::size_t>(k)].id2 = c.at(k, 1);
     }
     const auto cvec = [&](py::object a, const char* name, Eigen::Vector3d Contact::*member) {
       if (a.is_none()) return;

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "bindings.hpp"
+#include "dic_io.hpp"
 #include "dic_run.hpp"
 #include "errors.hpp"
 #include "image_io.hpp"
@@ -46,13 +47,13 @@ cv::Mat to_image(py::handle obj, const std::string& name, std::vector<py::object
                  const_cast<void*>(a.data()));
 }
 
-py::array_t<double> field(const dic::SequenceResult& r,
-                          const std::vector<double>& (*get)(const dic::FrameResult&)) {
+// One per-POI field of every frame as a (frames, ny, nx) array.
+py::array_t<double> field(const dic::SequenceResult& r, const dic::DicColumn& c) {
   const auto nf = static_cast<py::ssize_t>(r.frames.size());
   py::array_t<double> out(
       {nf, static_cast<py::ssize_t>(r.grid.ny), static_cast<py::ssize_t>(r.grid.nx)});
   double* p = out.mutable_data();
-  for (const auto& f : r.frames) p = std::copy(get(f).begin(), get(f).end(), p);
+  for (const auto& f : r.frames) p = std::copy(c.get(f).begin(), c.get(f).end(), p);
   return out;
 }
 
@@ -100,30 +101,10 @@ void bind_dic(py::module_& m) {
           r = dic::run_dic(mats, names, roi_mat, roi_name, req);
         }
         py::dict out;
-        std::vector<double> x(static_cast<std::size_t>(r.grid.nx)),
-            y(static_cast<std::size_t>(r.grid.ny));
-        for (int i = 0; i < r.grid.nx; ++i)
-          x[static_cast<std::size_t>(i)] = r.grid.x0 + i * r.grid.step;
-        for (int j = 0; j < r.grid.ny; ++j)
-          y[static_cast<std::size_t>(j)] = r.grid.y0 + j * r.grid.step;
+        const std::vector<double> x = dic::grid_x(r.grid), y = dic::grid_y(r.grid);
         out["x"] = py::array_t<double>(x.size(), x.data());
         out["y"] = py::array_t<double>(y.size(), y.data());
-        using F = dic::FrameResult;
-        out["u"] = field(r, [](const F& f) -> const std::vector<double>& { return f.u; });
-        out["v"] = field(r, [](const F& f) -> const std::vector<double>& { return f.v; });
-        out["zncc"] = field(r, [](const F& f) -> const std::vector<double>& { return f.zncc; });
-        out["exx"] =
-            field(r, [](const F& f) -> const std::vector<double>& { return f.strain.exx; });
-        out["eyy"] =
-            field(r, [](const F& f) -> const std::vector<double>& { return f.strain.eyy; });
-        out["exy"] =
-            field(r, [](const F& f) -> const std::vector<double>& { return f.strain.exy; });
-        out["exx_small"] =
-            field(r, [](const F& f) -> const std::vector<double>& { return f.strain.sxx; });
-        out["eyy_small"] =
-            field(r, [](const F& f) -> const std::vector<double>& { return f.strain.syy; });
-        out["exy_small"] =
-            field(r, [](const F& f) -> const std::vector<double>& { return f.strain.sxy; });
+        for (const auto& c : dic::dic_columns()) out[c.name] = field(r, c);
         const auto nf = static_cast<py::ssize_t>(r.frames.size());
         py::array_t<bool> valid(
             {nf, static_cast<py::ssize_t>(r.grid.ny), static_cast<py::ssize_t>(r.grid.nx)});

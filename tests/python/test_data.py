@@ -72,6 +72,20 @@ def test_round_trip_through_every_writer(tmp_path, ext):
         np.testing.assert_array_equal(g.velocities, f.velocities)
 
 
+def test_integer_fields_stay_exact(tmp_path):
+    big = np.array([2**60 + 1, 2**60 + 3], dtype=np.int64)  # not representable as doubles
+    f = gs.Frame.from_arrays(np.array([[0.0, 0, 0], [3.0, 0, 0]]), np.ones(2), ids=big,
+                             clump_ids=big - 1, contact_ids=big[None, :],
+                             contact_normals=np.array([[1.0, 0, 0]]))
+    np.testing.assert_array_equal(f.ids, big)
+    np.testing.assert_array_equal(f.clump_ids, big - 1)
+    np.testing.assert_array_equal(f.contact_ids, big[None, :])
+    gs.save(tmp_path / "big.h5", f)
+    np.testing.assert_array_equal(gs.open(tmp_path / "big.h5")[0].ids, big)
+    with pytest.raises(gs.Error, match="material_ids must be in"):
+        gs.Frame.from_arrays(np.zeros((1, 3)), np.ones(1), material_ids=np.array([2**40]))
+
+
 def test_trajectory_of_frames_saves_all(tmp_path):
     frames = []
     for k in range(3):
