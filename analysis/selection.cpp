@@ -4,6 +4,7 @@
 #include <stdexcept>
 
 #include "errors.hpp"
+#include "grain_size.hpp"
 
 namespace gs::analysis {
 
@@ -107,6 +108,16 @@ ContactBranches selected_branches(const Frame& f, const ContactBranches& all, co
     (b.p2 < 0 ? out.wall_contacts : out.particle_contacts) += 1;
   }
   return out;
+}
+
+Slab ProjectionSlabSpec::make(const Frame& frame) const {
+  Slab s;
+  if (origin.size() == 3) s.origin = Eigen::Vector3d(origin.data());
+  if (normal.size() == 3) s.normal = Eigen::Vector3d(normal.data());
+  if (axis.size() == 3) s.axis1 = Eigen::Vector3d(axis.data());
+  s.thickness = thickness;
+  if (d50_multiple > 0.0) s.thickness = d50_multiple * d50(frame);
+  return s;
 }
 
 }  // namespace gs::analysis

@@ -41,6 +41,17 @@ struct SelectionSpec {
       const std::string& file) const;
 };
 
+/// The slab options of `analyze strain | hhd | vortices`: a slab projected onto its plane (seed
+/// 000 §5). Unset: origin 0, normal z, axis x; thickness in m or in d50 of the frame.
+struct ProjectionSlabSpec {
+  std::vector<double> origin, normal, axis;  // 3 values each when given
+  double thickness = 0.0;                    // m
+  double d50_multiple = 0.0;                 // thickness in d50 of the frame
+  bool any() const { return !normal.empty() || thickness > 0.0 || d50_multiple > 0.0; }
+  /// The slab for `frame` (geometry checked where it is used: slab_axes / project_slab).
+  Slab make(const Frame& frame) const;
+};
+
 /// The slab and region as one predicate on points (all points when neither is given).
 struct Selection {
   std::optional<Slab> slab;

@@ -50,14 +50,6 @@ void GridArgs::add_to(CLI::App& cmd) {
   cmd.add_option("--step-d50", step_d50, "grid step in d50 (default 1)");
 }
 
-double GridArgs::cell_size(const std::string& file, double d50) const {
-  return length_option(file, "--cell", cell, cell_d50, 5.0, d50);
-}
-
-double GridArgs::step_size(const std::string& file, double d50) const {
-  return length_option(file, "--step", step, step_d50, 1.0, d50);
-}
-
 void SelectionArgs::add_to(CLI::App& cmd, bool with_region) {
   cmd.add_flag("--slab", slab,
                "a slab through the specimen: default the front view (normal -y, axis x, so x "

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "rev_map.hpp"
 #include "selection.hpp"
 #include "slab_projection.hpp"
 #include "snapshot.hpp"
@@ -37,11 +38,8 @@ using analysis::require_positive;
 using analysis::view_axes;
 
 /// REV grid: cell size L and step s, in m or d50 (defaults 5 d50 and 1 d50).
-struct GridArgs {
-  std::optional<double> cell, cell_d50, step, step_d50;
+struct GridArgs : analysis::GridSpec {
   void add_to(CLI::App& cmd);
-  double cell_size(const std::string& file, double d50) const;
-  double step_size(const std::string& file, double d50) const;
 };
 
 /// --slab, --slab-origin, --slab-normal, --slab-axis, --slab-thickness, --slab-d50, --region

@@ -18,6 +18,7 @@
 #include "hdf5_trajectory.hpp"
 #include "image_io.hpp"
 #include "render_frames.hpp"
+#include "render_run.hpp"
 
 namespace gs::cli {
 namespace {
@@ -84,60 +85,40 @@ void run_dic(const DicArgs& a) {
 struct RenderArgs {
   std::string input;
   std::string out_dir;
-  std::string view = "front";
-  double px_per_d50 = 25.0;
-  double margin_d50 = 0.5;
-  int supersample = 3;
-  double noise = 0.0;
-  int bits = 8;
   std::string format = "png";
-  std::uint64_t seed = 1;
+  dic::RenderRequest req;
 };
 
 void run_render(const RenderArgs& a) {
-  const dic::View view = dic::parse_view(a.view);
-  if (a.bits != 8 && a.bits != 16)
-    throw InputError("--bits", "must be 8 or 16", std::to_string(a.bits));
+  dic::check_render_request(a.req);
   if (a.format != "png" && a.format != "tif")
     throw InputError("--format", "must be png or tif", a.format);
-  if (a.supersample < 1 || a.supersample > 16)
-    throw InputError("--supersample", "must be in 1..16", std::to_string(a.supersample));
-  if (!(a.noise >= 0.0 && a.noise < 1.0))
-    throw InputError("--noise", "must be in [0, 1) (fraction of full scale)", value_str(a.noise));
   if (!std::filesystem::is_regular_file(a.input)) throw InputError(a.input, "no such file");
   const TrajectoryReader reader(a.input);
   if (reader.frame_count() == 0) throw InputError(a.input, "trajectory has no frames");
   const Frame ref = reader.frame(0);
-  const dic::Camera cam = dic::make_camera(ref, view, a.px_per_d50, a.margin_d50, a.input);
+  const dic::Camera cam = dic::render_camera(ref, a.req, a.input);
   std::error_code ec;
   std::filesystem::create_directories(a.out_dir, ec);
   if (!std::filesystem::is_directory(a.out_dir))
     throw InputError(a.out_dir, "cannot create output directory");
-  dic::RenderOptions ro;
-  ro.supersample = a.supersample;
-  ro.noise_sigma = a.noise * 255.0;
-  ro.seed = a.seed;
   std::vector<dic::GroundTruth> truth;
-  const double full = a.bits == 8 ? 255.0 : 65535.0;
   StagingDir staging(a.out_dir);
   staging.write([&] {
     for (std::size_t k = 0; k < reader.frame_count(); ++k) {
-      const Frame f = k == 0 ? ref : reader.frame(k);
-      const cv::Mat img = dic::render_frame(f, cam, ro);
-      cv::Mat q;
-      img.convertTo(q, a.bits == 8 ? CV_8U : CV_16U, full / 255.0);  // rounds and saturates
+      dic::RenderedFrame r = dic::render_one(ref, k == 0 ? ref : reader.frame(k), cam, a.req);
       char name[64];
       std::snprintf(name, sizeof name, "frame_%04zu.%s", k, a.format.c_str());
       const std::filesystem::path target = std::filesystem::path(a.out_dir) / name;
       const std::filesystem::path staged = staging / name;  // imwrite needs the extension
-      dic::write_image(staged, q, target.string());
-      truth.push_back(dic::ground_truth(ref, f, cam));
+      dic::write_image(staged, r.image, target.string());
+      truth.push_back(std::move(r.truth));
     }
-    dic::write_ground_truth_hdf5(staging / "ground_truth.h5", cam, a.view, truth);
+    dic::write_ground_truth_hdf5(staging / "ground_truth.h5", cam, a.req.view, truth);
   });
   staging.commit();  // the frames and their ground truth appear together or not at all
   std::cout << "rendered " << reader.frame_count() << " frames " << cam.cols << "x" << cam.rows
-            << " px (" << a.px_per_d50 << " px per d50) to " << a.out_dir << "\n";
+            << " px (" << a.req.px_per_d50 << " px per d50) to " << a.out_dir << "\n";
 }
 
 }  // namespace
@@ -149,18 +130,19 @@ void register_dic(CLI::App& app) {
   r->add_option("input", rargs->input, "trajectory RUN.h5")->required();
   r->add_option("-o,--output", rargs->out_dir, "output directory (frame_NNNN.png, ground_truth.h5)")
       ->required();
-  r->add_option("--view", rargs->view, "front, back, left, right, top or bottom")
+  r->add_option("--view", rargs->req.view, "front, back, left, right, top or bottom")
       ->capture_default_str();
-  r->add_option("--px-per-d50", rargs->px_per_d50, "pixels per median grain diameter")
+  r->add_option("--px-per-d50", rargs->req.px_per_d50, "pixels per median grain diameter")
       ->capture_default_str();
-  r->add_option("--margin", rargs->margin_d50, "margin around the grains, in d50")
+  r->add_option("--margin", rargs->req.margin_d50, "margin around the grains, in d50")
       ->capture_default_str();
-  r->add_option("--supersample", rargs->supersample, "s x s rays per pixel")->capture_default_str();
-  r->add_option("--noise", rargs->noise, "Gaussian noise sigma, fraction of full scale")
+  r->add_option("--supersample", rargs->req.supersample, "s x s rays per pixel")
       ->capture_default_str();
-  r->add_option("--bits", rargs->bits, "8 or 16")->capture_default_str();
+  r->add_option("--noise", rargs->req.noise, "Gaussian noise sigma, fraction of full scale")
+      ->capture_default_str();
+  r->add_option("--bits", rargs->req.bits, "8 or 16")->capture_default_str();
   r->add_option("--format", rargs->format, "png or tif")->capture_default_str();
-  r->add_option("--seed", rargs->seed, "grain textures and noise")->capture_default_str();
+  r->add_option("--seed", rargs->req.seed, "grain textures and noise")->capture_default_str();
   r->callback([rargs] { run_render(*rargs); });
 
   auto args = std::make_shared<DicArgs>();

@@ -6,14 +6,11 @@
 // VTP of tubes, each written under a temporary name and renamed.
 
 #include <CLI/CLI.hpp>
-#include <algorithm>
-#include <array>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
-#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -23,13 +20,11 @@
 #include "errors.hpp"
 #include "field_output.hpp"
 #include "frame_motion.hpp"
-#include "grain_size.hpp"
 #include "point_vectors_csv.hpp"
 #include "slab_options.hpp"
-#include "slab_projection.hpp"
-#include "snapshot.hpp"
 #include "vortex_analysis.hpp"
-#include "vortex_series.hpp"
+#include "vortex_count_series.hpp"
+#include "vortex_field.hpp"
 
 namespace gs::cli {
 namespace {
@@ -39,20 +34,8 @@ using analysis::VortexAnalysis;
 
 // ---- options shared by hhd and vortices -----------------------------------------------------
 
-struct FieldArgs {
-  SlabArgs slab;
-  bool slice = false;
-  bool ghosts = false;
-  double ghost_spacing = 0.0, ghost_min_distance = -1.0, ghost_extent = 0.0, ghost_radius = 0.0;
-  double d50 = 0.0;
-  std::string solver = "auto";
-  std::optional<double> tolerance;  // unset: the solver's default
-  int max_iterations = 10000;
-  std::vector<double> axis;
-  double delta = 0.05;
-  double significance = analysis::kSignificanceRelative;
-  double significance_abs = 0.0;
-};
+using FieldArgs = analysis::VortexFieldSpec;
+using Field = analysis::VortexField;
 
 void add_field_options(CLI::App* s, FieldArgs& a) {
   s->add_flag("--slice", a.slice,
@@ -87,124 +70,6 @@ void add_field_options(CLI::App* s, FieldArgs& a) {
                 "the strongest of the same potential (0.05; 0 counts every strict extremum)");
   s->add_option("--significance-abs", a.significance_abs,
                 "and >= this magnitude in the potential's units (vector units x m; 0)");
-}
-
-// One field to decompose: positions and vectors of the nodes (2D: in-plane coordinates).
-struct Field {
-  int dim = 3;
-  std::vector<Eigen::Vector3d> x, u;
-  std::vector<std::int64_t> id;
-  double d50 = 0.0;  // 0: unknown (CSV)
-  bool slab = false;
-  analysis::Slab plane;
-  Eigen::Vector3d e1 = Eigen::Vector3d::UnitX(), e2 = Eigen::Vector3d::UnitY();
-};
-
-Field field_from_motion(const FrameMotion& m, const FieldArgs& a, const std::string& source) {
-  Field f;
-  f.d50 = analysis::d50(m.frame);
-  f.slab = a.slice || a.slab.any();
-  for (const auto k : m.index) f.id.push_back(m.frame.particles[static_cast<std::size_t>(k)].id);
-  if (f.slab) {
-    if (m.frame.two_d) throw InputError(source, "--slice/--slab needs a 3D frame");
-    SlabArgs s = a.slab;
-    if (s.thickness <= 0.0 && s.d50_multiple <= 0.0) s.d50_multiple = 5.0;
-    f.plane = make_slab(s, m.frame);
-    if (s.origin.empty()) {  // mid-depth: the centre of the particles' box
-      const auto [lo, hi] = particle_bounds(m.frame);
-      f.plane.origin = 0.5 * (lo + hi);
-    }
-    analysis::SlabProjection p;
-    try {
-      p = analysis::project_slab(m.x, m.u, f.plane);
-    } catch (const std::invalid_argument& e) {
-      throw InputError(source, e.what());
-    }
-    f.dim = 2;
-    f.e1 = p.e1;
-    f.e2 = p.e2;
-    std::vector<std::int64_t> ids;
-    for (std::size_t i = 0; i < p.index.size(); ++i) {
-      f.x.emplace_back(p.position[i].x(), p.position[i].y(), 0.0);
-      f.u.emplace_back(p.vector[i].x(), p.vector[i].y(), 0.0);
-      ids.push_back(f.id[static_cast<std::size_t>(p.index[i])]);
-    }
-    f.id = ids;
-    return f;
-  }
-  f.dim = m.frame.two_d ? 2 : 3;
-  f.x = m.x;
-  f.u = m.u;
-  return f;
-}
-
-analysis::VortexAnalysisOptions analysis_options(const FieldArgs& a, const Field& f,
-                                                 const std::string& source) {
-  analysis::VortexAnalysisOptions o;
-  try {
-    o.hhd.solver = analysis::hhd_solver_from_name(a.solver);
-  } catch (const std::invalid_argument& e) {
-    throw InputError(source, "--solver: unknown solver", a.solver);
-  }
-  if (a.tolerance && !(*a.tolerance > 0.0 && *a.tolerance < 1.0)) {
-    throw InputError(source, "--tolerance must be in (0, 1)", value_str(*a.tolerance));
-  }
-  if (a.max_iterations < 1) {
-    throw InputError(source, "--max-iterations must be >= 1", std::to_string(a.max_iterations));
-  }
-  if (!(a.delta >= 0.0 && a.delta < 1.0)) {
-    throw InputError(source, "--delta must be in [0, 1)", value_str(a.delta));
-  }
-  if (!(a.significance >= 0.0 && a.significance <= 1.0)) {
-    throw InputError(source, "--significance must be in [0, 1]", value_str(a.significance));
-  }
-  if (!(a.significance_abs >= 0.0 && std::isfinite(a.significance_abs))) {
-    throw InputError(source, "--significance-abs must be >= 0", value_str(a.significance_abs));
-  }
-  o.significance_relative = a.significance;
-  o.significance_absolute = a.significance_abs;
-  o.hhd.tolerance = a.tolerance.value_or(0.0);
-  o.hhd.max_iterations = a.max_iterations;
-  o.tube_delta = a.delta;
-  if (a.axis.size() == 3) {
-    o.axis = Eigen::Vector3d(a.axis.data());
-    if (!(o.axis.norm() > 0.0) || !o.axis.allFinite()) {
-      throw InputError(source, "--axis must be a non-zero vector");
-    }
-  } else if (a.slab.normal.size() == 3) {
-    o.axis = Eigen::Vector3d(a.slab.normal.data());
-  }
-  o.ghosts = a.ghosts;
-  if (a.ghosts) {
-    const double d50 = a.d50 > 0.0 ? a.d50 : f.d50;
-    Eigen::Vector3d lo = f.x.empty() ? Eigen::Vector3d::Zero() : f.x[0], hi = lo;
-    for (const auto& p : f.x) {
-      lo = lo.cwiseMin(p);
-      hi = hi.cwiseMax(p);
-    }
-    double width = hi.x() - lo.x();
-    for (int d = 1; d < f.dim; ++d) width = std::min(width, hi[d] - lo[d]);
-    if (!(d50 > 0.0) && (a.ghost_spacing <= 0.0 || a.ghost_min_distance < 0.0)) {
-      throw InputError(source,
-                       "--ghosts: no radii in the input; give --d50, or --ghost-spacing and "
-                       "--ghost-min-distance");
-    }
-    o.ghost = analysis::paper_ghost_options(d50, width);
-    if (a.ghost_spacing > 0.0) o.ghost.spacing = a.ghost_spacing;
-    if (a.ghost_min_distance >= 0.0) o.ghost.min_distance = a.ghost_min_distance;
-    if (a.ghost_extent > 0.0) o.ghost.extent = a.ghost_extent;
-    if (a.ghost_radius > 0.0) o.ghost.radius = a.ghost_radius;
-  }
-  return o;
-}
-
-VortexAnalysis run_analysis(const Field& f, const analysis::VortexAnalysisOptions& o,
-                            const std::string& source) {
-  try {
-    return analysis::analyze_vortices(f.x, f.u, f.dim, o);
-  } catch (const std::invalid_argument& e) {
-    throw InputError(source, e.what());
-  }
 }
 
 // ---- hhd outputs ------------------------------------------------------------------------------
@@ -369,7 +234,7 @@ void run_hhd(const HhdArgs& a) {
   Field f;
   std::string motion = "csv";
   if (!a.csv.empty()) {
-    if (a.field.slice || a.field.slab.any()) {
+    if (a.field.projected()) {
       throw InputError(source, "--slice/--slab need a trajectory (give a 2D CSV instead)");
     }
     const auto p = read_point_vectors_csv(a.csv);
@@ -380,10 +245,10 @@ void run_hhd(const HhdArgs& a) {
   } else {
     const FrameMotion m = read_frame_motion(a.input, a.from, a.to);
     motion = m.kind;
-    f = field_from_motion(m, a.field, a.input);
+    f = analysis::vortex_field(m, a.field, a.input);
   }
-  const auto opts = analysis_options(a.field, f, source);
-  const VortexAnalysis r = run_analysis(f, opts, source);
+  const auto opts = analysis::vortex_analysis_options(a.field, f, source);
+  const VortexAnalysis r = analysis::analyze_field(f, opts, source);
   f.id.resize(r.mesh.points.size(), -1);  // ghosts: id -1
   const auto& vectors = r.vectors;
 
@@ -481,123 +346,57 @@ void run_hhd(const HhdArgs& a) {
 
 struct SeriesArgs {
   std::string input, output;
-  long every = 0, stride = 0, from = 0;
-  std::optional<long> last;
-  std::string strain_axis;
-  FieldArgs field;
+  analysis::VortexSeriesSpec spec;
 };
 
 void run_vortices(const SeriesArgs& a) {
   const auto n = static_cast<long>(frame_count(a.input));
-  if (a.every < 1) throw InputError(a.input, "--every must be >= 1", std::to_string(a.every));
-  const long stride = a.stride > 0 ? a.stride : a.every;
-  const long last = a.last.value_or(n - 1);
-  if (a.from < 0 || a.from >= n) {
-    throw InputError(a.input, "--from out of range 0.." + std::to_string(n - 1),
-                     std::to_string(a.from));
-  }
-  if (last < 0 || last >= n) {
-    throw InputError(a.input, "--last out of range 0.." + std::to_string(n - 1),
-                     std::to_string(last));
-  }
-  if (a.from + a.every > last) {
-    throw InputError(
-        a.input, "no frame pair: --from + --every beyond the last frame " + std::to_string(last),
-        std::to_string(a.from + a.every));
-  }
-  std::map<long, Frame> cache;  // frames still needed (reference and target of the increment)
-  const auto frame = [&](long i) -> const Frame& {
-    auto it = cache.find(i);
-    if (it == cache.end()) it = cache.emplace(i, read_frame(a.input, i)).first;
-    return it->second;
-  };
-  const Frame& first = frame(a.from);
-  const bool two_d = first.two_d;
-  int axis = two_d ? 1 : 2;
-  if (!a.strain_axis.empty()) {
-    if (a.strain_axis != "x" && a.strain_axis != "y" && a.strain_axis != "z") {
-      throw InputError(a.input, "--strain-axis must be x, y or z", a.strain_axis);
-    }
-    axis = a.strain_axis[0] - 'x';
-  }
-  const auto height = [&](const Frame& fr) {
-    const auto [lo, hi] = particle_bounds(fr);
-    return hi[axis] - lo[axis];
-  };
-  const double h0 = height(first);
-  if (!(h0 > 0.0)) throw InputError(a.input, "specimen has zero extent along the strain axis");
-  std::vector<std::int64_t> f0, f1;
-  std::vector<double> time, strain;
-  std::vector<std::int32_t> right, left, sources, sinks, tubes;
-  std::array<std::vector<std::int32_t>, 4> all_counts;  // every strict extremum
-  for (long k = a.from; k + a.every <= last; k += stride) {
-    cache.erase(cache.begin(), cache.lower_bound(k));
-    const Frame& ref = frame(k);
-    const double eps = (h0 - height(ref)) / h0;  // compression positive (seed 000: ε1 = u1/h)
-    const FrameMotion m = motion_between(ref, frame(k + a.every), a.input);
-    const Field f = field_from_motion(m, a.field, a.input);
-    const VortexAnalysis r = run_analysis(f, analysis_options(a.field, f, a.input), a.input);
-    const auto c = analysis::count_extrema(r.extrema, true);
-    const auto all = analysis::count_extrema(r.extrema, false);
-    for (std::size_t q = 0; q < 4; ++q) all_counts[q].push_back(static_cast<std::int32_t>(all[q]));
-    f0.push_back(k);
-    f1.push_back(k + a.every);
-    time.push_back(ref.time);
-    strain.push_back(eps);
-    right.push_back(static_cast<std::int32_t>(c[0]));
-    left.push_back(static_cast<std::int32_t>(c[1]));
-    sources.push_back(static_cast<std::int32_t>(c[2]));
-    sinks.push_back(static_cast<std::int32_t>(c[3]));
-    tubes.push_back(
-        static_cast<std::int32_t>(analysis::count_significant_tubes(r.tubes, r.extrema)));
-    std::printf("frames %ld-%ld strain %.5f: right %zu left %zu sources %zu sinks %zu (%.2f s)\n",
-                k, k + a.every, eps, c[0], c[1], c[2], c[3],
-                r.seconds_delaunay + r.hhd.report.seconds_assembly + r.hhd.report.seconds_factor +
-                    r.hhd.report.seconds_solve + r.seconds_detection + r.seconds_ghosts);
-  }
+  const analysis::VortexCountSeries s = analysis::vortex_count_series(
+      a.input, n, [&](long i) { return read_frame(a.input, i); }, a.spec,
+      [](const analysis::VortexSeriesStep& p) {
+        std::printf(
+            "frames %ld-%ld strain %.5f: right %zu left %zu sources %zu sinks %zu (%.2f s)\n",
+            p.from, p.to, p.strain, p.counts[0], p.counts[1], p.counts[2], p.counts[3], p.seconds);
+      });
+  const FieldArgs& field = a.spec.field;
   H5FieldFile h(a.output, "granoscope-vortices");
   h.attr("source", a.input);
-  h.attr("dim", static_cast<long long>(two_d || a.field.slice || a.field.slab.any() ? 2 : 3));
-  h.attr("every", static_cast<long long>(a.every));
-  h.attr("stride", static_cast<long long>(stride));
-  h.attr("strain_axis", std::string(1, static_cast<char>('x' + axis)));
-  h.attr("solver", a.field.solver);
-  h.attr("delta", a.field.delta);
-  h.attr("ghosts", static_cast<long long>(a.field.ghosts ? 1 : 0));
+  h.attr("dim", static_cast<long long>(s.dim));
+  h.attr("every", static_cast<long long>(a.spec.every));
+  h.attr("stride", static_cast<long long>(s.stride));
+  h.attr("strain_axis", std::string(1, s.strain_axis));
+  h.attr("solver", field.solver);
+  h.attr("delta", field.delta);
+  h.attr("ghosts", static_cast<long long>(field.ghosts ? 1 : 0));
   h.group("/series");
-  h.write("/series/frame_from", f0);
-  h.write("/series/frame_to", f1);
-  h.write("/series/time", time);
-  h.write("/series/strain", strain);
-  h.write("/series/right", right);
-  h.write("/series/left", left);
-  h.write("/series/sources", sources);
-  h.write("/series/sinks", sinks);
-  h.write("/series/tubes", tubes);
-  h.write("/series/right_all", all_counts[0]);
-  h.write("/series/left_all", all_counts[1]);
-  h.write("/series/sources_all", all_counts[2]);
-  h.write("/series/sinks_all", all_counts[3]);
-  h.attr("significance_relative", a.field.significance);
-  h.attr("significance_absolute", a.field.significance_abs);
-  // Fourier spectrum of the counts against strain (Figs 17–18), when strain increases strictly.
-  const bool increasing =
-      strain.size() >= 4 && std::adjacent_find(strain.begin(), strain.end(),
-                                               std::greater_equal<double>()) == strain.end();
-  if (increasing) {
+  h.write("/series/frame_from", s.frame_from);
+  h.write("/series/frame_to", s.frame_to);
+  h.write("/series/time", s.time);
+  h.write("/series/strain", s.strain);
+  h.write("/series/right", s.right);
+  h.write("/series/left", s.left);
+  h.write("/series/sources", s.sources);
+  h.write("/series/sinks", s.sinks);
+  h.write("/series/tubes", s.tubes);
+  h.write("/series/right_all", s.all[0]);
+  h.write("/series/left_all", s.all[1]);
+  h.write("/series/sources_all", s.all[2]);
+  h.write("/series/sinks_all", s.all[3]);
+  h.attr("significance_relative", field.significance);
+  h.attr("significance_absolute", field.significance_abs);
+  if (s.right_spectrum && s.left_spectrum) {
     h.group("/spectrum");
-    for (const auto& [name, counts] :
-         {std::pair<const char*, const std::vector<std::int32_t>*>{"right", &right},
-          {"left", &left}}) {
-      const auto s =
-          analysis::amplitude_spectrum(strain, std::vector<double>(counts->begin(), counts->end()));
+    for (const auto& [name, sp] :
+         {std::pair<const char*, const analysis::AmplitudeSpectrum*>{"right", &*s.right_spectrum},
+          {"left", &*s.left_spectrum}}) {
       const std::string g = std::string("/spectrum/") + name;
       h.group(g);
-      h.write(g + "/frequency", s.frequency);
-      h.write(g + "/period", s.period);
-      h.write(g + "/amplitude", s.amplitude);
-      h.attr("dominant_period", s.dominant_period, g);
-      std::printf("%s-handed vortices: dominant period %.4g of strain\n", name, s.dominant_period);
+      h.write(g + "/frequency", sp->frequency);
+      h.write(g + "/period", sp->period);
+      h.write(g + "/amplitude", sp->amplitude);
+      h.attr("dominant_period", sp->dominant_period, g);
+      std::printf("%s-handed vortices: dominant period %.4g of strain\n", name,
+                  sp->dominant_period);
     }
   } else {
     std::printf("no spectrum: fewer than 4 pairs or strain not increasing along the series\n");
@@ -639,15 +438,15 @@ void register_analyze_hhd(CLI::App& app) {
         "Figs 16-18)");
     s->add_option("input", a->input, "RUN.h5 trajectory")->required();
     s->add_option("-o,--output", a->output, "output HDF5 (format granoscope-vortices)")->required();
-    s->add_option("--every", a->every, "IT: frames between the two frames of an increment")
+    s->add_option("--every", a->spec.every, "IT: frames between the two frames of an increment")
         ->required();
-    s->add_option("--stride", a->stride, "frames between successive increments (default IT)");
-    s->add_option("--from", a->from, "first reference frame (default 0)");
-    s->add_option("--last", a->last, "last frame used (default: the last)");
-    s->add_option("--strain-axis", a->strain_axis,
+    s->add_option("--stride", a->spec.stride, "frames between successive increments (default IT)");
+    s->add_option("--from", a->spec.from, "first reference frame (default 0)");
+    s->add_option("--last", a->spec.last, "last frame used (default: the last)");
+    s->add_option("--strain-axis", a->spec.strain_axis,
                   "x|y|z: strain = relative shortening of the particles' extent along it "
                   "(default z, y for 2D frames)");
-    add_field_options(s, a->field);
+    add_field_options(s, a->spec.field);
     s->callback([a] { run_vortices(*a); });
   }
 }

@@ -14,9 +14,8 @@
 #include "commands.hpp"
 #include "errors.hpp"
 #include "field_output.hpp"
-#include "grain_size.hpp"
 #include "silo_report.hpp"
-#include "silo_theory.hpp"
+#include "silo_series.hpp"
 #include "trajectory_io.hpp"
 
 namespace gs::cli {
@@ -27,152 +26,19 @@ namespace ga = gs::analysis;
 struct SiloArgs {
   std::string input, output, csv, profiles_csv;
   std::vector<double> up{0.0, 0.0, 1.0}, across{1.0, 0.0, 0.0};
-  std::optional<double> bin, bin_d50, depth, d50, zone_height;
-  double zone_bin_d50 = 1.0, zone_band_d50 = 5.0;
-  long from = 0;
-  std::optional<double> from_time;
-  double gravity = 9.81;
-  std::vector<double> layers{0.2, 0.5, 0.8};
-  double layer_bin_d50 = 2.0, layer_band_d50 = 5.0;
-  int rose_bins = 36;
-  double phi_i = 35.0, en_k = 0.63;
-  double rev_width_d50 = 2.0;
-  int flow_bands = 10;
-  double flow_wall_d50 = 3.0, flow_threshold = 0.1;
+  ga::SiloSpec spec;
 };
 
-/// Janssen's P/G (seed 004 Eq 5.1) for a fill of height h in a plane silo of width b with
-/// friction on its side walls: P/G = (z0/h)·(1 − exp(−h/z0)), z0 = R/(K·μ), R = b/2 (the
-/// weight γ·b·h·depth cancels).
-double janssen_p_over_g(double K, double mu, double width, double height) {
-  const double R = 0.5 * width;
-  return ga::janssen_vertical_stress(1.0, K, mu, R, height) / height;
-}
-
-Eigen::Vector3d vec(const std::vector<double>& v) {
-  return {v[0], v[1], v[2]};
-}
-
 void run_silo(const SiloArgs& a) {
-  const Trajectory t = read_snapshots(a.input);
-  if (t.frames.empty()) throw InputError(a.input, "no frames");
-  const long n = static_cast<long>(t.frames.size());
-  if (a.from < 0 || a.from >= n)
-    throw InputError(a.input, "--from: no such frame (" + std::to_string(n) + " frames)",
-                     std::to_string(a.from));
-  long from = a.from;
-  if (a.from_time) {  // the first frame at or after that time
-    from = 0;
-    while (from < n && t.frames[static_cast<std::size_t>(from)].time < *a.from_time - 1e-12) ++from;
-    if (from == n || !std::isfinite(*a.from_time))
-      throw InputError(a.input, "--from-time: after the last frame", value_str(*a.from_time));
-  }
-  const Frame& last = t.frames.back();
-  if (last.particles.empty()) throw InputError(a.input, "the last frame has no particles");
-  if (a.d50) require_positive(a.input, "--d50", *a.d50);
-  const double d50 = a.d50 ? *a.d50 : ga::d50(last);
-  ga::SiloReportOptions o;
-  o.up = vec(a.up);
-  o.across = vec(a.across);
-  o.bin = length_option(a.input, "--bin", a.bin, a.bin_d50, 5.0, d50);
-  if (a.depth) require_positive(a.input, "--depth", *a.depth);
-  o.depth = a.depth.value_or(0.0);
-  require_positive(a.input, "--gravity", a.gravity);
-  o.gravity = a.gravity;
-  require_positive(a.input, "--zone-bin-d50", a.zone_bin_d50);
-  require_positive(a.input, "--zone-band-d50", a.zone_band_d50);
-  o.zone_bin = a.zone_bin_d50 * d50;
-  o.zone_band = a.zone_band_d50 * d50;
-  if (a.zone_height) require_positive(a.input, "--zone-height", *a.zone_height);
-  o.zone_height = a.zone_height.value_or(0.0);
-  for (const double f : a.layers)
-    if (!(f > 0 && f < 1))
-      throw InputError(a.input, "--layers: a fraction not in (0, 1)", value_str(f));
-  o.layer_fractions = a.layers;
-  require_positive(a.input, "--layer-bin-d50", a.layer_bin_d50);
-  require_positive(a.input, "--layer-band-d50", a.layer_band_d50);
-  o.layer_bin = a.layer_bin_d50 * d50;
-  o.layer_band = a.layer_band_d50 * d50;
-  if (a.rose_bins < 4 || a.rose_bins > 3600)
-    throw InputError(a.input, "--rose-bins: not in [4, 3600]", std::to_string(a.rose_bins));
-  o.fabric_bins = a.rose_bins;
-  if (!(a.phi_i > 0 && a.phi_i < 90))
-    throw InputError(a.input, "--phi-i: not in (0, 90) deg", value_str(a.phi_i));
-  require_positive(a.input, "--en-k", a.en_k);
-  if (!(a.rev_width_d50 >= 0) || !std::isfinite(a.rev_width_d50))
-    throw InputError(a.input, "--rev-width-d50: negative", value_str(a.rev_width_d50));
-  o.rev_width = a.rev_width_d50 * d50;
-  if (a.flow_bands < 0 || a.flow_bands > 10000)
-    throw InputError(a.input, "--flow-bands: not in [0, 10000]", std::to_string(a.flow_bands));
-  o.flow_bands = a.flow_bands;
-  require_positive(a.input, "--flow-wall-d50", a.flow_wall_d50);
-  o.flow_wall_width = a.flow_wall_d50 * d50;
-  if (!(a.flow_threshold > 0 && a.flow_threshold < 1))
-    throw InputError(a.input, "--flow-threshold: not in (0, 1)", value_str(a.flow_threshold));
-  o.flow_threshold = a.flow_threshold;
-  std::vector<ga::SiloFrameReport> reports;
-  for (long i = from; i < n; ++i) {
-    try {
-      reports.push_back(ga::silo_report(t.frames[static_cast<std::size_t>(i)], o,
-                                        &t.frames[static_cast<std::size_t>(from)]));
-    } catch (const std::invalid_argument& e) {
-      throw InputError(a.input, "frame " + std::to_string(i) + ": " + e.what());
-    }
-  }
-  // The states of seed 004 §5.3.1: initial (the first frame reported), maximum (the largest
-  // N_left + N_right), residual (the last).
-  std::size_t k_max = 0;
-  for (std::size_t k = 0; k < reports.size(); ++k)
-    if (reports[k].N_left + reports[k].N_right > reports[k_max].N_left + reports[k_max].N_right)
-      k_max = k;
-  const std::vector<std::pair<const char*, std::size_t>> states = {
-      {"initial", 0}, {"maximum", k_max}, {"residual", reports.size() - 1}};
-  std::vector<std::pair<const char*, std::vector<double>>> series = {{"frame", {}},
-                                                                     {"time_s", {}},
-                                                                     {"G_N", {}},
-                                                                     {"P_N", {}},
-                                                                     {"T_left_N", {}},
-                                                                     {"T_right_N", {}},
-                                                                     {"N_left_N", {}},
-                                                                     {"N_right_N", {}},
-                                                                     {"P_G", {}},
-                                                                     {"T_left_G", {}},
-                                                                     {"T_right_G", {}},
-                                                                     {"N_left_G", {}},
-                                                                     {"N_right_G", {}},
-                                                                     {"balance_G", {}},
-                                                                     {"phi_w_left_deg", {}},
-                                                                     {"phi_w_right_deg", {}},
-                                                                     {"discharged_kg", {}},
-                                                                     {"flow_pattern", {}},
-                                                                     {"transition_left_m", {}},
-                                                                     {"transition_right_m", {}},
-                                                                     {"flow_speed_m_s", {}}};
-  for (std::size_t k = 0; k < reports.size(); ++k) {
-    const auto& r = reports[k];
-    const double v[] = {static_cast<double>(from) + static_cast<double>(k),
-                        r.time,
-                        r.G,
-                        r.P,
-                        r.T_left,
-                        r.T_right,
-                        r.N_left,
-                        r.N_right,
-                        r.P / r.G,
-                        r.T_left / r.G,
-                        r.T_right / r.G,
-                        r.N_left / r.G,
-                        r.N_right / r.G,
-                        r.balance,
-                        r.phi_left_deg,
-                        r.phi_right_deg,
-                        (reports.front().G - r.G) / a.gravity,
-                        static_cast<double>(static_cast<int>(r.flow)),
-                        r.transition_left,
-                        r.transition_right,
-                        r.flow_speed};
-    for (std::size_t c = 0; c < series.size(); ++c) series[c].second.push_back(v[c]);
-  }
+  ga::SiloSpec spec = a.spec;
+  spec.up = Eigen::Vector3d(a.up[0], a.up[1], a.up[2]);
+  spec.across = Eigen::Vector3d(a.across[0], a.across[1], a.across[2]);
+  const ga::SiloSeries run = ga::silo_series(a.input, read_snapshots(a.input).frames, spec);
+  const auto& reports = run.reports;
+  const auto& series = run.series;
+  const double d50 = run.d50;
+  const long from = run.from;
+  const ga::SiloReportOptions& o = run.options;
   H5FieldFile h(a.output, "granoscope-silo");
   h.attr("source", a.input);
   h.attr("d50", d50);
@@ -181,8 +47,10 @@ void run_silo(const SiloArgs& a) {
   for (const auto& [name, v] : series) h.write(std::string("/series/") + name, v);
   h.group("/profiles");
   std::vector<double> st, ph, s11l, s21l, s11r, s21r, l11l, l21l, l11r, l21r;
-  for (std::size_t i = 0; i < states.size(); ++i) {
-    const auto& [name, k] = states[i];
+  for (std::size_t i = 0; i < run.states.size(); ++i) {
+    const ga::SiloState& state = run.states[i];
+    const char* name = state.name;
+    const std::size_t k = state.index;
     const auto& r = reports[k];
     const std::string g = std::string("/profiles/") + name;
     h.group(g);
@@ -224,16 +92,8 @@ void run_silo(const SiloArgs& a) {
     h.attr("fabric_left_contacts", static_cast<long long>(r.fabric_contacts), g);
     // The slice method beside ours (Eq 5.1 with R = b/2; K from Eq 5.2 with this state's
     // mean wall friction angle, and EN 1991-4's K).
-    const double phi_w = 0.5 * (r.phi_left_deg + r.phi_right_deg);
-    const double mu = std::tan(phi_w * M_PI / 180.0);
-    double k_dr = NAN, p_dr = NAN, p_en = NAN;
-    if (mu > 0 && r.width > 0 && r.fill_height > 0) {
-      if (phi_w <= a.phi_i) {
-        k_dr = ga::drescher_lateral_ratio(a.phi_i, phi_w);
-        p_dr = janssen_p_over_g(k_dr, mu, r.width, r.fill_height);
-      }
-      p_en = janssen_p_over_g(a.en_k, mu, r.width, r.fill_height);
-    }
+    const double phi_w = state.phi_w_mean_deg;
+    const double k_dr = state.K_drescher, p_dr = state.P_G_drescher, p_en = state.P_G_en1991;
     h.attr("phi_w_mean_deg", phi_w, g);
     h.attr("K_drescher", k_dr, g);
     h.attr("P_G_drescher", p_dr, g);
@@ -264,10 +124,10 @@ void run_silo(const SiloArgs& a) {
     if (std::isnan(k_dr) && !(phi_w > 0))
       std::printf("n/a (no wall friction mobilised)");
     else if (std::isnan(k_dr))
-      std::printf("Drescher n/a (phi_w > phi_i = %g deg)", a.phi_i);
+      std::printf("Drescher n/a (phi_w > phi_i = %g deg)", a.spec.phi_i);
     else
-      std::printf("Drescher %.3f (K %.3f, Eq 5.2, phi_i %g deg)", p_dr, k_dr, a.phi_i);
-    if (phi_w > 0) std::printf(", EN 1991-4 %.3f (K %g)", p_en, a.en_k);
+      std::printf("Drescher %.3f (K %.3f, Eq 5.2, phi_i %g deg)", p_dr, k_dr, a.spec.phi_i);
+    if (phi_w > 0) std::printf(", EN 1991-4 %.3f (K %g)", p_en, a.spec.en_k);
     std::printf("; ours %.3f\n", r.P / r.G);
     for (const auto& L : r.layers) {
       double e_wall = 0, e_mid = 0;
@@ -338,43 +198,44 @@ void register_analyze_silo(CLI::App& app) {
   s->add_option("--csv", a->csv, "also write the series as CSV");
   s->add_option("--profiles-csv", a->profiles_csv,
                 "also write the profiles as CSV (state 0 initial, 1 maximum, 2 residual)");
-  s->add_option("--from", a->from, "first frame (the initial state; default 0)");
-  s->add_option("--from-time", a->from_time,
+  s->add_option("--from", a->spec.from, "first frame (the initial state; default 0)");
+  s->add_option("--from-time", a->spec.from_time,
                 "first frame at or after this time in s (a silo run: curve.csv's first time_s, "
                 "the end of the filling)");
   s->add_option("--up", a->up, "vertical direction x y z (default 0 0 1)")->expected(3);
   s->add_option("--across", a->across, "from the left wall to the right (default 1 0 0)")
       ->expected(3);
-  s->add_option("--bin", a->bin, "profile bin along the height in m");
-  s->add_option("--bin-d50", a->bin_d50, "profile bin in d50 (default 5)");
-  s->add_option("--depth", a->depth, "silo depth in m (default: extent of the particles)");
-  s->add_option("--d50", a->d50, "d50 in m (default: from the last frame)");
-  s->add_option("--gravity", a->gravity, "m/s^2 for the weight G (default 9.81)");
-  s->add_option("--zone-height", a->zone_height,
+  s->add_option("--bin", a->spec.bin, "profile bin along the height in m");
+  s->add_option("--bin-d50", a->spec.bin_d50, "profile bin in d50 (default 5)");
+  s->add_option("--depth", a->spec.depth, "silo depth in m (default: extent of the particles)");
+  s->add_option("--d50", a->spec.d50, "d50 in m (default: from the last frame)");
+  s->add_option("--gravity", a->spec.gravity, "m/s^2 for the weight G (default 9.81)");
+  s->add_option("--zone-height", a->spec.zone_height,
                 "height of the wall shear zones above the bottom in m (default: half the fill)");
-  s->add_option("--zone-band-d50", a->zone_band_d50,
+  s->add_option("--zone-band-d50", a->spec.zone_band_d50,
                 "thickness of the band the rotation profile is taken in, d50 (default 5)");
-  s->add_option("--zone-bin-d50", a->zone_bin_d50, "bins across the silo, d50 (default 1)");
-  s->add_option("--layers", a->layers,
+  s->add_option("--zone-bin-d50", a->spec.zone_bin_d50, "bins across the silo, d50 (default 1)");
+  s->add_option("--layers", a->spec.layers,
                 "heights of the void-ratio layers as fractions of the fill (default 0.2 0.5 0.8: "
                 "10, 25 and 40 cm of the seed's 0.5 m)");
-  s->add_option("--layer-bin-d50", a->layer_bin_d50, "void-ratio boxes across, d50 (default 2)");
-  s->add_option("--layer-band-d50", a->layer_band_d50,
+  s->add_option("--layer-bin-d50", a->spec.layer_bin_d50,
+                "void-ratio boxes across, d50 (default 2)");
+  s->add_option("--layer-band-d50", a->spec.layer_band_d50,
                 "thickness of the void-ratio layers, d50 (default 5)");
-  s->add_option("--rose-bins", a->rose_bins,
+  s->add_option("--rose-bins", a->spec.rose_bins,
                 "bins of the left half's contact rose over 360 deg (default 36)");
-  s->add_option("--rev-width-d50", a->rev_width_d50,
+  s->add_option("--rev-width-d50", a->spec.rev_width_d50,
                 "width of the near-wall Love-Weber cells, d50 (default 2; 0: none)");
-  s->add_option("--flow-bands", a->flow_bands,
+  s->add_option("--flow-bands", a->spec.flow_bands,
                 "bands of the fill for the flow pattern (default 10; 0: none)");
-  s->add_option("--flow-wall-d50", a->flow_wall_d50,
+  s->add_option("--flow-wall-d50", a->spec.flow_wall_d50,
                 "width of the columns at the walls for the flow pattern, d50 (default 3)");
-  s->add_option("--flow-threshold", a->flow_threshold,
+  s->add_option("--flow-threshold", a->spec.flow_threshold,
                 "a wall moves when its column goes down faster than this fraction of the "
                 "fastest column (default 0.1)");
-  s->add_option("--phi-i", a->phi_i,
+  s->add_option("--phi-i", a->spec.phi_i,
                 "internal friction angle for Eq 5.2, deg (default 35, seed 004 §5.3.1)");
-  s->add_option("--en-k", a->en_k,
+  s->add_option("--en-k", a->spec.en_k,
                 "EN 1991-4 lateral pressure ratio (default 0.63 = 0.45 x 1.4, seed 004 §5.3.1)");
   s->callback([a] { run_silo(*a); });
 }

@@ -97,21 +97,29 @@ FrameMotion checked(FrameMotion m, const std::string& path) {
 
 }  // namespace
 
+FrameMotion frame_motion(const Frame& from, const Frame* to, const std::string& source) {
+  if (to) return checked(motion_between(from, *to, source), source);
+  FrameMotion m;
+  m.kind = "velocity";
+  for (std::size_t i = 0; i < from.particles.size(); ++i) {
+    m.index.push_back(static_cast<std::int32_t>(i));
+    m.x.push_back(from.particles[i].position);
+    m.u.push_back(from.particles[i].velocity);
+  }
+  m.frame = from;
+  return checked(std::move(m), source);
+}
+
 FrameMotion read_frame_motion(const std::string& path, long from, std::optional<long> to) {
   const std::size_t n = frame_count(path);
   check_index(path, from, n, "reference frame");
   if (to) check_index(path, *to, n, "target frame");
-  Frame ref = read_frame(path, from);
-  if (to) return checked(motion_between(ref, read_frame(path, *to), path), path);
-  FrameMotion m;
-  m.kind = "velocity";
-  for (std::size_t i = 0; i < ref.particles.size(); ++i) {
-    m.index.push_back(static_cast<std::int32_t>(i));
-    m.x.push_back(ref.particles[i].position);
-    m.u.push_back(ref.particles[i].velocity);
+  const Frame ref = read_frame(path, from);
+  if (to) {
+    const Frame target = read_frame(path, *to);
+    return frame_motion(ref, &target, path);
   }
-  m.frame = std::move(ref);
-  return checked(std::move(m), path);
+  return frame_motion(ref, nullptr, path);
 }
 
 }  // namespace gs

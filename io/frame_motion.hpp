@@ -29,6 +29,9 @@ std::size_t frame_count(const std::string& path);
 /// of every particle present in both (matched by id; periodic cells take the minimum image
 /// with respect to the target frame's cell, the one wrapped positions were wrapped into).
 FrameMotion motion_between(const Frame& from, const Frame& to, const std::string& source);
+/// The motion of frame `from`: the velocities of its particles, or with `to` the displacement
+/// to it (motion_between); positions and motions checked for lengths the geometry can handle.
+FrameMotion frame_motion(const Frame& from, const Frame* to, const std::string& source);
 FrameMotion read_frame_motion(const std::string& path, long from, std::optional<long> to);
 
 }  // namespace gs

@@ -16,11 +16,16 @@ See docs/python.md.
 import os as _os
 
 from . import _granoscope as _c
-from ._granoscope import (Error, Frame, Trajectory, chains, d50, dic, fabric, invariants,
-                          rose, stress_invariants, walls)
+from ._granoscope import (Error, Frame, Trajectory, chains, d50, dic, fabric, hhd, invariants,
+                          render, rev, rose, shearzone, strain, stress_invariants, voidcells,
+                          vortices, walls)
 
-__all__ = ["Error", "FileNotFound", "Frame", "Trajectory", "open", "save", "chains", "d50",
-           "dic", "fabric", "invariants", "rose", "stress_invariants", "walls", "__version__"]
+__all__ = ["Error", "FileNotFound", "Frame", "Run", "Scene", "Trajectory", "open", "save",
+           "chains", "d50", "dic", "fabric", "hhd", "invariants", "render", "rev", "rose",
+           "shearzone", "strain", "stress_invariants", "voidcells", "vortices", "walls",
+           "__version__"]
+
+from .simulation import Run, Scene  # noqa: E402 (needs the compiled module)
 
 __version__ = _c.code_version().split()[-1]
 

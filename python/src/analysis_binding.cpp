@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "bindings.hpp"
+#include "common.hpp"
 #include "errors.hpp"
 #include "fabric.hpp"
 #include "fabric_report.hpp"
@@ -30,33 +31,14 @@ namespace ga = gs::analysis;
 namespace gs::py_bind {
 namespace {
 
-using OptVec = std::optional<std::vector<double>>;
-constexpr const char* kFrame = "<frame>";  // how messages name a frame given from Python
-
-// d50 as the CLI's --d50 option gives it, else the frame's.
-double frame_d50(const Frame& f, std::optional<double> d50) {
-  if (d50) {
-    ga::require_positive(kFrame, "--d50", *d50);
-    return *d50;
-  }
-  if (f.particles.empty()) throw InputError(kFrame, "the frame has no particles");
-  return ga::d50(f);
-}
-
 // The selection the CLI's --slab* / --region / --d50 options would make on this frame.
 ga::Selection selection_of(const Frame& f, bool slab, const OptVec& slab_origin,
                            const OptVec& slab_normal, const OptVec& slab_axis,
                            std::optional<double> slab_thickness, std::optional<double> slab_d50,
                            const OptVec& region, std::optional<double> d50) {
-  ga::SelectionSpec spec;
-  spec.slab = slab;
-  spec.slab_origin = slab_origin.value_or(std::vector<double>{});
-  spec.slab_normal = slab_normal.value_or(std::vector<double>{});
-  spec.slab_axis = slab_axis.value_or(std::vector<double>{});
-  spec.slab_thickness = slab_thickness;
-  spec.slab_d50 = slab_d50;
-  spec.region = region.value_or(std::vector<double>{});
-  return ga::make_selection(kFrame, f, frame_d50(f, d50), spec);
+  return ga::make_selection(
+      kFrame, f, frame_d50(f, d50),
+      selection_spec(slab, slab_origin, slab_normal, slab_axis, slab_thickness, slab_d50, region));
 }
 
 }  // namespace

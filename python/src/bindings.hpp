@@ -11,6 +11,12 @@ void bind_errors(pybind11::module_& m);
 void bind_data(pybind11::module_& m);
 /// Analyses of frames.
 void bind_analysis(pybind11::module_& m);
+/// REV maps and shear zones.
+void bind_maps(pybind11::module_& m);
+/// Strain, void cells, HHD and vortex series of a frame's motion.
+void bind_motion(pybind11::module_& m);
+/// Scenes: load with values set over the file, run with progress, stop and resume.
+void bind_simulation(pybind11::module_& m);
 /// Subset DIC of images.
 void bind_dic(pybind11::module_& m);
 

@@ -14,6 +14,8 @@
 #include "dic_run.hpp"
 #include "errors.hpp"
 #include "image_io.hpp"
+#include "render_run.hpp"
+#include "snapshot.hpp"
 
 namespace py = pybind11;
 
@@ -45,6 +47,17 @@ cv::Mat to_image(py::handle obj, const std::string& name, std::vector<py::object
   keep.push_back(a);
   return cv::Mat(static_cast<int>(a.shape(0)), static_cast<int>(a.shape(1)), type,
                  const_cast<void*>(a.data()));
+}
+
+// Matrices of one type and size as a (frames, rows, cols) array of T.
+template <class T>
+py::array_t<T> stack(const std::vector<cv::Mat>& m, int rows, int cols) {
+  py::array_t<T> out({static_cast<py::ssize_t>(m.size()), static_cast<py::ssize_t>(rows),
+                      static_cast<py::ssize_t>(cols)});
+  T* p = out.mutable_data();
+  for (const auto& a : m)
+    for (int r = 0; r < rows; ++r) p = std::copy(a.ptr<T>(r), a.ptr<T>(r) + cols, p);
+  return out;
 }
 
 // One per-POI field of every frame as a (frames, ny, nx) array.
@@ -135,6 +148,66 @@ void bind_dic(py::module_& m) {
       "float32, float64), as `granoscope dic`: returns x (nx,), y (ny,) POI coordinates (px) and "
       "u, v (px, reference grid, NaN where invalid), zncc, valid, exx, eyy, exy (Green-Lagrange), "
       "exx_small, eyy_small, exy_small of shape (frames, ny, nx), and vsg_px.");
+
+  m.def(
+      "render",
+      [](py::object frames, const std::string& view, double px_per_d50, double margin_d50,
+         int supersample, double noise, int bits, std::uint64_t seed) {
+        dic::RenderRequest req;
+        req.view = view;
+        req.px_per_d50 = px_per_d50;
+        req.margin_d50 = margin_d50;
+        req.supersample = supersample;
+        req.noise = noise;
+        req.bits = bits;
+        req.seed = seed;
+        dic::check_render_request(req);
+        const auto n = static_cast<long>(py::len(frames));
+        if (n == 0) throw InputError("<trajectory>", "trajectory has no frames");
+        const Frame ref = frames[py::int_(0)].cast<Frame>();
+        const dic::Camera cam = dic::render_camera(ref, req, "<trajectory>");
+        std::vector<cv::Mat> images, u, v, visible, grain;
+        for (long k = 0; k < n; ++k) {
+          const Frame f = k == 0 ? ref : frames[py::int_(k)].cast<Frame>();
+          dic::RenderedFrame r;
+          {
+            py::gil_scoped_release unlocked;
+            r = dic::render_one(ref, f, cam, req);
+          }
+          if (PyErr_CheckSignals() != 0) throw py::error_already_set();
+          images.push_back(r.image);
+          u.push_back(r.truth.u);
+          v.push_back(r.truth.v);
+          visible.push_back(r.truth.visible);
+          grain.push_back(r.truth.grain);
+        }
+        py::dict out;
+        out["images"] = bits == 8 ? py::object(stack<std::uint8_t>(images, cam.rows, cam.cols))
+                                  : py::object(stack<std::uint16_t>(images, cam.rows, cam.cols));
+        out["u"] = stack<double>(u, cam.rows, cam.cols);
+        out["v"] = stack<double>(v, cam.rows, cam.cols);
+        out["visible"] = stack<std::uint8_t>(visible, cam.rows, cam.cols);
+        out["grain"] = stack<std::int32_t>(grain, cam.rows, cam.cols);
+        py::dict c;
+        c["right"] = std::vector<double>{cam.right.x(), cam.right.y(), cam.right.z()};
+        c["up"] = std::vector<double>{cam.up.x(), cam.up.y(), cam.up.z()};
+        c["dir"] = std::vector<double>{cam.dir.x(), cam.dir.y(), cam.dir.z()};
+        c["px_per_m"] = cam.px_per_m;
+        c["a0"] = cam.a0;
+        c["b0"] = cam.b0;
+        c["rows"] = cam.rows;
+        c["cols"] = cam.cols;
+        out["camera"] = c;
+        return out;
+      },
+      py::arg("frames"), py::kw_only(), py::arg("view") = "front", py::arg("px_per_d50") = 25.0,
+      py::arg("margin_d50") = 0.5, py::arg("supersample") = 3, py::arg("noise") = 0.0,
+      py::arg("bits") = 8, py::arg("seed") = 1,
+      "Speckle images of DEM frames as `granoscope render` (a Trajectory or a list of Frames; "
+      "the first is the reference the camera frames): images (frames, rows, cols) uint8 or "
+      "uint16, and the exact ground truth from the reference to each frame: u, v (px, NaN where "
+      "no grain), visible, grain (reference particle index, -1 background); camera (right, up, "
+      "dir, px_per_m, a0, b0 in m: pixel (col, row) shows right.x = a0 + col / px_per_m).");
 }
 
 }  // namespace gs::py_bind

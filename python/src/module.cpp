@@ -14,5 +14,8 @@ PYBIND11_MODULE(_granoscope, m) {
   gs::py_bind::bind_errors(m);
   gs::py_bind::bind_data(m);
   gs::py_bind::bind_analysis(m);
+  gs::py_bind::bind_maps(m);
+  gs::py_bind::bind_motion(m);
+  gs::py_bind::bind_simulation(m);
   gs::py_bind::bind_dic(m);
 }

@@ -906,7 +906,52 @@ bool scene_has_sweep(const std::filesystem::path& path) {
   }
 }
 
-Scene load_scene(const std::filesystem::path& path, int sweep_point) {
+namespace {
+
+/// Sets `key` (SECTION.KEY, SECTION.INDEX.KEY for arrays of tables) of `root` to the TOML value
+/// `value`; missing sections are created.
+template <class Reader>
+void apply_override(const Reader& r, toml::table& root, const std::string& key,
+                    const std::string& value) {
+  toml::table parsed;
+  try {
+    parsed = toml::parse("v = " + value);
+  } catch (const toml::parse_error&) {
+    r.fail(key, "not a TOML value", value);
+  }
+  if (parsed.size() != 1) r.fail(key, "not a TOML value", value);
+  std::vector<std::string> parts;
+  {
+    std::string part;
+    std::istringstream in(key);
+    while (std::getline(in, part, '.')) parts.push_back(part);
+  }
+  if (parts.size() < 2 || parts[0] == "sweep") r.fail(key, "expected SECTION.KEY to set", key);
+  toml::node* node = &root;
+  for (std::size_t i = 0; i + 1 < parts.size(); ++i) {
+    if (auto* t = node->as_table()) {
+      if (!t->contains(parts[i])) t->insert(parts[i], toml::table{});
+      node = t->get(parts[i]);
+    } else if (auto* a = node->as_array()) {
+      char* end = nullptr;
+      const long k = std::strtol(parts[i].c_str(), &end, 10);
+      if (end == parts[i].c_str() || *end != '\0' || k < 0 ||
+          static_cast<std::size_t>(k) >= a->size())
+        r.fail(key, "no such element", parts[i]);
+      node = a->get(static_cast<std::size_t>(k));
+    } else {
+      r.fail(key, "not a section", parts[i]);
+    }
+  }
+  auto* t = node->as_table();
+  if (!t) r.fail(key, "not a section", parts[parts.size() - 2]);
+  parsed.get("v")->visit([&](auto&& x) { t->insert_or_assign(parts.back(), x); });
+}
+
+}  // namespace
+
+Scene load_scene(const std::filesystem::path& path, int sweep_point,
+                 const SceneOverrides& overrides) {
   const std::string file = path.string();
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec)) throw InputError(file, "no such scene file");
@@ -963,6 +1008,7 @@ Scene load_scene(const std::filesystem::path& path, int sweep_point) {
     });
     root.erase("sweep");
   }
+  for (const auto& [key, value] : overrides) apply_override(r, root, key, value);
   for (const auto& [k, v] : root) {
     static const char* sections[] = {"scene",
                                      "material",
@@ -1505,6 +1551,12 @@ void flatten(const toml::table& t, const std::string& prefix,
   }
 }
 }  // namespace
+
+std::map<std::string, std::string> scene_values(const std::string& toml_text) {
+  std::map<std::string, std::string> out;
+  flatten(toml::parse(toml_text), "", out);
+  return out;
+}
 
 std::vector<std::string> scene_differences(const std::string& a, const std::string& b) {
   std::map<std::string, std::string> fa, fb;

@@ -5,6 +5,7 @@
 #include <array>
 #include <cstdint>
 #include <filesystem>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -172,9 +173,19 @@ void replace_spheres_by_clumps(Scene& scene);
 /// reports it).
 bool scene_has_sweep(const std::filesystem::path& path);
 
+/// Values set over the file's: dotted key (SECTION.KEY; SECTION.INDEX.KEY in an array of
+/// tables such as walls.0.friction_deg) and a TOML value ("1e-6", "true", "\"name\"", "[1, 2]").
+using SceneOverrides = std::vector<std::pair<std::string, std::string>>;
+
 /// `sweep_point`: with a [sweep] section, the point to load (its key set to values[point];
 /// negative: point 0). The scene's `sweep` then names the key, the values and the point.
-Scene load_scene(const std::filesystem::path& path, int sweep_point = -1);
+/// `overrides` are applied after the sweep point and checked as if the file said them.
+Scene load_scene(const std::filesystem::path& path, int sweep_point = -1,
+                 const SceneOverrides& overrides = {});
+
+/// Dotted keys and their values (TOML text) of a scene given as TOML text; arrays of tables
+/// (walls, materials) as one value.
+std::map<std::string, std::string> scene_values(const std::string& toml_text);
 
 /// Dotted keys whose values differ between two scenes given as TOML text (keys present in only
 /// one included), sorted. What `simulate --resume` compares with the scene of the run it resumes.

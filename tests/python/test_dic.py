@@ -103,3 +103,39 @@ except KeyboardInterrupt:
     word, seconds = out.split()
     assert word == "interrupted"
     assert float(seconds) < 10.0
+
+
+def test_render_equals_the_cli_and_its_truth_is_the_motion(cli, tmp_path):
+    """Speckle images of two frames (the second translated by dx along x): the CLI's images and
+    ground truth, and u = dx px_per_m, v = 0 on every grain pixel."""
+    import matplotlib.image as mpimg
+    rng = np.random.default_rng(2)
+    n = 40
+    xyz = np.column_stack([rng.uniform(0, 0.01, n), rng.uniform(0, 0.002, n),
+                           rng.uniform(0, 0.01, n)])
+    r = rng.uniform(0.0008, 0.0012, n)
+    dx = 1.3e-4
+    frames = [gs.Frame.from_arrays(xyz, r), gs.Frame.from_arrays(xyz + [dx, 0, 0], r, time=1.0)]
+    gs.save(tmp_path / "t.h5", frames)
+    rc, _, err = cli("render", tmp_path / "t.h5", "-o", tmp_path / "img", "--px-per-d50", 12)
+    assert rc == 0, err
+    py = gs.render(gs.open(tmp_path / "t.h5"), px_per_d50=12)
+    assert py["images"].dtype == np.uint8 and py["images"].shape[0] == 2
+    for k in range(2):
+        png = mpimg.imread(str(tmp_path / "img" / ("frame_%04d.png" % k)))
+        np.testing.assert_array_equal(np.rint(png * 255).astype(np.uint8), py["images"][k])
+    with h5py.File(tmp_path / "img" / "ground_truth.h5", "r") as h:
+        np.testing.assert_array_equal(h["u"][()], py["u"].astype(np.float32))
+        np.testing.assert_array_equal(h["grain"][()], py["grain"][0])
+        ppm = h.attrs["px_per_m"]
+    assert py["camera"]["px_per_m"] == ppm
+    grain = py["grain"][1] >= 0
+    assert grain.mean() > 0.2
+    np.testing.assert_allclose(py["u"][1][grain], dx * ppm, rtol=1e-9)
+    np.testing.assert_allclose(py["v"][1][grain], 0.0, atol=1e-9)
+    # The same from a list of frames; 16 bits.
+    same = gs.render(frames, px_per_d50=12)
+    np.testing.assert_array_equal(same["images"], py["images"])
+    assert gs.render(frames, px_per_d50=12, bits=16)["images"].dtype == np.uint16
+    with pytest.raises(gs.Error, match=r"^--bits: must be 8 or 16 \(12\)$"):
+        gs.render(frames, bits=12)
