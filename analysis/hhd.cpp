@@ -274,7 +274,8 @@ Eigen::MatrixXd apply_blocks(const std::vector<Eigen::Matrix3d>& d, const Eigen:
 template <class SolveK>
 Eigen::MatrixXd projection_pcg(const HhdMesh& m, const P1Geometry& g, const std::vector<int>& idx,
                                const Eigen::MatrixXd& b, SolveK&& solve_k, double tolerance,
-                               int max_iterations, int& iterations, bool& converged) {
+                               int max_iterations, int& iterations, bool& converged,
+                               const std::function<void()>& poll) {
   const Eigen::Index n = b.rows();
   iterations = 0;
   converged = true;
@@ -315,6 +316,7 @@ Eigen::MatrixXd projection_pcg(const HhdMesh& m, const P1Geometry& g, const std:
     r -= alpha * ap;
     iterations = it;
     if (r.norm() <= tolerance * bnorm) return v;
+    if (poll && it % 8 == 0) poll();
     z = precondition(r);
     const double rz_new = frobenius_dot(r, z);
     p = z + (rz_new / rz) * p;
@@ -539,13 +541,14 @@ HhdResult helmholtz_hodge(const HhdMesh& m, const std::vector<Eigen::Vector3d>& 
     case HhdSolver::Projection: {
       Eigen::CholmodDecomposition<SpMat, Eigen::Lower> s;
       direct(s);  // u, and path (b)'s v (eq 18 itself in 2D)
+      if (o.poll) o.poll();
       if (m.dim == 3) {
         t0 = Clock::now();
         v_coulomb = x.rightCols(3);
         x.rightCols(3) = projection_pcg(
             m, g, idx, Eigen::MatrixXd(-b18),
             [&](const Eigen::MatrixXd& q) { return Eigen::MatrixXd(s.solve(q)); }, tolerance,
-            o.max_iterations, r.report.iterations_v, r.report.converged);
+            o.max_iterations, r.report.iterations_v, r.report.converged, o.poll);
         r.report.seconds_solve += seconds_since(t0);
       }
       break;

@@ -30,6 +30,7 @@
 #include <Eigen/Core>
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -58,6 +59,9 @@ struct HhdOptions {
   HhdSolver solver = HhdSolver::Auto;
   double tolerance = 0.0;  // iterative solvers: relative residual ‖r‖/‖b‖ per system; 0: default
   int max_iterations = 10000;  // iterative solvers, per system
+  /// Called between the phases and every 8 iterations of the projection solver; may throw to
+  /// abandon the decomposition (Python's Ctrl-C). Changes no result.
+  std::function<void()> poll;
 };
 
 /// The mesh of the decomposition: nodes (2D: x, y used, z ignored), simplices in the

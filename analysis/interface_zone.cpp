@@ -1,9 +1,12 @@
 #include "interface_zone.hpp"
 
 #include <algorithm>
+#include <cstdlib>
 #include <stdexcept>
 #include <unordered_map>
 
+#include "errors.hpp"
+#include "selection.hpp"
 #include "shear_zone.hpp"
 
 namespace gs::analysis {
@@ -88,6 +91,38 @@ InterfaceZone interface_zone(const Frame& f, const InterfaceZoneOptions& o) {
     r.slip_ratio = r.u_surface / r.u_top;
   }
   return r;
+}
+
+InterfaceZoneOptions interface_zone_options(const std::string& file, double d50,
+                                            const InterfaceSpec& a,
+                                            std::optional<double> recorded) {
+  InterfaceZoneOptions o;
+  if (a.surface_z) {
+    if (!std::isfinite(*a.surface_z))
+      throw InputError(file, "--surface-z: not finite", value_str(*a.surface_z));
+    o.surface_z = *a.surface_z;
+  } else if (recorded) {
+    o.surface_z = *recorded;
+  } else {
+    throw InputError(file,
+                     "--surface-z: needed (the file does not record an interface shear surface)");
+  }
+  o.bin = length_option(file, "--bin", a.bin, a.bin_d50, 1.0, d50);
+  if (!(a.inset_d50 >= 0) || !std::isfinite(a.inset_d50))
+    throw InputError(file, "--inset-d50: must not be negative", value_str(a.inset_d50));
+  o.x_inset = a.inset_d50 * d50;
+  return o;
+}
+
+std::optional<double> recorded_surface(
+    const std::vector<std::pair<std::string, std::string>>& parameters) {
+  for (const auto& [key, v] : parameters)
+    if (key == "interface_shear.surface_mean_z_m") {
+      char* end = nullptr;
+      const double z = std::strtod(v.c_str(), &end);
+      if (end != v.c_str() && std::isfinite(z)) return z;
+    }
+  return std::nullopt;
 }
 
 }  // namespace gs::analysis

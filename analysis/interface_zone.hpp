@@ -19,6 +19,8 @@
 #pragma once
 
 #include <cmath>
+#include <optional>
+#include <string>
 #include <vector>
 
 #include "snapshot.hpp"
@@ -42,6 +44,24 @@ struct InterfaceZone {
   double lower = NAN, upper = NAN, thickness = NAN;  // zone boundaries above the surface, m
   double u_top = NAN, u_surface = NAN, slip_ratio = NAN;
 };
+
+/// The options as `analyze interface` names them: the surface level (m; unset: what the run
+/// recorded, `recorded_surface`), the bin in m or d50 (default 1 d50), the inset in d50.
+struct InterfaceSpec {
+  std::optional<double> surface_z, bin, bin_d50;
+  double inset_d50 = 2.0;
+};
+
+/// The options of `spec` for a frame of d50 `d50`; throws InputError (naming `file`) for a bad
+/// option or no surface level at all.
+InterfaceZoneOptions interface_zone_options(const std::string& file, double d50,
+                                            const InterfaceSpec& spec,
+                                            std::optional<double> recorded_surface);
+
+/// The surface level an interface shear run recorded in its metadata
+/// ("interface_shear.surface_mean_z_m"), if any.
+std::optional<double> recorded_surface(
+    const std::vector<std::pair<std::string, std::string>>& parameters);
 
 /// Throws std::invalid_argument for a bin that is not positive, a negative inset, a frame with
 /// no particles, or an x range emptied by the inset.

@@ -6,9 +6,11 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
+#include "field_output.hpp"
 #include "snapshot.hpp"
 
 namespace gs::analysis {
@@ -37,5 +39,23 @@ std::vector<MaterialStats> material_zone_stats(const std::vector<Particle>& part
 /// Parses "NAME:xlo,ylo,zlo,xhi,yhi,zhi" (bounds may be inf or -inf); std::invalid_argument
 /// saying what is wrong.
 Zone parse_zone(const std::string& spec);
+
+/// The zones of `analyze materials`: with `drum` the benchmark's quadrants x+z- and x-z+, then
+/// `specs` parsed. Throws InputError (naming `file`) for a bad spec or a name used twice.
+std::vector<Zone> material_zones(const std::string& file, bool drum,
+                                 const std::vector<std::string>& specs);
+
+/// Per frame (0, every, 2 every, ... of `frames`, read by `frame(i)`): columns step, time_s, then
+/// for each material (named by `names[id]`, else "material<id>") NAME_count, NAME_com_x_m,
+/// NAME_com_y_m, NAME_com_z_m and per zone ZONE_NAME_count; `materials` gets their number.
+std::vector<VtkArray> material_table(const std::string& file, long frames,
+                                     const std::function<Frame(long)>& frame, long every,
+                                     const std::vector<Zone>& zones,
+                                     const std::vector<std::string>& names,
+                                     std::size_t* materials = nullptr);
+
+/// The material names a granoscope run recorded (metadata "material_names", comma-separated).
+std::vector<std::string> recorded_material_names(
+    const std::vector<std::pair<std::string, std::string>>& parameters);
 
 }  // namespace gs::analysis

@@ -14,22 +14,6 @@
 namespace gs::analysis {
 namespace {
 
-std::vector<double> flat(const std::vector<Eigen::Vector3d>& v) {
-  std::vector<double> out;
-  out.reserve(3 * v.size());
-  for (const auto& x : v) out.insert(out.end(), {x.x(), x.y(), x.z()});
-  return out;
-}
-
-std::vector<double> flat(const std::vector<Eigen::Matrix3d>& m) {
-  std::vector<double> out;
-  out.reserve(9 * m.size());
-  for (const auto& a : m)
-    for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j) out.push_back(a(i, j));  // row-major sigma_ij
-  return out;
-}
-
 /// Invariants of each cell's stress (symmetric part; compression positive).
 void add_invariants(MapFields& f, const std::vector<Eigen::Matrix3d>& stress, int dim) {
   std::vector<double> p, q, eta, phi, b, lode;
@@ -85,8 +69,8 @@ double GridSpec::step_size(const std::string& file, double d50) const {
 std::vector<VtkArray> MapFields::arrays() const {
   std::vector<VtkArray> a;
   for (const auto& [n, v] : scalar) a.push_back({n, 1, v});
-  for (const auto& [n, v] : vector) a.push_back({n, 3, flat(v)});
-  for (const auto& [n, v] : tensor) a.push_back({n, 9, flat(v)});
+  for (const auto& [n, v] : vector) a.push_back({n, 3, flat_rows(v)});
+  for (const auto& [n, v] : tensor) a.push_back({n, 9, flat_rows(v)});
   return a;
 }
 
@@ -185,7 +169,7 @@ std::vector<VtkArray> rev_cell_table(const RevMap& map) {
     centre.push_back(g.centre(c));
     local.push_back(g.local(centre.back()));
   }
-  std::vector<VtkArray> cols{{"centre", 3, flat(centre)}, {"local", 3, flat(local)}};
+  std::vector<VtkArray> cols{{"centre", 3, flat_rows(centre)}, {"local", 3, flat_rows(local)}};
   for (auto& arr : map.fields.arrays()) cols.push_back(std::move(arr));
   return cols;
 }
@@ -210,7 +194,7 @@ std::vector<VtkArray> rev_profile(const std::string& file, const RevMap& map,
     dist.push_back(t * (p1 - p0).norm());
     w.push_back(rev_interpolation(map.grid, pts.back()));
   }
-  std::vector<VtkArray> cols{{"distance", 1, dist}, {"point", 3, flat(pts)}};
+  std::vector<VtkArray> cols{{"distance", 1, dist}, {"point", 3, flat_rows(pts)}};
   for (const auto& arr : map.fields.arrays()) {
     VtkArray c{arr.name, arr.components, {}};
     for (const auto& wk : w)

@@ -57,6 +57,7 @@ VortexAnalysis analyze_vortices(const std::vector<Eigen::Vector3d>& points,
   a.mesh.simplices = std::move(d.simplices);
   a.mesh.dirichlet = std::move(d.on_hull);
   a.seconds_delaunay = seconds_since(t0);
+  if (o.hhd.poll) o.hhd.poll();
   a.hhd = helmholtz_hodge(a.mesh, simplex_mean(a.mesh, nodal), o.hhd);
   t0 = std::chrono::steady_clock::now();
   a.rings = vertex_rings(dim, a.mesh.simplices, a.mesh.points.size());

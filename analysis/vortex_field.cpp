@@ -71,6 +71,7 @@ VortexAnalysisOptions vortex_analysis_options(const VortexFieldSpec& a, const Vo
   o.significance_absolute = a.significance_abs;
   o.hhd.tolerance = a.tolerance.value_or(0.0);
   o.hhd.max_iterations = a.max_iterations;
+  o.hhd.poll = a.poll;
   o.tube_delta = a.delta;
   if (a.axis.size() == 3) {
     o.axis = Eigen::Vector3d(a.axis.data());
@@ -112,6 +113,30 @@ VortexAnalysis analyze_field(const VortexField& f, const VortexAnalysisOptions& 
   } catch (const std::invalid_argument& e) {
     throw InputError(file, e.what());
   }
+}
+
+ExtremaColumns extrema_columns(const VortexAnalysis& r) {
+  ExtremaColumns c;
+  for (const auto& e : r.extrema) {
+    c.node.push_back(e.node);
+    c.kind.push_back(static_cast<std::int32_t>(e.kind));
+    c.value.push_back(e.value);
+    c.magnitude.push_back(e.magnitude);
+    c.significant.push_back(e.significant ? 1 : 0);
+    c.position.push_back(r.mesh.points[static_cast<std::size_t>(e.node)]);
+    c.v.push_back(e.v);
+  }
+  return c;
+}
+
+TubeColumns tube_columns(const VortexAnalysis& r) {
+  TubeColumns c;
+  for (const auto& t : r.tubes) {
+    c.nodes.insert(c.nodes.end(), t.nodes.begin(), t.nodes.end());
+    c.offsets.push_back(static_cast<std::int64_t>(c.nodes.size()));
+    c.extremum.push_back(static_cast<std::int32_t>(t.extremum));
+  }
+  return c;
 }
 
 }  // namespace gs::analysis

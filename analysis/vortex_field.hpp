@@ -7,6 +7,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -32,6 +33,7 @@ struct VortexFieldSpec {
   double delta = 0.05;
   double significance = kSignificanceRelative;
   double significance_abs = 0.0;
+  std::function<void()> poll;  // HhdOptions::poll (Python's Ctrl-C); changes no result
   bool projected() const { return slice || slab.any(); }
 };
 
@@ -57,5 +59,22 @@ VortexAnalysisOptions vortex_analysis_options(const VortexFieldSpec& spec, const
 /// HHD, extrema and tubes of `field` (degenerate input: InputError naming `file`).
 VortexAnalysis analyze_field(const VortexField& field, const VortexAnalysisOptions& options,
                              const std::string& file);
+
+/// The extrema and tubes of an analysis as columns: the datasets of `analyze hhd`'s /extrema and
+/// /tubes and Python's arrays. kind: 0 right vortex, 1 left vortex, 2 source, 3 sink; tube t
+/// holds nodes[offsets[t]:offsets[t + 1]] from extremum extremum[t].
+struct ExtremaColumns {
+  std::vector<std::int32_t> node, kind;
+  std::vector<double> value, magnitude;
+  std::vector<std::uint8_t> significant;
+  std::vector<Eigen::Vector3d> position, v;
+};
+ExtremaColumns extrema_columns(const VortexAnalysis& r);
+
+struct TubeColumns {
+  std::vector<std::int64_t> offsets{0};
+  std::vector<std::int32_t> nodes, extremum;
+};
+TubeColumns tube_columns(const VortexAnalysis& r);
 
 }  // namespace gs::analysis

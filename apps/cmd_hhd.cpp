@@ -80,21 +80,6 @@ void write_rows(H5FieldFile& h, const std::string& name, const std::vector<T>& v
   h.write(name, v, {cols > 0 ? v.size() / cols : 0, cols});
 }
 
-std::vector<double> flat(const std::vector<Eigen::Vector3d>& v) {
-  std::vector<double> out;
-  out.reserve(3 * v.size());
-  for (const auto& x : v) out.insert(out.end(), x.data(), x.data() + 3);
-  return out;
-}
-
-std::vector<double> flat(const Eigen::MatrixXd& m) {
-  std::vector<double> out;
-  out.reserve(static_cast<std::size_t>(m.size()));
-  for (Eigen::Index i = 0; i < m.rows(); ++i)
-    for (Eigen::Index j = 0; j < m.cols(); ++j) out.push_back(m(i, j));
-  return out;
-}
-
 void write_extrema_csv(const fs::path& path, const VortexAnalysis& a, const Field& f) {
   AtomicOutput out(path);
   {
@@ -146,14 +131,14 @@ void write_hhd_vtu(const fs::path& path, const VortexAnalysis& a,
   const auto& r = a.hhd;
   write_vtu_mesh(path, a.mesh.points, dim == 3 ? 10 : 5, cells,
                  {{"u", 1, std::vector<double>(r.u.data(), r.u.data() + r.u.size())},
-                  {"v", static_cast<int>(r.v.cols()), flat(r.v)},
-                  {"v_coulomb", static_cast<int>(r.v_coulomb.cols()), flat(r.v_coulomb)},
-                  {"vector", 3, flat(vectors)},
+                  {"v", static_cast<int>(r.v.cols()), flat_rows(r.v)},
+                  {"v_coulomb", static_cast<int>(r.v_coulomb.cols()), flat_rows(r.v_coulomb)},
+                  {"vector", 3, flat_rows(vectors)},
                   {"ghost", 1, ghost}},
-                 {{"xi", 3, flat(r.xi)},
-                  {"grad_u", 3, flat(r.grad_u)},
-                  {"curl_v", 3, flat(r.curl_v)},
-                  {"h", 3, flat(r.harmonic)},
+                 {{"xi", 3, flat_rows(r.xi)},
+                  {"grad_u", 3, flat_rows(r.grad_u)},
+                  {"curl_v", 3, flat_rows(r.curl_v)},
+                  {"h", 3, flat_rows(r.harmonic)},
                   {"measure", 1, r.measure}});
 }
 
@@ -272,12 +257,12 @@ void run_hhd(const HhdArgs& a) {
   h.group("/simplices");
   h.group("/extrema");
   h.group("/tubes");
-  write_rows(h, "/nodes/position", flat(r.mesh.points), 3);
-  write_rows(h, "/nodes/vector", flat(vectors), 3);
+  write_rows(h, "/nodes/position", flat_rows(r.mesh.points), 3);
+  write_rows(h, "/nodes/vector", flat_rows(vectors), 3);
   h.write("/nodes/id", f.id);
   h.write("/nodes/u", std::vector<double>(r.hhd.u.data(), r.hhd.u.data() + r.hhd.u.size()));
-  write_rows(h, "/nodes/v", flat(r.hhd.v), static_cast<std::size_t>(r.hhd.v.cols()));
-  write_rows(h, "/nodes/v_coulomb", flat(r.hhd.v_coulomb),
+  write_rows(h, "/nodes/v", flat_rows(r.hhd.v), static_cast<std::size_t>(r.hhd.v.cols()));
+  write_rows(h, "/nodes/v_coulomb", flat_rows(r.hhd.v_coulomb),
              static_cast<std::size_t>(r.hhd.v_coulomb.cols()));
   std::vector<std::uint8_t> ghost(r.mesh.points.size(), 0);
   for (std::size_t i = r.true_nodes; i < ghost.size(); ++i) ghost[i] = 1;
@@ -288,43 +273,25 @@ void run_hhd(const HhdArgs& a) {
     for (int k = 0; k <= r.mesh.dim; ++k) simp.push_back(s[static_cast<std::size_t>(k)]);
   write_rows(h, "/simplices/vertices", simp, static_cast<std::size_t>(r.mesh.dim + 1));
   h.write("/simplices/measure", r.hhd.measure);
-  write_rows(h, "/simplices/xi", flat(r.hhd.xi), 3);
-  write_rows(h, "/simplices/grad_u", flat(r.hhd.grad_u), 3);
-  write_rows(h, "/simplices/curl_v", flat(r.hhd.curl_v), 3);
-  write_rows(h, "/simplices/harmonic", flat(r.hhd.harmonic), 3);
-  std::vector<std::int32_t> enode, ekind;
-  std::vector<std::uint8_t> esig;
-  std::vector<double> evalue, emag;
-  std::vector<Eigen::Vector3d> epos, ev;
-  for (const auto& e : r.extrema) {
-    enode.push_back(e.node);
-    ekind.push_back(static_cast<std::int32_t>(e.kind));
-    evalue.push_back(e.value);
-    emag.push_back(e.magnitude);
-    esig.push_back(e.significant ? 1 : 0);
-    epos.push_back(r.mesh.points[static_cast<std::size_t>(e.node)]);
-    ev.push_back(e.v);
-  }
+  write_rows(h, "/simplices/xi", flat_rows(r.hhd.xi), 3);
+  write_rows(h, "/simplices/grad_u", flat_rows(r.hhd.grad_u), 3);
+  write_rows(h, "/simplices/curl_v", flat_rows(r.hhd.curl_v), 3);
+  write_rows(h, "/simplices/harmonic", flat_rows(r.hhd.harmonic), 3);
+  const analysis::ExtremaColumns e = analysis::extrema_columns(r);
   h.attr("kinds", "0 right_vortex, 1 left_vortex, 2 source, 3 sink", "/extrema");
-  h.write("/extrema/node", enode);
-  h.write("/extrema/kind", ekind);
-  h.write("/extrema/value", evalue);
-  h.write("/extrema/magnitude", emag);
-  h.write("/extrema/significant", esig);
+  h.write("/extrema/node", e.node);
+  h.write("/extrema/kind", e.kind);
+  h.write("/extrema/value", e.value);
+  h.write("/extrema/magnitude", e.magnitude);
+  h.write("/extrema/significant", e.significant);
   h.attr("significance_relative", r.significance_relative, "/extrema");
   h.attr("significance_absolute", r.significance_absolute, "/extrema");
-  write_rows(h, "/extrema/position", flat(epos), 3);
-  write_rows(h, "/extrema/v", flat(ev), 3);
-  std::vector<std::int64_t> offsets{0};
-  std::vector<std::int32_t> tnodes, textremum;
-  for (const auto& t : r.tubes) {
-    tnodes.insert(tnodes.end(), t.nodes.begin(), t.nodes.end());
-    offsets.push_back(static_cast<std::int64_t>(tnodes.size()));
-    textremum.push_back(static_cast<std::int32_t>(t.extremum));
-  }
-  h.write("/tubes/offsets", offsets);
-  h.write("/tubes/nodes", tnodes);
-  h.write("/tubes/extremum", textremum);
+  write_rows(h, "/extrema/position", flat_rows(e.position), 3);
+  write_rows(h, "/extrema/v", flat_rows(e.v), 3);
+  const analysis::TubeColumns t = analysis::tube_columns(r);
+  h.write("/tubes/offsets", t.offsets);
+  h.write("/tubes/nodes", t.nodes);
+  h.write("/tubes/extremum", t.extremum);
   if (f.slab) {
     h.group("/slab");
     h.write("/slab/origin", std::vector<Eigen::Vector3d>{f.plane.origin});

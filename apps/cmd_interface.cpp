@@ -27,22 +27,8 @@ struct InterfaceArgs {
   FrameArgs in;  // input, --frame, --d50
   std::string output, csv;
   long from = 0;
-  std::optional<double> surface_z, bin, bin_d50;
-  double inset_d50 = 2.0;
+  ga::InterfaceSpec spec;
 };
-
-/// The surface's mean level an interface shear run recorded in its metadata (granoscope HDF5).
-std::optional<double> recorded_surface(const std::string& file) {
-  if (!is_hdf5_file(file)) return std::nullopt;
-  const TrajectoryReader reader(file);  // (alive through the loop)
-  for (const auto& [key, v] : reader.metadata().parameters)
-    if (key == "interface_shear.surface_mean_z_m") {
-      char* end = nullptr;
-      const double z = std::strtod(v.c_str(), &end);
-      if (end != v.c_str() && std::isfinite(z)) return z;
-    }
-  return std::nullopt;
-}
 
 void run_interface(const InterfaceArgs& a) {
   const std::string& file = a.in.input;
@@ -53,22 +39,11 @@ void run_interface(const InterfaceArgs& a) {
   if (r < 0) r += static_cast<long>(frame_count(file));
   const std::optional<Frame> reference =
       r != k ? std::optional<Frame>(read_frame(file, r)) : std::nullopt;
-  ga::InterfaceZoneOptions o;
   // The surface's mean level: given, or what the interface shear run recorded.
-  if (a.surface_z) {
-    if (!std::isfinite(*a.surface_z))
-      throw InputError(file, "--surface-z: not finite", value_str(*a.surface_z));
-    o.surface_z = *a.surface_z;
-  } else if (const auto z = recorded_surface(file)) {
-    o.surface_z = *z;
-  } else {
-    throw InputError(file,
-                     "--surface-z: needed (the file does not record an interface shear surface)");
-  }
-  o.bin = length_option(file, "--bin", a.bin, a.bin_d50, 1.0, d50);
-  if (!(a.inset_d50 >= 0) || !std::isfinite(a.inset_d50))
-    throw InputError(file, "--inset-d50: must not be negative", value_str(a.inset_d50));
-  o.x_inset = a.inset_d50 * d50;
+  std::optional<double> recorded;
+  if (!a.spec.surface_z && is_hdf5_file(file))
+    recorded = ga::recorded_surface(TrajectoryReader(file).metadata().parameters);
+  ga::InterfaceZoneOptions o = ga::interface_zone_options(file, d50, a.spec, recorded);
   if (reference) o.reference = &*reference;
   ga::InterfaceZone z;
   try {
@@ -126,11 +101,11 @@ void register_analyze_interface(CLI::App& app) {
   s->add_option("--csv", a->csv, "also write the profiles as CSV");
   s->add_option("--from", a->from,
                 "reference frame of the displacements, negative from the end (default 0)");
-  s->add_option("--surface-z", a->surface_z,
+  s->add_option("--surface-z", a->spec.surface_z,
                 "the surface's mean level in m (default: recorded by the interface shear run)");
-  s->add_option("--bin", a->bin, "profile bin in m");
-  s->add_option("--bin-d50", a->bin_d50, "profile bin in d50 (default 1)");
-  s->add_option("--inset-d50", a->inset_d50,
+  s->add_option("--bin", a->spec.bin, "profile bin in m");
+  s->add_option("--bin-d50", a->spec.bin_d50, "profile bin in d50 (default 1)");
+  s->add_option("--inset-d50", a->spec.inset_d50,
                 "profiles this far in from the specimen's ends, d50 (default 2)");
   s->callback([a] { run_interface(*a); });
 }

@@ -27,17 +27,8 @@ namespace {
 
 namespace ga = gs::analysis;
 
-std::vector<double> flat(const std::vector<Eigen::Matrix3d>& m) {
-  std::vector<double> out;
-  out.reserve(9 * m.size());
-  for (const auto& a : m)
-    for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j) out.push_back(a(i, j));  // row-major sigma_ij
-  return out;
-}
-
 std::vector<double> flat(const Eigen::Matrix3d& m) {
-  return flat(std::vector<Eigen::Matrix3d>{m});
+  return flat_rows(std::vector<Eigen::Matrix3d>{m});
 }
 
 void write_grid(H5FieldFile& h, const ga::RevGrid& g) {

@@ -374,4 +374,28 @@ void write_csv_table(const std::filesystem::path& path, const std::vector<VtkArr
   out.commit();
 }
 
+std::vector<double> flat_rows(const std::vector<Eigen::Vector3d>& v) {
+  std::vector<double> out;
+  out.reserve(3 * v.size());
+  for (const auto& x : v) out.insert(out.end(), {x.x(), x.y(), x.z()});
+  return out;
+}
+
+std::vector<double> flat_rows(const std::vector<Eigen::Matrix3d>& m) {
+  std::vector<double> out;
+  out.reserve(9 * m.size());
+  for (const auto& a : m)
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) out.push_back(a(i, j));
+  return out;
+}
+
+std::vector<double> flat_rows(const Eigen::MatrixXd& m) {
+  std::vector<double> out;
+  out.reserve(static_cast<std::size_t>(m.size()));
+  for (Eigen::Index i = 0; i < m.rows(); ++i)
+    for (Eigen::Index j = 0; j < m.cols(); ++j) out.push_back(m(i, j));
+  return out;
+}
+
 }  // namespace gs

@@ -91,4 +91,10 @@ void write_vti_image(const std::filesystem::path& path, const Eigen::Vector3d& o
 /// others as name_0, name_1, ... Non-finite values are written as nan.
 void write_csv_table(const std::filesystem::path& path, const std::vector<VtkArray>& columns);
 
+/// Row-major values for VtkArray columns and HDF5 datasets: vectors x, y, z in turn; each
+/// matrix row by row (a(0, 0), a(0, 1), ...); a dynamic matrix row by row.
+std::vector<double> flat_rows(const std::vector<Eigen::Vector3d>& v);
+std::vector<double> flat_rows(const std::vector<Eigen::Matrix3d>& m);
+std::vector<double> flat_rows(const Eigen::MatrixXd& m);
+
 }  // namespace gs

@@ -16,14 +16,14 @@ See docs/python.md.
 import os as _os
 
 from . import _granoscope as _c
-from ._granoscope import (Error, Frame, Trajectory, chains, d50, dic, fabric, hhd, invariants,
-                          render, rev, rose, shearzone, strain, stress_invariants, voidcells,
-                          vortices, walls)
+from ._granoscope import (Error, Frame, Trajectory, chains, d50, dic, fabric, hhd, interface,
+                          invariants, materials, render, rev, rose, shearzone, silo, strain,
+                          stress_invariants, voidcells, vortices, walls)
 
 __all__ = ["Error", "FileNotFound", "Frame", "Run", "Scene", "Trajectory", "open", "save",
-           "chains", "d50", "dic", "fabric", "hhd", "invariants", "render", "rev", "rose",
-           "shearzone", "strain", "stress_invariants", "voidcells", "vortices", "walls",
-           "__version__"]
+           "chains", "d50", "dic", "fabric", "hhd", "interface", "invariants", "materials",
+           "render", "rev", "rose", "shearzone", "silo", "strain", "stress_invariants",
+           "voidcells", "vortices", "walls", "__version__"]
 
 from .simulation import Run, Scene  # noqa: E402 (needs the compiled module)
 

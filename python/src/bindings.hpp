@@ -17,6 +17,8 @@ void bind_maps(pybind11::module_& m);
 void bind_motion(pybind11::module_& m);
 /// Scenes: load with values set over the file, run with progress, stop and resume.
 void bind_simulation(pybind11::module_& m);
+/// Scene reports: silo, interface shear zone, materials.
+void bind_reports(pybind11::module_& m);
 /// Subset DIC of images.
 void bind_dic(pybind11::module_& m);
 

@@ -16,6 +16,7 @@ PYBIND11_MODULE(_granoscope, m) {
   gs::py_bind::bind_analysis(m);
   gs::py_bind::bind_maps(m);
   gs::py_bind::bind_motion(m);
+  gs::py_bind::bind_reports(m);
   gs::py_bind::bind_simulation(m);
   gs::py_bind::bind_dic(m);
 }

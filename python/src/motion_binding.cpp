@@ -89,6 +89,10 @@ ga::VortexFieldSpec field_spec(bool slice, const OptVec& slab_origin, const OptV
   s.delta = delta;
   s.significance = significance;
   s.significance_abs = significance_abs;
+  s.poll = [] {  // Ctrl-C between the phases and during the projection solver's iterations
+    py::gil_scoped_acquire locked;
+    if (PyErr_CheckSignals() != 0) throw py::error_already_set();
+  };
   return s;
 }
 
@@ -115,38 +119,20 @@ py::dict hhd_dict(const ga::VortexAnalysis& r, const ga::VortexField& f,
   simp["grad_u"] = rows3(h.grad_u);
   simp["curl_v"] = rows3(h.curl_v);
   simp["harmonic"] = rows3(h.harmonic);
+  const ga::ExtremaColumns e = ga::extrema_columns(r);
   py::dict ext;
-  std::vector<std::int32_t> enode, ekind;
-  std::vector<std::uint8_t> esig;
-  std::vector<double> evalue, emag;
-  std::vector<Eigen::Vector3d> epos, ev;
-  for (const auto& e : r.extrema) {
-    enode.push_back(e.node);
-    ekind.push_back(static_cast<std::int32_t>(e.kind));
-    evalue.push_back(e.value);
-    emag.push_back(e.magnitude);
-    esig.push_back(e.significant ? 1 : 0);
-    epos.push_back(r.mesh.points[static_cast<std::size_t>(e.node)]);
-    ev.push_back(e.v);
-  }
-  ext["node"] = array1(enode);
-  ext["kind"] = array1(ekind);
-  ext["value"] = array1(evalue);
-  ext["magnitude"] = array1(emag);
-  ext["significant"] = array1(esig);
-  ext["position"] = rows3(epos);
-  ext["v"] = rows3(ev);
-  std::vector<std::int64_t> offsets{0};
-  std::vector<std::int32_t> tnodes, textremum;
-  for (const auto& t : r.tubes) {
-    tnodes.insert(tnodes.end(), t.nodes.begin(), t.nodes.end());
-    offsets.push_back(static_cast<std::int64_t>(tnodes.size()));
-    textremum.push_back(static_cast<std::int32_t>(t.extremum));
-  }
+  ext["node"] = array1(e.node);
+  ext["kind"] = array1(e.kind);
+  ext["value"] = array1(e.value);
+  ext["magnitude"] = array1(e.magnitude);
+  ext["significant"] = array1(e.significant);
+  ext["position"] = rows3(e.position);
+  ext["v"] = rows3(e.v);
+  const ga::TubeColumns t = ga::tube_columns(r);
   py::dict tubes;
-  tubes["offsets"] = array1(offsets);
-  tubes["nodes"] = array1(tnodes);
-  tubes["extremum"] = array1(textremum);
+  tubes["offsets"] = array1(t.offsets);
+  tubes["nodes"] = array1(t.nodes);
+  tubes["extremum"] = array1(t.extremum);
   const auto sig = ga::count_extrema(r.extrema, true);
   const auto all = ga::count_extrema(r.extrema, false);
   py::dict counts;
