@@ -100,3 +100,22 @@ def test_ctrl_c_stops_after_a_checkpoint(oedometer, tmp_path):
     assert os.path.exists(tmp_path / "run" / "checkpoint.txt")
     rest = sc.run(tmp_path / "run", steps=0, resume=True)  # stops at once: nothing more to do
     assert rest.step > 0
+
+
+def test_a_tqdm_bar_follows_the_run(oedometer, tmp_path):
+    """The progress callback drives a tqdm bar (Debian's python3-tqdm) as it is: bar.update's
+    return value (True or None) does not stop the run."""
+    import io
+    import tqdm
+    out = io.StringIO()
+    bar = tqdm.tqdm(total=400, file=out, mininterval=0)
+    run = gs.Scene(oedometer).run(tmp_path / "run", steps=400, every=100,
+                                  progress=lambda p: bar.update(p["step"] - bar.n))
+    bar.close()
+    assert not run.stopped and run.step == 400 and bar.n == 400
+    assert "400/400" in out.getvalue()
+    # By fraction (a laboratory test's steps are not known beforehand), as docs/python.md shows.
+    bar = tqdm.tqdm(total=100, unit="%", file=io.StringIO(), mininterval=0)
+    gs.Scene(oedometer).run(tmp_path / "run2", steps=400, every=100,
+                            progress=lambda p: bar.update(100 * p["fraction"] - bar.n))
+    assert bar.n == pytest.approx(100)
