@@ -1,0 +1,162 @@
+// Seed 003's tangential polyhedron and its walls under an imposed F (see
+// tangential_polyhedron.hpp).
+#include "tangential_polyhedron.hpp"
+
+#include <Eigen/Dense>
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+#include <string>
+
+namespace gs::solver {
+namespace {
+
+Eigen::Vector3d unit(double theta, double phi) {
+  return {std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta)};
+}
+
+}  // namespace
+
+PolygonMeasure polygon_measure(const std::vector<Eigen::Vector3d>& p) {
+  PolygonMeasure m;
+  if (p.size() < 3) return m;
+  // Fan from the first vertex: area vector Σ (a × b) / 2, centre Σ area_k centroid_k / area.
+  Eigen::Vector3d area_vector = Eigen::Vector3d::Zero(), moment = Eigen::Vector3d::Zero();
+  for (std::size_t k = 1; k + 1 < p.size(); ++k) {
+    const Eigen::Vector3d a = 0.5 * (p[k] - p[0]).cross(p[k + 1] - p[0]);
+    area_vector += a;
+    moment += a.norm() * (p[0] + p[k] + p[k + 1]) / 3.0;  // (convex polygons: all fans agree)
+  }
+  m.area = area_vector.norm();
+  if (m.area > 0.0) {
+    m.normal = area_vector / m.area;
+    double fan = 0.0;
+    for (std::size_t k = 1; k + 1 < p.size(); ++k)
+      fan += 0.5 * (p[k] - p[0]).cross(p[k + 1] - p[0]).norm();
+    m.centre = moment / fan;
+  }
+  return m;
+}
+
+double polyhedron_volume(const std::vector<Eigen::Vector3d>& v,
+                         const std::vector<std::vector<int>>& faces) {
+  double vol = 0.0;  // (1/3) Σ (x_c · n) A over the faces, with the origin as the apex
+  for (const auto& f : faces) {
+    std::vector<Eigen::Vector3d> p;
+    for (const int k : f) p.push_back(v[static_cast<std::size_t>(k)]);
+    const PolygonMeasure m = polygon_measure(p);
+    vol += m.centre.dot(m.normal) * m.area / 3.0;
+  }
+  return vol;
+}
+
+TangentialPolyhedron tangential_polyhedron(int n, double R) {
+  if (n < 4 || n % 2 != 0)
+    throw std::invalid_argument("the polyhedron needs an even n >= 4 (" + std::to_string(n) + ")");
+  if (!(R > 0.0) || !std::isfinite(R))
+    throw std::invalid_argument("the polyhedron needs a radius R > 0 (" + std::to_string(R) + ")");
+  TangentialPolyhedron P;
+  P.n = n;
+  P.R = R;
+  const double w = std::numbers::pi / n;  // ϖ = 180°/n
+  const double cw = std::cos(w);
+  // Layer i: the vertical polygons' vertices at polar angle (2i - 1) ϖ, distance R / cos ϖ from
+  // the centre (App. 3 (b)); they are the mid-edge points of the layer's horizontal n-gon, whose
+  // vertices sit at azimuths (2j - 1) ϖ, a factor 1 / cos ϖ further out (App. 3 (c)-(d)).
+  for (int i = 1; i <= n / 2; ++i) {
+    const double a = (2 * i - 1) * w;
+    const double z = R * std::cos(a) / cw, r = R * std::sin(a) / (cw * cw);
+    for (int j = 1; j <= n; ++j) {
+      const double phi = (2 * j - 1) * w;
+      P.vertices.emplace_back(r * std::cos(phi), r * std::sin(phi), z);
+    }
+  }
+  const auto id = [n](int i, int j) { return (i - 1) * n + (j - 1); };  // (1-based i, j)
+  // Side wall (i - 1) n + j: layers i and i + 1, columns j - 1 (n when j = 1) and j; tangent at
+  // (R, 2 i ϖ, 2 (j - 1) ϖ).
+  for (int i = 1; i <= n / 2 - 1; ++i)
+    for (int j = 1; j <= n; ++j) {
+      const int jm = j == 1 ? n : j - 1;
+      P.faces.push_back({id(i + 1, jm), id(i + 1, j), id(i, j), id(i, jm)});
+      P.normals.push_back(unit(2 * i * w, 2 * (j - 1) * w));
+    }
+  std::vector<int> top, bottom;
+  for (int j = 1; j <= n; ++j) top.push_back(id(1, j));
+  for (int j = n; j >= 1; --j) bottom.push_back(id(n / 2, j));
+  P.faces.push_back(top);
+  P.normals.emplace_back(0.0, 0.0, 1.0);
+  P.faces.push_back(bottom);
+  P.normals.emplace_back(0.0, 0.0, -1.0);
+  for (std::size_t f = 0; f < P.faces.size(); ++f) {
+    // Counter-clockwise seen from outside: reverse a face whose polygon normal points inward.
+    std::vector<Eigen::Vector3d> p;
+    for (const int k : P.faces[f]) p.push_back(P.vertices[static_cast<std::size_t>(k)]);
+    if (polygon_measure(p).normal.dot(P.normals[f]) < 0.0)
+      P.faces[f] = std::vector<int>(P.faces[f].rbegin(), P.faces[f].rend());
+    P.tangent.push_back(R * P.normals[f]);
+  }
+  return P;
+}
+
+Eigen::Matrix3d deformation_gradient_from_faces(const TangentialPolyhedron& ref,
+                                                const std::vector<Eigen::Vector3d>& current) {
+  Eigen::Matrix3d sum = Eigen::Matrix3d::Zero();
+  double volume = 0.0;
+  for (const auto& f : ref.faces) {
+    std::vector<Eigen::Vector3d> p0, p;
+    for (const int k : f) {
+      p0.push_back(ref.vertices[static_cast<std::size_t>(k)]);
+      p.push_back(current[static_cast<std::size_t>(k)]);
+    }
+    const PolygonMeasure m0 = polygon_measure(p0);
+    const PolygonMeasure m = polygon_measure(p);
+    // Eq 4 with N the inward normal: -x^c N^T ΔS = x^c n_out^T ΔS.
+    sum += m.centre * m0.normal.transpose() * m0.area;
+    volume += m0.centre.dot(m0.normal) * m0.area / 3.0;
+  }
+  return sum / volume;
+}
+
+std::vector<Eigen::Vector3d> vertices_from_planes(const TangentialPolyhedron& ref,
+                                                  const std::vector<Eigen::Vector3d>& point,
+                                                  const std::vector<Eigen::Vector3d>& normal) {
+  std::vector<Eigen::Matrix3d> A(ref.vertices.size(), Eigen::Matrix3d::Zero());
+  std::vector<Eigen::Vector3d> b(ref.vertices.size(), Eigen::Vector3d::Zero());
+  for (std::size_t f = 0; f < ref.faces.size(); ++f) {
+    const Eigen::Vector3d nf = normal[f].normalized();
+    for (const int k : ref.faces[f]) {
+      A[static_cast<std::size_t>(k)] += nf * nf.transpose();
+      b[static_cast<std::size_t>(k)] += nf * nf.dot(point[f]);
+    }
+  }
+  std::vector<Eigen::Vector3d> out;
+  for (std::size_t k = 0; k < A.size(); ++k) out.push_back(A[k].ldlt().solve(b[k]));
+  return out;
+}
+
+std::vector<WallMotion> wall_motions(const TangentialPolyhedron& ref, const Eigen::Matrix3d& F,
+                                     const Eigen::Matrix3d& F_target, double dt) {
+  if (!(dt > 0.0)) throw std::invalid_argument("wall_motions needs dt > 0");
+  std::vector<WallMotion> out;
+  for (std::size_t f = 0; f < ref.faces.size(); ++f) {
+    const Eigen::Vector3d X = ref.tangent[f], N = ref.normals[f];
+    // Two in-plane vectors of the reference wall (Eq 6 maps them; Eq 7 gives the normal).
+    const Eigen::Vector3d T1 =
+        (std::abs(N.z()) < 0.9 ? Eigen::Vector3d::UnitZ() : Eigen::Vector3d::UnitX())
+            .cross(N)
+            .normalized();
+    const Eigen::Vector3d T2 = N.cross(T1);
+    const auto normal_of = [&](const Eigen::Matrix3d& G) {
+      return Eigen::Vector3d((G * T1).cross(G * T2).normalized());
+    };
+    WallMotion m;
+    m.centre = F * X;                                               // Eq 5
+    m.normal = normal_of(F);                                        // Eq 7
+    m.velocity = (F_target - F) * X / dt;                           // Eq 8
+    m.angular_velocity = m.normal.cross(normal_of(F_target)) / dt;  // Eq 9
+    out.push_back(m);
+  }
+  return out;
+}
+
+}  // namespace gs::solver

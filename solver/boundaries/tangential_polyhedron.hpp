@@ -1,0 +1,71 @@
+// Seed 003's tangential polyhedron (§2.3, App. 3): the specimen boundary of the principal stress
+// rotation tests, n-sided (n even, n >= 4) and tangent in every face to a sphere of radius R
+// centred at the origin. Two end walls (regular n-gons at z = ±R) and (n/2 - 1) n side walls
+// (quadrangles) whose tangent points have the spherical coordinates (R, 2 i ϖ, 2 (j - 1) ϖ),
+// ϖ = 180°/n; n²/2 vertices in n/2 layers. n = 4 is the cube of half-width R; n = 8 (the paper's)
+// has 32 vertices and 26 walls.
+//
+// The walls follow an imposed deformation gradient F (§2.1.2): a wall's centre moves to F X_o
+// (Eq 5), its in-plane vectors to F T (Eq 6), its normal to the normalised t1 × t2 (Eq 7); over a
+// step dt the centre gets the velocity ΔF X_o / dt (Eq 8) and the normal the spin n × n_t / dt
+// (Eq 9). F is measured back from the faces' polygons (Eq 4).
+#pragma once
+
+#include <Eigen/Core>
+#include <vector>
+
+namespace gs::solver {
+
+struct TangentialPolyhedron {
+  int n = 0;
+  double R = 0.0;                         // m, the inscribed sphere's radius
+  std::vector<Eigen::Vector3d> vertices;  // App. 3 order: layer i (top down), then j ccw from +x
+  // Faces in App. 3's wall order: the (n/2 - 1) n side walls (ID (i - 1) n + j, 1-based), then
+  // the top and the bottom end wall. Vertex indices counter-clockwise seen from outside.
+  std::vector<std::vector<int>> faces;
+  std::vector<Eigen::Vector3d> normals;  // outward unit normals
+  std::vector<Eigen::Vector3d> tangent;  // tangent points on the sphere (= R · normal)
+};
+
+/// The polyhedron of App. 3. Throws std::invalid_argument for n odd or below 4, or R <= 0 (or
+/// not finite).
+TangentialPolyhedron tangential_polyhedron(int n, double R);
+
+/// Area (m²), area centre, and unit normal (by the right-hand rule of the vertex order) of a
+/// planar polygon.
+struct PolygonMeasure {
+  double area = 0.0;
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+};
+PolygonMeasure polygon_measure(const std::vector<Eigen::Vector3d>& polygon);
+
+/// Volume (m³) enclosed by the faces (outward vertex order), by the divergence theorem.
+double polyhedron_volume(const std::vector<Eigen::Vector3d>& vertices,
+                         const std::vector<std::vector<int>>& faces);
+
+/// Eq 4: F_iJ = -(1/V) Σ x_i^c N_J ΔS over the faces, with V, N (inward) and ΔS of the reference
+/// polyhedron and x^c the area centres of the same faces with the `current` vertices. Exact for a
+/// homogeneous deformation (an affine map keeps area centres).
+Eigen::Matrix3d deformation_gradient_from_faces(const TangentialPolyhedron& reference,
+                                                const std::vector<Eigen::Vector3d>& current);
+
+/// The current vertices from the walls' current planes (point p_w, unit normal n_w per face, in
+/// face order): each vertex is the least-squares intersection of the planes of its faces.
+std::vector<Eigen::Vector3d> vertices_from_planes(const TangentialPolyhedron& reference,
+                                                  const std::vector<Eigen::Vector3d>& point,
+                                                  const std::vector<Eigen::Vector3d>& normal);
+
+/// A wall's motion over one step towards deformation gradient F_target from F (Eqs 5-9): the
+/// velocity of its centre (the reference tangent point X_o mapped by F) and its spin.
+struct WallMotion {
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();  // F X_o, m
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();  // Eq 7 with F
+  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
+  Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();
+};
+std::vector<WallMotion> wall_motions(const TangentialPolyhedron& reference,
+                                     const Eigen::Matrix3d& F, const Eigen::Matrix3d& F_target,
+                                     double dt);
+
+}  // namespace gs::solver
