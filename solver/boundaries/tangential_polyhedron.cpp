@@ -8,6 +8,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "simulation.hpp"
+
 namespace gs::solver {
 namespace {
 
@@ -157,6 +159,48 @@ std::vector<WallMotion> wall_motions(const TangentialPolyhedron& ref, const Eige
     out.push_back(m);
   }
   return out;
+}
+
+std::vector<WallSpec> polyhedron_walls(const TangentialPolyhedron& P, double friction_deg) {
+  std::vector<WallSpec> out;
+  for (std::size_t f = 0; f < P.faces.size(); ++f) {
+    WallSpec w;
+    w.name = "poly" + std::to_string(f + 1);
+    w.shape = WallShape::Plane;
+    w.center = P.tangent[f];
+    w.normal = -P.normals[f];
+    w.friction_deg = friction_deg;
+    out.push_back(w);
+  }
+  return out;
+}
+
+void drive_polyhedron(Simulation& sim, std::size_t first, const TangentialPolyhedron& P,
+                      const Eigen::Matrix3d& F_target, double dt) {
+  const auto target = wall_motions(P, F_target, F_target, dt);
+  auto& walls = sim.mutable_walls();
+  for (std::size_t f = 0; f < P.faces.size(); ++f) {
+    WallState& w = walls[first + f];
+    const Eigen::Vector3d n_now = -w.normal, n_next = target[f].normal;  // outward
+    w.vel = (target[f].centre - w.pos) / dt;
+    // Eq 9 turns n by asin|n x n_t| (the engine turns by |ω| dt): the angle itself, so that one
+    // step lands on n_t to round-off.
+    const Eigen::Vector3d axis = n_now.cross(n_next);
+    const double s = axis.norm();
+    w.spec.angular_velocity =
+        s > 0.0 ? Eigen::Vector3d(axis / s * std::atan2(s, n_now.dot(n_next)) / dt)
+                : Eigen::Vector3d::Zero();
+  }
+}
+
+Eigen::Matrix3d polyhedron_deformation_gradient(const Simulation& sim, std::size_t first,
+                                                const TangentialPolyhedron& P) {
+  std::vector<Eigen::Vector3d> point, normal;
+  for (std::size_t f = 0; f < P.faces.size(); ++f) {
+    point.push_back(sim.walls()[first + f].pos);
+    normal.push_back(-sim.walls()[first + f].normal);
+  }
+  return deformation_gradient_from_faces(P, vertices_from_planes(P, point, normal));
 }
 
 }  // namespace gs::solver

@@ -12,7 +12,10 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cstddef>
 #include <vector>
+
+#include "dem_types.hpp"
 
 namespace gs::solver {
 
@@ -67,5 +70,25 @@ struct WallMotion {
 std::vector<WallMotion> wall_motions(const TangentialPolyhedron& reference,
                                      const Eigen::Matrix3d& F, const Eigen::Matrix3d& F_target,
                                      double dt);
+
+class Simulation;
+
+/// The faces as the engine's plane walls, in face order: the point is the tangent point, the
+/// normal points into the specimen (the engine's plane convention); frictional at the
+/// material's angle unless `friction_deg` >= 0. Named poly1, poly2, ... by App. 3's wall IDs
+/// (the end walls are poly<(n/2 - 1) n + 1> top and poly<(n/2 - 1) n + 2> bottom).
+std::vector<WallSpec> polyhedron_walls(const TangentialPolyhedron& P, double friction_deg = -1);
+
+/// Sets the velocities (Eq 8) and spins (Eq 9) of the engine's walls first .. first + faces - 1
+/// so that the next step of length dt carries each from its current plane to the plane of the
+/// target deformation gradient: the point to F_target X_o, the normal to Eq 7's. Taken from the
+/// walls' current planes (not from the previous target), so no error accumulates.
+void drive_polyhedron(Simulation& sim, std::size_t first, const TangentialPolyhedron& P,
+                      const Eigen::Matrix3d& F_target, double dt);
+
+/// Eq 4 from the engine's walls first .. first + faces - 1: the vertices rebuilt as their planes'
+/// intersections, then F from the faces' area centres.
+Eigen::Matrix3d polyhedron_deformation_gradient(const Simulation& sim, std::size_t first,
+                                                const TangentialPolyhedron& P);
 
 }  // namespace gs::solver

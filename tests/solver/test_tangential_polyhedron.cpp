@@ -12,6 +12,7 @@
 #include <set>
 #include <utility>
 
+#include "simulation.hpp"
 #include "tangential_polyhedron.hpp"
 
 namespace {
@@ -165,4 +166,40 @@ TEST(TangentialPolyhedron, BadSidesOrRadiusAreRejected) {
     EXPECT_THROW(gs::solver::tangential_polyhedron(n, 1.0), std::invalid_argument) << n;
   for (const double R : {0.0, -1.0, std::nan("")})
     EXPECT_THROW(gs::solver::tangential_polyhedron(8, R), std::invalid_argument) << R;
+}
+
+TEST(TangentialPolyhedron, EngineWallsFollowAnImposedDeformationPath) {
+  // The 26 walls of the n = 8 polyhedron as the engine's plane walls, driven step by step along
+  // F(t) = I + t H (stretch, shear and spin at once) for 2000 steps; Eq 4 on the walls' planes
+  // gives F(t) back at every check to round-off, and the one sphere at the centre, touching
+  // nothing, stays put.
+  const TangentialPolyhedron P = gs::solver::tangential_polyhedron(8, 6.6e-3);
+  gs::solver::SimulationConfig cfg;
+  cfg.dt = 1e-6;
+  cfg.material.young_ec = 1e7;
+  cfg.material.stiffness_ratio = 0.3;
+  cfg.material.friction_deg = 30;
+  cfg.material.density = 2700;
+  gs::Particle p;
+  p.radius = 1e-4;
+  gs::solver::Simulation sim(cfg, {p}, gs::solver::polyhedron_walls(P));
+  ASSERT_EQ(sim.walls().size(), 26u);
+  EXPECT_LT(
+      (gs::solver::polyhedron_deformation_gradient(sim, 0, P) - Eigen::Matrix3d::Identity()).norm(),
+      1e-14);
+  Eigen::Matrix3d H;
+  H << -0.10, 0.04, 0.02, -0.03, 0.05, 0.01, 0.06, -0.02, -0.08;
+  const int steps = 2000;
+  for (int k = 1; k <= steps; ++k) {
+    const Eigen::Matrix3d F = Eigen::Matrix3d::Identity() + (double(k) / steps) * H;
+    gs::solver::drive_polyhedron(sim, 0, P, F, cfg.dt);
+    sim.step();
+    if (k % 500 == 0) {
+      SCOPED_TRACE(k);
+      EXPECT_LT((gs::solver::polyhedron_deformation_gradient(sim, 0, P) - F).norm(), 1e-12);
+      for (const auto& w : sim.walls()) EXPECT_NEAR(w.normal.norm(), 1.0, 1e-15);
+    }
+  }
+  EXPECT_EQ(sim.particles().pos[0], Eigen::Vector3d::Zero());
+  EXPECT_EQ(sim.contact_count(), 0u);
 }
