@@ -203,4 +203,52 @@ Eigen::Matrix3d polyhedron_deformation_gradient(const Simulation& sim, std::size
   return deformation_gradient_from_faces(P, vertices_from_planes(P, point, normal));
 }
 
+Eigen::Matrix3d polyhedron_stress(const Simulation& sim, std::size_t first,
+                                  const TangentialPolyhedron& P) {
+  std::vector<Eigen::Vector3d> point, normal;
+  for (std::size_t f = 0; f < P.faces.size(); ++f) {
+    point.push_back(sim.walls()[first + f].pos);
+    normal.push_back(-sim.walls()[first + f].normal);
+  }
+  const double v = polyhedron_volume(vertices_from_planes(P, point, normal), P.faces);
+  Eigen::Matrix3d m = sim.wall_contact_moment(first, P.faces.size());
+  const auto& p = sim.particles();
+  const Eigen::Vector3d g = sim.config().gravity;
+  if (g.squaredNorm() > 0.0)
+    for (std::size_t k = 0; k < p.pos.size(); ++k)
+      if (!p.removed[k]) m += p.pos[k] * (p.mass[k] * g).transpose();
+  return -m / v;
+}
+
+double servo_modulus(double kn, double mean_radius, double circumradius, double relaxation) {
+  if (!(kn > 0.0) || !(mean_radius > 0.0) || !(circumradius > 0.0) || !(relaxation > 0.0))
+    throw std::invalid_argument("servo_modulus needs kn, radii and relaxation > 0");
+  const double A = 4.0 * mean_radius * mean_radius, L = 2.0 * circumradius;
+  return kn * L / (relaxation * A);
+}
+
+Eigen::Matrix3d servo_step(Simulation& sim, std::size_t first, const TangentialPolyhedron& P,
+                           const Eigen::Matrix3d& sigma_target, const PolyhedronServo& servo,
+                           double dt) {
+  if (!(servo.E > 0.0)) throw std::invalid_argument("servo needs E > 0");
+  const Eigen::Matrix3d F = polyhedron_deformation_gradient(sim, first, P);
+  const Eigen::Matrix3d sigma = polyhedron_stress(sim, first, P);
+  Eigen::Matrix3d ds = sigma_target - sigma;
+  ds = 0.5 * (ds + ds.transpose()).eval();
+  const double tr = ds.trace();
+  Eigen::Matrix3d de = (1.0 + servo.nu) / servo.E * ds -
+                       servo.nu / servo.E * tr * Eigen::Matrix3d::Identity();
+  const double dv = de.trace() / 3.0;  // its volumetric part, scaled by the gain
+  de += (servo.volumetric_gain - 1.0) * dv * Eigen::Matrix3d::Identity();
+  const double largest = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(de, Eigen::EigenvaluesOnly)
+                             .eigenvalues()
+                             .cwiseAbs()
+                             .maxCoeff();
+  if (servo.max_strain_step > 0.0 && largest > servo.max_strain_step)
+    de *= servo.max_strain_step / largest;
+  const Eigen::Matrix3d target = F - de;
+  drive_polyhedron(sim, first, P, target, dt);
+  return target;
+}
+
 }  // namespace gs::solver

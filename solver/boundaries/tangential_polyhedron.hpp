@@ -91,4 +91,35 @@ void drive_polyhedron(Simulation& sim, std::size_t first, const TangentialPolyhe
 Eigen::Matrix3d polyhedron_deformation_gradient(const Simulation& sim, std::size_t first,
                                                 const TangentialPolyhedron& P);
 
+/// Eq 14: the specimen's stress from its boundary, σ = -(1/v)(Σ x ⊗ F + Σ x_P ⊗ m_P g) over
+/// the contacts of the walls first .. first + faces - 1 and the particles (v: the polyhedron's
+/// current volume from the walls' planes). Compression positive. Pa.
+Eigen::Matrix3d polyhedron_stress(const Simulation& sim, std::size_t first,
+                                  const TangentialPolyhedron& P);
+
+/// The stress servo of §2.2.2. Eq 15 maps a stress error Δσ = σ_t - σ to a strain increment by
+/// isotropic elasticity, Δε = ((1 + ν)/E) Δσ - (ν/E) tr(Δσ) 1 (principal directions shared),
+/// imposed in one step (F → F - Δε: Biot strain, Eq 2, no rigid rotation). Eq 16 sets E = kn L /
+/// (ς A), A = (2 r̄)², L = 2 R_e (R_e the circumscribed radius), ς = 0.8. The paper's ν = 0.5
+/// makes tr(Δε) = (1 - 2ν) tr(Δσ)/E = 0: the walls never move to correct the mean stress. ν is
+/// a parameter here (default 0.25); `volumetric_gain` scales the volumetric part of Δε on top.
+/// `max_strain_step` caps the largest principal value of Δε in one step (the paper has no
+/// cap: far from the target, before the walls touch the grains, Eq 15 would move them at
+/// Δσ L / (E dt), metres per second).
+struct PolyhedronServo {
+  double E = 0.0;  // Pa, Eq 16
+  double nu = 0.25;
+  double volumetric_gain = 1.0;
+  double max_strain_step = 1e-6;
+};
+
+/// Eq 16's nominal modulus. Throws std::invalid_argument for a non-positive argument.
+double servo_modulus(double kn, double mean_radius, double circumradius, double relaxation = 0.8);
+
+/// One servo step: the walls are driven from their current F (Eq 4) towards F - Δε (Eq 15);
+/// returns that target F.
+Eigen::Matrix3d servo_step(Simulation& sim, std::size_t first, const TangentialPolyhedron& P,
+                           const Eigen::Matrix3d& sigma_target, const PolyhedronServo& servo,
+                           double dt);
+
 }  // namespace gs::solver

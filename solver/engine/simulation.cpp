@@ -1256,6 +1256,18 @@ double Simulation::inertial_number() const {
   return rate * (dsum / static_cast<double>(n)) / std::sqrt(pressure / cfg_.material.density);
 }
 
+Eigen::Matrix3d Simulation::wall_contact_moment(std::size_t first, std::size_t count) const {
+  Eigen::Matrix3d m = Eigen::Matrix3d::Zero();
+  for (const auto& h : hist_) {
+    if (!h.real || h.b < kWallBase) continue;
+    const std::size_t w = h.b - kWallBase;
+    if (w < first || w >= first + count) continue;
+    // Wall pairs: the sphere is the law's body 2 and receives Fn n + Fs (n from the wall to it).
+    m += h.point * (h.fn * h.normal + h.shear_force).transpose();
+  }
+  return m;
+}
+
 double Simulation::unbalanced_force() const {
   double sum_f = 0;
   std::size_t nf = 0;

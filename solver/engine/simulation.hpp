@@ -201,6 +201,10 @@ class Simulation {
   /// YADE's utils.getStress() in a periodic cell: (1/det H)·Σ (Fn + Fs) ⊗ (x1 − x2 − H·cellDist)
   /// over the real contacts (Pa, compression negative; seed 000 eq 12, Love–Weber).
   Eigen::Matrix3d cell_stress() const;
+  /// Σ x ⊗ f over the real contacts of the walls first .. first + count - 1: x the contact
+  /// point, f the force the wall exerts on the sphere (N·m). The boundary term of seed 003's
+  /// Eq 14 (σ = -(1/v)(Σ x ⊗ F + Σ x ⊗ G), compression positive).
+  Eigen::Matrix3d wall_contact_moment(std::size_t first, std::size_t count) const;
   /// The affine stiffness of the contacts along each axis (Pa): K_ii of CellServo.
   Eigen::Vector3d cell_stiffness() const;
   /// The cell servo in force, if any.

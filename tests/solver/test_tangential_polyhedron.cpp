@@ -203,3 +203,4 @@ TEST(TangentialPolyhedron, EngineWallsFollowAnImposedDeformationPath) {
   EXPECT_EQ(sim.particles().pos[0], Eigen::Vector3d::Zero());
   EXPECT_EQ(sim.contact_count(), 0u);
 }
+
