@@ -1,9 +1,16 @@
 #include "common.hpp"
 
+#include <pybind11/pybind11.h>
+
 #include "errors.hpp"
 #include "grain_size.hpp"
 
 namespace gs::py_bind {
+
+void raise_pending_signal() {
+  pybind11::gil_scoped_acquire locked;
+  if (PyErr_CheckSignals() != 0) throw pybind11::error_already_set();
+}
 
 double frame_d50(const Frame& f, std::optional<double> d50) {
   if (d50) {

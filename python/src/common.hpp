@@ -14,6 +14,10 @@ namespace gs::py_bind {
 using OptVec = std::optional<std::vector<double>>;
 constexpr const char* kFrame = "<frame>";  // how messages name a frame given from Python
 
+/// Raises a pending Ctrl-C (KeyboardInterrupt) as a C++ exception that unwinds the library call
+/// it is polled from. Takes the GIL (callable from code that released it; with it held, too).
+void raise_pending_signal();
+
 /// d50 as the CLI's --d50 option gives it, else the frame's (m).
 double frame_d50(const Frame& f, std::optional<double> d50);
 

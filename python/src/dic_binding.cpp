@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "bindings.hpp"
+#include "common.hpp"
 #include "dic_io.hpp"
 #include "dic_run.hpp"
 #include "errors.hpp"
@@ -90,10 +91,7 @@ void bind_dic(py::module_& m) {
         req.threads = threads;
         // Ctrl-C: between propagation fronts, take the GIL and look for a pending signal; its
         // exception (KeyboardInterrupt) unwinds the correlation.
-        req.poll = [] {
-          py::gil_scoped_acquire gil;
-          if (PyErr_CheckSignals() != 0) throw py::error_already_set();
-        };
+        req.poll = raise_pending_signal;
         dic::check_request(req);
         std::vector<py::object> keep;
         std::vector<cv::Mat> mats;
@@ -174,7 +172,7 @@ void bind_dic(py::module_& m) {
             py::gil_scoped_release unlocked;
             r = dic::render_one(ref, f, cam, req);
           }
-          if (PyErr_CheckSignals() != 0) throw py::error_already_set();
+          raise_pending_signal();
           images.push_back(r.image);
           u.push_back(r.truth.u);
           v.push_back(r.truth.v);

@@ -89,10 +89,7 @@ ga::VortexFieldSpec field_spec(bool slice, const OptVec& slab_origin, const OptV
   s.delta = delta;
   s.significance = significance;
   s.significance_abs = significance_abs;
-  s.poll = [] {  // Ctrl-C between the phases and during the projection solver's iterations
-    py::gil_scoped_acquire locked;
-    if (PyErr_CheckSignals() != 0) throw py::error_already_set();
-  };
+  s.poll = raise_pending_signal;  // between the phases and the projection solver's iterations
   return s;
 }
 
@@ -415,8 +412,8 @@ void bind_motion(py::module_& m) {
           return run[py::int_(i)].cast<Frame>();
         };
         const auto report = [&progress](const ga::VortexSeriesStep& p) {
+          raise_pending_signal();
           py::gil_scoped_acquire locked;
-          if (PyErr_CheckSignals() != 0) throw py::error_already_set();
           if (!progress.is_none())
             progress(p.from, p.to, p.strain,
                      py::make_tuple(p.counts[0], p.counts[1], p.counts[2], p.counts[3]));

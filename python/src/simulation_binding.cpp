@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "bindings.hpp"
+#include "common.hpp"
 #include "scene_file.hpp"
 #include "scene_run.hpp"
 
@@ -81,8 +82,8 @@ void bind_simulation(py::module_& m) {
         // Every report: a pending Ctrl-C (KeyboardInterrupt) stops the run after a checkpoint;
         // the callback's False stops it quietly; its exception stops it and is raised.
         o.progress = [&progress](const solver::RunProgress& p) {
+          raise_pending_signal();
           py::gil_scoped_acquire locked;
-          if (PyErr_CheckSignals() != 0) throw py::error_already_set();
           if (progress.is_none()) return true;
           py::dict d;
           d["phase"] = p.phase;
