@@ -7,6 +7,7 @@
 #include <numbers>
 #include <stdexcept>
 #include <string>
+#include <unordered_map>
 
 #include "simulation.hpp"
 
@@ -236,8 +237,8 @@ Eigen::Matrix3d servo_step(Simulation& sim, std::size_t first, const TangentialP
   Eigen::Matrix3d ds = sigma_target - sigma;
   ds = 0.5 * (ds + ds.transpose()).eval();
   const double tr = ds.trace();
-  Eigen::Matrix3d de = (1.0 + servo.nu) / servo.E * ds -
-                       servo.nu / servo.E * tr * Eigen::Matrix3d::Identity();
+  Eigen::Matrix3d de =
+      (1.0 + servo.nu) / servo.E * ds - servo.nu / servo.E * tr * Eigen::Matrix3d::Identity();
   const double dv = de.trace() / 3.0;  // its volumetric part, scaled by the gain
   de += (servo.volumetric_gain - 1.0) * dv * Eigen::Matrix3d::Identity();
   const double largest = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(de, Eigen::EigenvaluesOnly)
@@ -249,6 +250,45 @@ Eigen::Matrix3d servo_step(Simulation& sim, std::size_t first, const TangentialP
   const Eigen::Matrix3d target = F - de;
   drive_polyhedron(sim, first, P, target, dt);
   return target;
+}
+
+Eigen::Matrix3d principal_stress_state(double p, double eta, double b, double alpha) {
+  const double th = std::atan2(std::sqrt(3.0) * b, 2.0 - b);
+  const double k = 2.0 / 3.0 * eta, third = 2.0 * std::numbers::pi / 3.0;
+  const double s1 = p * (1 + k * std::cos(th)), s2 = p * (1 + k * std::cos(third - th)),
+               s3 = p * (1 + k * std::cos(third + th));
+  const Eigen::Vector3d n1(std::cos(alpha), 0, std::sin(alpha)), n2(0, 1, 0),
+      n3(-std::sin(alpha), 0, std::cos(alpha));
+  return s1 * n1 * n1.transpose() + s2 * n2 * n2.transpose() + s3 * n3 * n3.transpose();
+}
+
+bool inside_polyhedron(const TangentialPolyhedron& P, const Eigen::Vector3d& x, double margin) {
+  for (const auto& n : P.normals)
+    if (!(x.dot(n) <= P.R - margin)) return false;
+  return true;
+}
+
+std::vector<std::size_t> carve_polyhedron(const TangentialPolyhedron& P,
+                                          const std::vector<Eigen::Vector3d>& centre,
+                                          const std::vector<double>& radius,
+                                          const std::vector<std::int64_t>& clump) {
+  std::vector<std::uint8_t> keep(centre.size());
+  for (std::size_t k = 0; k < centre.size(); ++k)
+    keep[k] = inside_polyhedron(P, centre[k], radius[k]) ? 1 : 0;
+  if (!clump.empty()) {  // a clump goes as a whole
+    std::unordered_map<std::int64_t, std::uint8_t> whole;
+    for (std::size_t k = 0; k < centre.size(); ++k)
+      if (clump[k] >= 0) {
+        auto [it, fresh] = whole.emplace(clump[k], keep[k]);
+        if (!fresh) it->second &= keep[k];
+      }
+    for (std::size_t k = 0; k < centre.size(); ++k)
+      if (clump[k] >= 0) keep[k] = whole[clump[k]];
+  }
+  std::vector<std::size_t> out;
+  for (std::size_t k = 0; k < centre.size(); ++k)
+    if (keep[k]) out.push_back(k);
+  return out;
 }
 
 }  // namespace gs::solver

@@ -13,6 +13,7 @@
 
 #include <Eigen/Core>
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 #include "dem_types.hpp"
@@ -121,5 +122,22 @@ double servo_modulus(double kn, double mean_radius, double circumradius, double 
 Eigen::Matrix3d servo_step(Simulation& sim, std::size_t first, const TangentialPolyhedron& P,
                            const Eigen::Matrix3d& sigma_target, const PolyhedronServo& servo,
                            double dt);
+
+/// Eq 17 (§2.2.3): the stress of mean p, ratio η = q/p and b = (σ2 - σ3)/(σ1 - σ3) (Lode
+/// angle tan θ = √3 b / (2 - b)), with σ1 in the x-z plane at angle alpha (rad) from x, σ2 along
+/// y and σ3 normal to both: the states of the rotation path (§2.2.3, Fig 3). Pa, compression
+/// positive.
+Eigen::Matrix3d principal_stress_state(double p, double eta, double b, double alpha);
+
+/// Whether x lies inside the polyhedron at least `margin` from every face.
+bool inside_polyhedron(const TangentialPolyhedron& P, const Eigen::Vector3d& x, double margin);
+
+/// §2.4's carving: the indices of the spheres to keep, those whole inside (a sphere touching or
+/// crossing a face goes). With `clump` (per sphere, -1: free) a clump stays only if all its
+/// members do.
+std::vector<std::size_t> carve_polyhedron(const TangentialPolyhedron& P,
+                                          const std::vector<Eigen::Vector3d>& centre,
+                                          const std::vector<double>& radius,
+                                          const std::vector<std::int64_t>& clump = {});
 
 }  // namespace gs::solver

@@ -16,22 +16,6 @@
 
 using gs::solver::TangentialPolyhedron;
 
-namespace {
-
-// Eq 17: principal stresses from p, η and b (Lode angle tan θ = √3 b / (2 - b)), σ1 in the x-z
-// plane at angle alpha from x, σ2 along y (seed 003 §2.2.3 and §2.2.3's rotation path).
-Eigen::Matrix3d stress_state(double p, double eta, double b, double alpha) {
-  const double th = std::atan2(std::sqrt(3.0) * b, 2.0 - b);
-  const double s1 = p * (1 + 2.0 / 3.0 * eta * std::cos(th));
-  const double s2 = p * (1 + 2.0 / 3.0 * eta * std::cos(2 * std::numbers::pi / 3 - th));
-  const double s3 = p * (1 + 2.0 / 3.0 * eta * std::cos(2 * std::numbers::pi / 3 + th));
-  const Eigen::Vector3d n1(std::cos(alpha), 0, std::sin(alpha)), n2(0, 1, 0),
-      n3(-std::sin(alpha), 0, std::cos(alpha));
-  return s1 * n1 * n1.transpose() + s2 * n2 * n2.transpose() + s3 * n3 * n3.transpose();
-}
-
-}  // namespace
-
 TEST(TangentialPolyhedron, StressServoHoldsMeanStressDeviatorAndDirections) {
   // About 1 300 spheres (r = 0.48 mm, jittered cubic sites 1 mm apart) in the n = 8 polyhedron
   // of R = 6.6 mm, frictional, strongly damped (seed 003's quasi-static 0.7); the servo of
@@ -45,11 +29,9 @@ TEST(TangentialPolyhedron, StressServoHoldsMeanStressDeviatorAndDirections) {
   for (int i = -8; i <= 8; ++i)
     for (int j = -8; j <= 8; ++j)
       for (int k = -8; k <= 8; ++k) {
-        const Eigen::Vector3d x = a * Eigen::Vector3d(i, j, k) +
-                                  Eigen::Vector3d(jitter(rng), jitter(rng), jitter(rng));
-        bool inside = true;
-        for (const auto& n : P.normals) inside = inside && x.dot(n) <= R - 1.05 * r;
-        if (!inside) continue;
+        const Eigen::Vector3d x =
+            a * Eigen::Vector3d(i, j, k) + Eigen::Vector3d(jitter(rng), jitter(rng), jitter(rng));
+        if (!gs::solver::inside_polyhedron(P, x, 1.05 * r)) continue;
         gs::Particle q;
         q.id = static_cast<std::int64_t>(ps.size());
         q.position = x;
@@ -84,7 +66,8 @@ TEST(TangentialPolyhedron, StressServoHoldsMeanStressDeviatorAndDirections) {
   const Eigen::Matrix3d iso = p0 * Eigen::Matrix3d::Identity();
   Eigen::Matrix3d s = run_to(iso, 20000);
   EXPECT_LT((s - iso).norm() / p0, 0.02) << s;
-  const Eigen::Matrix3d target = stress_state(p0, 0.5, 0.5, 30 * std::numbers::pi / 180);
+  const Eigen::Matrix3d target =
+      gs::solver::principal_stress_state(p0, 0.5, 0.5, 30 * std::numbers::pi / 180);
   s = run_to(target, 20000);
   const double reached = (s - target).norm() / p0;
   EXPECT_LT(reached, 0.03) << s << "\n" << target;

@@ -204,3 +204,73 @@ TEST(TangentialPolyhedron, EngineWallsFollowAnImposedDeformationPath) {
   EXPECT_EQ(sim.contact_count(), 0u);
 }
 
+TEST(TangentialPolyhedron, Eq17StatesHaveTheirInvariantsAndDirections) {
+  // p, q = η p, b and the major direction back from the tensor, for states along the path.
+  for (const double eta : {0.0, 0.5, 0.9})
+    for (const double b : {0.0, 0.5, 1.0})
+      for (const double deg : {0.0, 30.0, 90.0, 135.0}) {
+        SCOPED_TRACE(eta);
+        SCOPED_TRACE(b);
+        SCOPED_TRACE(deg);
+        const double p = 5e5, alpha = deg * std::numbers::pi / 180;
+        const Eigen::Matrix3d s = gs::solver::principal_stress_state(p, eta, b, alpha);
+        EXPECT_NEAR((s - s.transpose()).norm(), 0.0, 1e-9);
+        EXPECT_NEAR(s.trace() / 3, p, 1e-9 * p);
+        Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> e(s);
+        const Eigen::Vector3d v = e.eigenvalues();  // ascending: σ3, σ2, σ1
+        const double q =
+            std::sqrt(0.5 * ((v[2] - v[1]) * (v[2] - v[1]) + (v[1] - v[0]) * (v[1] - v[0]) +
+                             (v[2] - v[0]) * (v[2] - v[0])));
+        EXPECT_NEAR(q, eta * p, 1e-9 * p);
+        if (eta > 0) {
+          EXPECT_NEAR((v[1] - v[0]) / (v[2] - v[0]), b, 1e-12);
+          const Eigen::Vector3d n1 = e.eigenvectors().col(2);
+          if (b < 1.0) {  // (b = 1: σ1 = σ2, the major direction is not unique)
+            const Eigen::Vector3d major(std::cos(alpha), 0, std::sin(alpha));
+            EXPECT_NEAR(std::abs(n1.dot(major)), 1.0, 1e-12);
+          }
+        }
+        // σ2 acts along y: y is a principal direction whatever α.
+        EXPECT_NEAR(s(0, 1), 0.0, 1e-9);
+        EXPECT_NEAR(s(2, 1), 0.0, 1e-9);
+      }
+}
+
+TEST(TangentialPolyhedron, CarvingKeepsWholeSpheresAndWholeClumps) {
+  const double R = 6.6e-3, r = 0.4e-3;
+  const TangentialPolyhedron P = gs::solver::tangential_polyhedron(8, R);
+  std::vector<Eigen::Vector3d> x;
+  std::vector<double> rad;
+  std::vector<std::int64_t> clump;
+  // Dimers along x on a grid through and beyond the polyhedron (members 1.4 r apart).
+  std::int64_t c = 0;
+  for (double gx = -9e-3; gx <= 9e-3; gx += 1.5e-3)
+    for (double gy = -9e-3; gy <= 9e-3; gy += 1.1e-3)
+      for (double gz = -9e-3; gz <= 9e-3; gz += 1.1e-3, ++c)
+        for (const double dx : {-0.7 * r, 0.7 * r}) {
+          x.emplace_back(gx + dx, gy, gz);
+          rad.push_back(r);
+          clump.push_back(c);
+        }
+  const auto spheres = gs::solver::carve_polyhedron(P, x, rad);
+  const auto clumps = gs::solver::carve_polyhedron(P, x, rad, clump);
+  std::vector<std::uint8_t> kept(x.size(), 0);
+  for (const auto k : spheres) kept[k] = 1;
+  for (std::size_t k = 0; k < x.size(); ++k) {
+    // Kept: every point of the sphere inside every face; gone: some point outside some face.
+    double reach = -1e9;
+    for (const auto& n : P.normals) reach = std::max(reach, x[k].dot(n) + rad[k] - R);
+    EXPECT_EQ(kept[k] == 1, reach <= 0.0) << k;
+  }
+  // Whole clumps: both members kept or both gone, and only clumps whose members both fit.
+  std::vector<std::uint8_t> kc(x.size(), 0);
+  for (const auto k : clumps) kc[k] = 1;
+  std::size_t both = 0;
+  for (std::size_t k = 0; k + 1 < x.size(); k += 2) {
+    EXPECT_EQ(kc[k], kc[k + 1]);
+    EXPECT_EQ(kc[k] == 1, kept[k] == 1 && kept[k + 1] == 1);
+    both += kc[k];
+  }
+  EXPECT_GT(both, 100u);
+  EXPECT_LT(clumps.size(), spheres.size());
+}
