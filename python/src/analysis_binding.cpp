@@ -41,6 +41,22 @@ ga::Selection selection_of(const Frame& f, bool slab, const OptVec& slab_origin,
       selection_spec(slab, slab_origin, slab_normal, slab_axis, slab_thickness, slab_d50, region));
 }
 
+// The invariants of a stress tensor under their C++ names (`invariants`' "stress" dict and
+// `stress_invariants`).
+void put_stress_invariants(py::dict& d, const ga::StressInvariants& s) {
+  d["p"] = s.p;
+  d["q"] = s.q;
+  d["eta"] = s.eta;
+  d["b"] = s.b;
+  d["lode_deg"] = s.lode_deg;
+  d["phi_mob_deg"] = s.phi_mob_deg;
+  d["j2d"] = s.j2d;
+  d["j3d"] = s.j3d;
+  d["asymmetry"] = s.asymmetry;
+  d["principal"] = s.principal;
+  d["directions"] = s.directions;
+}
+
 }  // namespace
 
 void bind_analysis(py::module_& m) {
@@ -260,17 +276,7 @@ void bind_analysis(py::module_& m) {
         if (sigma) {
           const ga::StressInvariants s = ga::stress_invariants(*sigma, dim);
           sd["tensor"] = *sigma;
-          sd["p"] = s.p;
-          sd["q"] = s.q;
-          sd["eta"] = s.eta;
-          sd["b"] = s.b;
-          sd["lode_deg"] = s.lode_deg;
-          sd["phi_mob_deg"] = s.phi_mob_deg;
-          sd["j2d"] = s.j2d;
-          sd["j3d"] = s.j3d;
-          sd["asymmetry"] = s.asymmetry;
-          sd["principal"] = s.principal;
-          sd["directions"] = s.directions;
+          put_stress_invariants(sd, s);
           out["stress"] = sd;
         }
         if (F) {
@@ -313,17 +319,7 @@ void bind_analysis(py::module_& m) {
         if (dim != 2 && dim != 3) throw InputError("dim", "must be 2 or 3", std::to_string(dim));
         const ga::StressInvariants s = ga::stress_invariants(sigma, dim);
         py::dict out;
-        out["p"] = s.p;
-        out["q"] = s.q;
-        out["eta"] = s.eta;
-        out["b"] = s.b;
-        out["lode_deg"] = s.lode_deg;
-        out["phi_mob_deg"] = s.phi_mob_deg;
-        out["j2d"] = s.j2d;
-        out["j3d"] = s.j3d;
-        out["principal"] = s.principal;
-        out["directions"] = s.directions;
-        out["asymmetry"] = s.asymmetry;
+        put_stress_invariants(out, s);
         return out;
       },
       py::arg("sigma"), py::arg("dim") = 3,

@@ -98,26 +98,27 @@ TangentialPolyhedron tangential_polyhedron(int n, double R) {
       P.faces[f] = std::vector<int>(P.faces[f].rbegin(), P.faces[f].rend());
     P.tangent.push_back(R * P.normals[f]);
   }
+  for (const auto& f : P.faces) {  // the reference measures of Eq 4, from the oriented polygons
+    std::vector<Eigen::Vector3d> p;
+    for (const int k : f) p.push_back(P.vertices[static_cast<std::size_t>(k)]);
+    const PolygonMeasure m = polygon_measure(p);
+    P.face_normal.push_back(m.normal);
+    P.area.push_back(m.area);
+  }
+  P.volume = polyhedron_volume(P.vertices, P.faces);
   return P;
 }
 
 Eigen::Matrix3d deformation_gradient_from_faces(const TangentialPolyhedron& ref,
                                                 const std::vector<Eigen::Vector3d>& current) {
   Eigen::Matrix3d sum = Eigen::Matrix3d::Zero();
-  double volume = 0.0;
-  for (const auto& f : ref.faces) {
-    std::vector<Eigen::Vector3d> p0, p;
-    for (const int k : f) {
-      p0.push_back(ref.vertices[static_cast<std::size_t>(k)]);
-      p.push_back(current[static_cast<std::size_t>(k)]);
-    }
-    const PolygonMeasure m0 = polygon_measure(p0);
-    const PolygonMeasure m = polygon_measure(p);
-    // Eq 4 with N the inward normal: -x^c N^T ΔS = x^c n_out^T ΔS.
-    sum += m.centre * m0.normal.transpose() * m0.area;
-    volume += m0.centre.dot(m0.normal) * m0.area / 3.0;
+  for (std::size_t f = 0; f < ref.faces.size(); ++f) {
+    std::vector<Eigen::Vector3d> p;
+    for (const int k : ref.faces[f]) p.push_back(current[static_cast<std::size_t>(k)]);
+    // Eq 4 with N the inward normal: -x^c N^T ΔS = x^c n_out^T ΔS (reference n_out, ΔS, V).
+    sum += polygon_measure(p).centre * ref.face_normal[f].transpose() * ref.area[f];
   }
-  return sum / volume;
+  return sum / ref.volume;
 }
 
 std::vector<Eigen::Vector3d> vertices_from_planes(const TangentialPolyhedron& ref,
@@ -137,26 +138,32 @@ std::vector<Eigen::Vector3d> vertices_from_planes(const TangentialPolyhedron& re
   return out;
 }
 
-std::vector<WallMotion> wall_motions(const TangentialPolyhedron& ref, const Eigen::Matrix3d& F,
-                                     const Eigen::Matrix3d& F_target, double dt) {
-  if (!(dt > 0.0)) throw std::invalid_argument("wall_motions needs dt > 0");
-  std::vector<WallMotion> out;
+std::vector<WallPlane> wall_planes(const TangentialPolyhedron& ref, const Eigen::Matrix3d& F) {
+  std::vector<WallPlane> out;
   for (std::size_t f = 0; f < ref.faces.size(); ++f) {
-    const Eigen::Vector3d X = ref.tangent[f], N = ref.normals[f];
+    const Eigen::Vector3d N = ref.normals[f];
     // Two in-plane vectors of the reference wall (Eq 6 maps them; Eq 7 gives the normal).
     const Eigen::Vector3d T1 =
         (std::abs(N.z()) < 0.9 ? Eigen::Vector3d::UnitZ() : Eigen::Vector3d::UnitX())
             .cross(N)
             .normalized();
     const Eigen::Vector3d T2 = N.cross(T1);
-    const auto normal_of = [&](const Eigen::Matrix3d& G) {
-      return Eigen::Vector3d((G * T1).cross(G * T2).normalized());
-    };
+    out.push_back({F * ref.tangent[f], (F * T1).cross(F * T2).normalized()});
+  }
+  return out;
+}
+
+std::vector<WallMotion> wall_motions(const TangentialPolyhedron& ref, const Eigen::Matrix3d& F,
+                                     const Eigen::Matrix3d& F_target, double dt) {
+  if (!(dt > 0.0)) throw std::invalid_argument("wall_motions needs dt > 0");
+  const auto now = wall_planes(ref, F), next = wall_planes(ref, F_target);
+  std::vector<WallMotion> out;
+  for (std::size_t f = 0; f < ref.faces.size(); ++f) {
     WallMotion m;
-    m.centre = F * X;                                               // Eq 5
-    m.normal = normal_of(F);                                        // Eq 7
-    m.velocity = (F_target - F) * X / dt;                           // Eq 8
-    m.angular_velocity = m.normal.cross(normal_of(F_target)) / dt;  // Eq 9
+    m.centre = now[f].centre;                                  // Eq 5
+    m.normal = now[f].normal;                                  // Eq 7
+    m.velocity = (F_target - F) * ref.tangent[f] / dt;         // Eq 8
+    m.angular_velocity = m.normal.cross(next[f].normal) / dt;  // Eq 9
     out.push_back(m);
   }
   return out;
@@ -178,7 +185,7 @@ std::vector<WallSpec> polyhedron_walls(const TangentialPolyhedron& P, double fri
 
 void drive_polyhedron(Simulation& sim, std::size_t first, const TangentialPolyhedron& P,
                       const Eigen::Matrix3d& F_target, double dt) {
-  const auto target = wall_motions(P, F_target, F_target, dt);
+  const auto target = wall_planes(P, F_target);
   auto& walls = sim.mutable_walls();
   for (std::size_t f = 0; f < P.faces.size(); ++f) {
     WallState& w = walls[first + f];
@@ -194,24 +201,24 @@ void drive_polyhedron(Simulation& sim, std::size_t first, const TangentialPolyhe
   }
 }
 
-Eigen::Matrix3d polyhedron_deformation_gradient(const Simulation& sim, std::size_t first,
-                                                const TangentialPolyhedron& P) {
+namespace {
+
+// The polyhedron's current vertices: the intersections of the engine walls' planes.
+std::vector<Eigen::Vector3d> current_vertices(const Simulation& sim, std::size_t first,
+                                              const TangentialPolyhedron& P) {
   std::vector<Eigen::Vector3d> point, normal;
   for (std::size_t f = 0; f < P.faces.size(); ++f) {
     point.push_back(sim.walls()[first + f].pos);
     normal.push_back(-sim.walls()[first + f].normal);
   }
-  return deformation_gradient_from_faces(P, vertices_from_planes(P, point, normal));
+  return vertices_from_planes(P, point, normal);
 }
 
-Eigen::Matrix3d polyhedron_stress(const Simulation& sim, std::size_t first,
-                                  const TangentialPolyhedron& P) {
-  std::vector<Eigen::Vector3d> point, normal;
-  for (std::size_t f = 0; f < P.faces.size(); ++f) {
-    point.push_back(sim.walls()[first + f].pos);
-    normal.push_back(-sim.walls()[first + f].normal);
-  }
-  const double v = polyhedron_volume(vertices_from_planes(P, point, normal), P.faces);
+// Eq 14 over the volume of the `current` vertices.
+Eigen::Matrix3d stress_within(const Simulation& sim, std::size_t first,
+                              const TangentialPolyhedron& P,
+                              const std::vector<Eigen::Vector3d>& current) {
+  const double v = polyhedron_volume(current, P.faces);
   Eigen::Matrix3d m = sim.wall_contact_moment(first, P.faces.size());
   const auto& p = sim.particles();
   const Eigen::Vector3d g = sim.config().gravity;
@@ -219,6 +226,18 @@ Eigen::Matrix3d polyhedron_stress(const Simulation& sim, std::size_t first,
     for (std::size_t k = 0; k < p.pos.size(); ++k)
       if (!p.removed[k]) m += p.pos[k] * (p.mass[k] * g).transpose();
   return -m / v;
+}
+
+}  // namespace
+
+Eigen::Matrix3d polyhedron_deformation_gradient(const Simulation& sim, std::size_t first,
+                                                const TangentialPolyhedron& P) {
+  return deformation_gradient_from_faces(P, current_vertices(sim, first, P));
+}
+
+Eigen::Matrix3d polyhedron_stress(const Simulation& sim, std::size_t first,
+                                  const TangentialPolyhedron& P) {
+  return stress_within(sim, first, P, current_vertices(sim, first, P));
 }
 
 double servo_modulus(double kn, double mean_radius, double circumradius, double relaxation) {
@@ -232,8 +251,9 @@ Eigen::Matrix3d servo_step(Simulation& sim, std::size_t first, const TangentialP
                            const Eigen::Matrix3d& sigma_target, const PolyhedronServo& servo,
                            double dt) {
   if (!(servo.E > 0.0)) throw std::invalid_argument("servo needs E > 0");
-  const Eigen::Matrix3d F = polyhedron_deformation_gradient(sim, first, P);
-  const Eigen::Matrix3d sigma = polyhedron_stress(sim, first, P);
+  const auto current = current_vertices(sim, first, P);  // (once: F and the volume)
+  const Eigen::Matrix3d F = deformation_gradient_from_faces(P, current);
+  const Eigen::Matrix3d sigma = stress_within(sim, first, P, current);
   Eigen::Matrix3d ds = sigma_target - sigma;
   ds = 0.5 * (ds + ds.transpose()).eval();
   const double tr = ds.trace();

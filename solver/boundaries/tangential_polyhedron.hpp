@@ -27,8 +27,11 @@ struct TangentialPolyhedron {
   // Faces in App. 3's wall order: the (n/2 - 1) n side walls (ID (i - 1) n + j, 1-based), then
   // the top and the bottom end wall. Vertex indices counter-clockwise seen from outside.
   std::vector<std::vector<int>> faces;
-  std::vector<Eigen::Vector3d> normals;  // outward unit normals
-  std::vector<Eigen::Vector3d> tangent;  // tangent points on the sphere (= R · normal)
+  std::vector<Eigen::Vector3d> normals;      // outward unit normals
+  std::vector<Eigen::Vector3d> tangent;      // tangent points on the sphere (= R · normal)
+  std::vector<Eigen::Vector3d> face_normal;  // outward, of the vertex polygons (Eq 4's N)
+  std::vector<double> area;                  // face areas, m² (Eq 4's reference ΔS)
+  double volume = 0.0;                       // m³ (Eq 4's reference V)
 };
 
 /// The polyhedron of App. 3. Throws std::invalid_argument for n odd or below 4, or R <= 0 (or
@@ -59,6 +62,14 @@ Eigen::Matrix3d deformation_gradient_from_faces(const TangentialPolyhedron& refe
 std::vector<Eigen::Vector3d> vertices_from_planes(const TangentialPolyhedron& reference,
                                                   const std::vector<Eigen::Vector3d>& point,
                                                   const std::vector<Eigen::Vector3d>& normal);
+
+/// The walls' planes under deformation gradient F: each centre (the reference tangent point X_o)
+/// mapped to F X_o (Eq 5), each normal to Eq 7's (t1 × t2 of the mapped in-plane vectors, Eq 6).
+struct WallPlane {
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();  // m
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();  // outward
+};
+std::vector<WallPlane> wall_planes(const TangentialPolyhedron& reference, const Eigen::Matrix3d& F);
 
 /// A wall's motion over one step towards deformation gradient F_target from F (Eqs 5-9): the
 /// velocity of its centre (the reference tangent point X_o mapped by F) and its spin.

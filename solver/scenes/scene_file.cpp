@@ -908,6 +908,15 @@ bool scene_has_sweep(const std::filesystem::path& path) {
 
 namespace {
 
+/// "a.b.c" -> {"a", "b", "c"} (a sweep's or an override's key).
+std::vector<std::string> dotted_parts(const std::string& key) {
+  std::vector<std::string> parts;
+  std::string part;
+  std::istringstream in(key);
+  while (std::getline(in, part, '.')) parts.push_back(part);
+  return parts;
+}
+
 /// Sets `key` (SECTION.KEY, SECTION.INDEX.KEY for arrays of tables) of `root` to the TOML value
 /// `value`; missing sections are created.
 template <class Reader>
@@ -920,12 +929,7 @@ void apply_override(const Reader& r, toml::table& root, const std::string& key,
     r.fail(key, "not a TOML value", value);
   }
   if (parsed.size() != 1) r.fail(key, "not a TOML value", value);
-  std::vector<std::string> parts;
-  {
-    std::string part;
-    std::istringstream in(key);
-    while (std::getline(in, part, '.')) parts.push_back(part);
-  }
+  const std::vector<std::string> parts = dotted_parts(key);
   if (parts.size() < 2 || parts[0] == "sweep") r.fail(key, "expected SECTION.KEY to set", key);
   toml::node* node = &root;
   for (std::size_t i = 0; i + 1 < parts.size(); ++i) {
@@ -973,12 +977,7 @@ Scene load_scene(const std::filesystem::path& path, int sweep_point,
     const std::string key = r.string(sw, "sweep", "key", true, "");
     const auto* values = (*sw)["values"].as_array();
     if (!values || values->empty()) r.fail("sweep.values", "expected a non-empty array");
-    std::vector<std::string> parts;
-    {
-      std::string part;
-      std::istringstream in(key);
-      while (std::getline(in, part, '.')) parts.push_back(part);
-    }
+    const std::vector<std::string> parts = dotted_parts(key);
     if (parts.size() < 2 || parts[0] == "sweep")
       r.fail("sweep.key", "expected SECTION.KEY of another section", key);
     toml::table* t = &root;
