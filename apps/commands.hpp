@@ -32,6 +32,8 @@ void register_analyze_contacts(CLI::App& app);
 
 /// `granoscope analyze silo` (apps/cmd_silo.cpp).
 void register_analyze_silo(CLI::App& app);
+/// `granoscope analyze rotation` (apps/cmd_rotation.cpp).
+void register_analyze_rotation(CLI::App& app);
 /// `granoscope analyze interface` (apps/cmd_interface.cpp).
 void register_analyze_interface(CLI::App& app);
 

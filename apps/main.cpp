@@ -68,6 +68,7 @@ int main(int argc, char** argv) {
   gs::cli::register_analyze_rev(app);
   gs::cli::register_analyze_contacts(app);
   gs::cli::register_analyze_silo(app);
+  gs::cli::register_analyze_rotation(app);
   gs::cli::register_analyze_interface(app);
   gs::cli::register_analyze_hhd(app);
   gs::cli::register_analyze_materials(app);

@@ -6,6 +6,10 @@ curve.csv (and preparation.csv) beside the trajectory; nothing when there is non
   interface shear: φs (μeff = T/P on the right) and εv vs u (seed 004 Figs 4.37-4.38, 4.73-4.74);
   silo: P/G, T/G, N/G per wall vs the bottom's travel u or the discharge time (seed 004 §5.3.1);
   periodic biaxial (2D): σ22 − σ11 and σ22/σ11 vs ε22, area strain vs ε22 (seed 002 Fig 7b);
+  principal stress rotation: the six stress and strain components against α, the x-z strain
+  trajectory and εv, εyy against cycles (seed 003 Figs 5-7, 9; strains from the rotation's
+  start); with `granoscope analyze rotation RUN -o DIR` written beside the run (DIR = the run's
+  `rotation/`), also the non-coaxiality against α and the fabric loop (Figs 10, 14);
   preparation: void ratio and friction against steps."""
 import csv
 import os
@@ -118,6 +122,65 @@ def preparation(c, title):
     return fig
 
 
+def rotation(c, title):
+    k = c["stage"] >= 4
+    a = c["alpha_deg"][k]
+    e0 = {n: c[n][k][0] for n in ("exx", "eyy", "ezz", "exy", "exz", "eyz", "eps_v")}
+    fig, ax = plt.subplots(2, 2, figsize=(11, 8))
+    for n, lab in (("sxx", "σxx"), ("syy", "σyy"), ("szz", "σzz"), ("sxy", "σxy"),
+                   ("sxz", "σxz"), ("syz", "σyz")):
+        ax[0, 0].plot(a, c[n + "_Pa"][k] / 1e3, lw=0.8, label=lab)
+    ax[0, 0].set_xlabel("α, σ1 from z (°)")
+    ax[0, 0].set_ylabel("stress (kPa, compression +)")
+    ax[0, 0].legend(ncol=3, fontsize=8)
+    for n in ("exx", "eyy", "ezz", "exy", "exz", "eyz"):
+        ax[0, 1].plot(a, 100 * (c[n][k] - e0[n]), lw=0.8, label="ε" + n[1:])
+    ax[0, 1].set_xlabel("α (°)")
+    ax[0, 1].set_ylabel("strain from the rotation's start (%, compression +)")
+    ax[0, 1].legend(ncol=3, fontsize=8)
+    dx = 100 * 0.5 * ((c["exx"][k] - e0["exx"]) - (c["ezz"][k] - e0["ezz"]))
+    ax[1, 0].plot(dx, 100 * (c["exz"][k] - e0["exz"]), lw=0.8)
+    ax[1, 0].set_xlabel("(εxx − εzz)/2 (%)")
+    ax[1, 0].set_ylabel("εxz (%)")
+    ax[1, 0].set_title("x–z strain trajectory (Fig 7)", fontsize=9)
+    ax[1, 0].set_aspect("equal", adjustable="datalim")
+    cyc = a / 180.0
+    ax[1, 1].plot(cyc, 100 * (c["eps_v"][k] - e0["eps_v"]), label="εv")
+    ax[1, 1].plot(cyc, 100 * (c["eyy"][k] - e0["eyy"]), label="εyy")
+    ax[1, 1].set_xlabel("cycles (180° each)")
+    ax[1, 1].set_ylabel("strain (%, compression +)")
+    ax[1, 1].legend()
+    fig.suptitle(title)
+    fig.tight_layout()
+    return fig
+
+
+def rotation_report(here, title):
+    """Non-coaxiality against α and the fabric loop, from `analyze rotation`'s tables."""
+    inc, fab = (os.path.join(here, "rotation", f) for f in
+                ("rotation_increments.csv", "rotation_fabric.csv"))
+    if not (os.path.exists(inc) and os.path.exists(fab)):
+        return None
+    i, f = read(inc), read(fab)
+    fig, (a1, a2) = plt.subplots(1, 2, figsize=(11, 4.5))
+    a1.plot(i["alpha_deg"], i["non_coaxiality_deg"], ".-", lw=0.8)
+    a1.axhspan(30, 40, color="0.9", label="seed 003: 30–40°")
+    a1.set_xlabel("α (°)")
+    a1.set_ylabel("α^R_Δε − α (°)")
+    a1.set_title("non-coaxiality (Fig 10)", fontsize=9)
+    a1.legend()
+    a2.plot(0.5 * (f["Dxx"] - f["Dzz"]), f["Dxz"], "o-", ms=3, lw=0.8)
+    a2.axhline(0, color="0.6", lw=0.5)
+    a2.axvline(0, color="0.6", lw=0.5)
+    a2.set_xlabel("(Dxx − Dzz)/2")
+    a2.set_ylabel("Dxz")
+    a2.set_title("contact fabric loop (Fig 14)", fontsize=9)
+    a2.set_aspect("equal", adjustable="datalim")
+    fig.suptitle(title)
+    fig.tight_layout()
+    return fig
+
+
 def make(path, out_dir, args):
     here = os.path.dirname(os.path.abspath(path))
     stem = os.path.splitext(os.path.basename(path))[0]
@@ -125,7 +188,12 @@ def make(path, out_dir, args):
     curve = os.path.join(here, "curve.csv")
     if os.path.exists(curve):
         c = read(curve)
-        if "mu_eff" in c:
+        if "alpha_sigma_deg" in c:
+            fig = rotation(c, f"{stem}: principal stress rotation")
+            report = rotation_report(here, f"{stem}: principal stress rotation")
+            if report is not None:
+                written.append(figutil.save(report, out_dir, f"{stem}_rotation.png"))
+        elif "mu_eff" in c:
             fig = interface(c, f"{stem}: interface shear")
         elif "P_G" in c:
             fig = silo(c, f"{stem}: silo")

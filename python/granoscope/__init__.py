@@ -17,12 +17,12 @@ import os as _os
 
 from . import _granoscope as _c
 from ._granoscope import (Error, Frame, Trajectory, chains, d50, dic, fabric, hhd, interface,
-                          invariants, materials, render, rev, rose, shearzone, silo, strain,
-                          stress_invariants, voidcells, vortices, walls)
+                          invariants, materials, render, rev, rose, rotation, shearzone, silo,
+                          strain, stress_invariants, voidcells, vortices, walls)
 
 __all__ = ["Error", "FileNotFound", "Frame", "Run", "Scene", "Trajectory", "open", "save",
            "chains", "d50", "dic", "fabric", "hhd", "interface", "invariants", "materials",
-           "render", "rev", "rose", "shearzone", "silo", "strain", "stress_invariants",
+           "render", "rev", "rose", "rotation", "shearzone", "silo", "strain", "stress_invariants",
            "voidcells", "vortices", "walls", "__version__"]
 
 from .simulation import Run, Scene  # noqa: E402 (needs the compiled module)

@@ -1,11 +1,14 @@
-// granoscope.silo, .interface and .materials: the scene reports of `granoscope analyze silo |
-// interface | materials` (seed 004 §5.3 and §4.3-4.4, the DEM8 drum's mixing monitor), through
-// the same library calls (analysis/silo_series.hpp, interface_zone.hpp, material_zones.hpp).
+// granoscope.rotation, .silo, .interface and .materials: the scene reports of `granoscope analyze
+// rotation | silo | interface | materials` (seed 003 §3-4, seed 004 §5.3 and §4.3-4.4, the DEM8
+// drum's mixing monitor), through the same library calls (analysis/rotation_report.hpp,
+// silo_series.hpp, interface_zone.hpp, material_zones.hpp).
 #include <pybind11/eigen.h>
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
+#include <pybind11/stl/filesystem.h>
 
+#include <filesystem>
 #include <optional>
 #include <string>
 #include <vector>
@@ -16,6 +19,7 @@
 #include "errors.hpp"
 #include "interface_zone.hpp"
 #include "material_zones.hpp"
+#include "rotation_report.hpp"
 #include "silo_series.hpp"
 
 namespace py = pybind11;
@@ -50,6 +54,38 @@ Eigen::Vector3d vec3(const std::vector<double>& v, const char* name) {
 }  // namespace
 
 void bind_reports(py::module_& m) {
+  m.def(
+      "rotation",
+      [](py::object run, const std::filesystem::path& curve, double window_deg) {
+        if (!(window_deg > 0))
+          throw InputError(kRun, "window_deg must be positive", std::to_string(window_deg));
+        std::vector<Frame> frames;
+        const auto n = static_cast<long>(py::len(run));
+        for (long i = 0; i < n; ++i) frames.push_back(run[py::int_(i)].cast<Frame>());
+        ga::RotationReport r;
+        {
+          py::gil_scoped_release unlocked;
+          r = ga::rotation_report(ga::read_rotation_curve(curve), frames, window_deg,
+                                  curve.string(), kRun);
+        }
+        const auto table = [](const ga::RotationColumns& c) {
+          py::dict d;
+          for (const auto& [name, v] : c) d[py::str(name)] = array1(v);
+          return d;
+        };
+        py::dict out;
+        out["strain"] = table(ga::rotation_strain_table(r));
+        out["increments"] = table(ga::rotation_increments_table(r));
+        out["fabric"] = table(ga::rotation_fabric_table(r));
+        out["cycles"] = table(ga::rotation_cycles_table(r));
+        return out;
+      },
+      py::arg("run"), py::arg("curve"), py::arg("window_deg") = 3.0,
+      "Principal stress rotation report as `granoscope analyze rotation` (seed 003 §3-4) of a "
+      "stress_rotation run (a Trajectory or list of Frames) and its curve.csv: dicts 'strain', "
+      "'increments', 'fabric' and 'cycles' of numpy columns, named as the CSV files' columns "
+      "(docs/rotation.md).");
+
   m.def(
       "silo",
       [](py::object run, std::vector<double> up, std::vector<double> across, long from_frame,

@@ -235,6 +235,11 @@ Eigen::Matrix3d polyhedron_deformation_gradient(const Simulation& sim, std::size
   return deformation_gradient_from_faces(P, current_vertices(sim, first, P));
 }
 
+double polyhedron_current_volume(const Simulation& sim, std::size_t first,
+                                 const TangentialPolyhedron& P) {
+  return polyhedron_volume(current_vertices(sim, first, P), P.faces);
+}
+
 Eigen::Matrix3d polyhedron_stress(const Simulation& sim, std::size_t first,
                                   const TangentialPolyhedron& P) {
   return stress_within(sim, first, P, current_vertices(sim, first, P));
@@ -249,11 +254,13 @@ double servo_modulus(double kn, double mean_radius, double circumradius, double 
 
 Eigen::Matrix3d servo_step(Simulation& sim, std::size_t first, const TangentialPolyhedron& P,
                            const Eigen::Matrix3d& sigma_target, const PolyhedronServo& servo,
-                           double dt) {
+                           double dt, Eigen::Matrix3d* sigma_now, Eigen::Matrix3d* F_now) {
   if (!(servo.E > 0.0)) throw std::invalid_argument("servo needs E > 0");
   const auto current = current_vertices(sim, first, P);  // (once: F and the volume)
   const Eigen::Matrix3d F = deformation_gradient_from_faces(P, current);
   const Eigen::Matrix3d sigma = stress_within(sim, first, P, current);
+  if (sigma_now) *sigma_now = sigma;
+  if (F_now) *F_now = F;
   Eigen::Matrix3d ds = sigma_target - sigma;
   ds = 0.5 * (ds + ds.transpose()).eval();
   const double tr = ds.trace();

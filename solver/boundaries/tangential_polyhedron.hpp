@@ -103,6 +103,11 @@ void drive_polyhedron(Simulation& sim, std::size_t first, const TangentialPolyhe
 Eigen::Matrix3d polyhedron_deformation_gradient(const Simulation& sim, std::size_t first,
                                                 const TangentialPolyhedron& P);
 
+/// The volume (m³) enclosed by the engine's walls first .. first + faces - 1 (their planes'
+/// intersections).
+double polyhedron_current_volume(const Simulation& sim, std::size_t first,
+                                 const TangentialPolyhedron& P);
+
 /// Eq 14: the specimen's stress from its boundary, σ = -(1/v)(Σ x ⊗ F + Σ x_P ⊗ m_P g) over
 /// the contacts of the walls first .. first + faces - 1 and the particles (v: the polyhedron's
 /// current volume from the walls' planes). Compression positive. Pa.
@@ -129,10 +134,12 @@ struct PolyhedronServo {
 double servo_modulus(double kn, double mean_radius, double circumradius, double relaxation = 0.8);
 
 /// One servo step: the walls are driven from their current F (Eq 4) towards F - Δε (Eq 15);
-/// returns that target F.
+/// returns that target F. `sigma_now` and `F_now` (when given) receive the stress (Eq 14) and F
+/// the step started from.
 Eigen::Matrix3d servo_step(Simulation& sim, std::size_t first, const TangentialPolyhedron& P,
                            const Eigen::Matrix3d& sigma_target, const PolyhedronServo& servo,
-                           double dt);
+                           double dt, Eigen::Matrix3d* sigma_now = nullptr,
+                           Eigen::Matrix3d* F_now = nullptr);
 
 /// Eq 17 (§2.2.3): the stress of mean p, ratio η = q/p and b = (σ2 - σ3)/(σ1 - σ3) (Lode
 /// angle tan θ = √3 b / (2 - b)), with σ1 in the x-z plane at angle alpha (rad) from x, σ2 along

@@ -8,8 +8,15 @@ namespace gs::solver {
 
 ContactParams contact_params(const Material& m, double r1, double r2, double twist_beta,
                              double twist_eta) {
-  const auto k =
-      contact_stiffness(m.young_ec, m.stiffness_ratio, m.rolling_beta, r1, r2, m.rolling_radius);
+  auto k = m.normal_stiffness_N_m > 0
+               ? contact_stiffness(1.0, m.stiffness_ratio, m.rolling_beta, r1, r2, m.rolling_radius)
+               : contact_stiffness(m.young_ec, m.stiffness_ratio, m.rolling_beta, r1, r2,
+                                   m.rolling_radius);
+  if (m.normal_stiffness_N_m > 0) {  // constant stiffness (seed 003 §2.4): Kn given, Ks = νc·Kn
+    k.kn = m.normal_stiffness_N_m;
+    k.ks = m.stiffness_ratio * k.kn;
+    k.kr = m.rolling_beta * k.ks * r1 * r2;
+  }
   ContactParams p;
   p.kn = k.kn;
   p.ks = k.ks;

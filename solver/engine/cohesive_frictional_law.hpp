@@ -17,6 +17,9 @@ struct ContactParams {
   double max_twist = -1;  // likewise for twisting
 };
 
+/// The parameters of a contact between radii r1 and r2 (a wall passes the sphere's radius, a
+/// YADE facet 2R): modulus-based (contact_stiffness) or, with m.normal_stiffness_N_m > 0, the
+/// constant Kn and Ks = νc·Kn of seed 003 §2.4 (Kr = β·Ks·r1·r2 either way).
 ContactParams contact_params(const Material& m, double r1, double r2, double twist_beta,
                              double twist_eta);
 

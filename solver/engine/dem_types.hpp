@@ -26,6 +26,10 @@ struct Material {
   // Hertz–Mindlin law only (young_ec is then the material's Young's modulus E):
   double poisson = 0;      // ν
   double restitution = 1;  // en of a pair of these grains (and of a grain on a wall)
+  // Linear law only: > 0: every contact (sphere pairs and walls) has this constant normal stiffness
+  // instead of the modulus-based Kn (PFC's linear model with constant kn, seed 003 §2.4); Ks =
+  // νc·Kn.
+  double normal_stiffness_N_m = 0;
 };
 
 /// The contact law of a scene.

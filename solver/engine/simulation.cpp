@@ -25,12 +25,23 @@ double pwave_timestep(const std::vector<double>& radii, double density, double y
   return dt;
 }
 
+double material_timestep(const std::vector<double>& radii, const Material& m) {
+  if (!(m.normal_stiffness_N_m > 0)) return pwave_timestep(radii, m.density, m.young_ec);
+  double dt = std::numeric_limits<double>::infinity();
+  for (double r : radii)
+    dt = std::min(dt, std::sqrt(m.density * 4.0 / 3.0 * M_PI * r * r * r / m.normal_stiffness_N_m));
+  return dt;
+}
+
 Simulation::Simulation(SimulationConfig config, const std::vector<Particle>& particles,
                        std::vector<WallSpec> walls)
     : cfg_(std::move(config)) {
   if (!(cfg_.dt > 0)) throw std::invalid_argument("time step must be positive");
-  if (!(cfg_.material.density > 0) || !(cfg_.material.young_ec > 0))
-    throw std::invalid_argument("material density and Ec must be positive");
+  if (!(cfg_.material.density > 0) ||
+      !(cfg_.material.young_ec > 0 || cfg_.material.normal_stiffness_N_m > 0))
+    throw std::invalid_argument("material density and Ec (or a constant Kn) must be positive");
+  if (cfg_.material.normal_stiffness_N_m > 0 && cfg_.law != ContactLaw::CohesiveFrictional)
+    throw std::invalid_argument("a constant Kn needs the linear (CohFrictMat) law");
   const std::size_t n = particles.size();
   if (n >= kWallBase) throw std::invalid_argument("too many particles");
   p_.id.resize(n);
@@ -190,18 +201,24 @@ void Simulation::remove_outflow() {
     if (p_.removed[i] || p_.clump[i] >= 0) continue;
     const Eigen::Vector3d& x = p_.pos[i];
     if ((x.array() >= keep_lo_.array()).all() && (x.array() <= keep_hi_.array()).all()) continue;
-    ledger_.outflow += 0.5 * p_.mass[i] * p_.vel[i].squaredNorm() +
-                       0.5 * p_.inertia[i] * p_.angvel[i].squaredNorm();
-    p_.removed[i] = 1;
-    p_.fixed[i] = 1;
-    p_.vel[i].setZero();
-    p_.angvel[i].setZero();
-    p_.external_force[i].setZero();
-    ++removed_count_;
-    removed_mass_ += p_.mass[i];
+    retire(i);
     any = true;
   }
   if (any) invalidate_neighbors();  // (its pairs go with the rebuild before the next step)
+}
+
+void Simulation::retire(std::size_t i) {
+  if (p_.clump[i] < 0) {  // (a member's motion and mass are its clump's)
+    ledger_.outflow += 0.5 * p_.mass[i] * p_.vel[i].squaredNorm() +
+                       0.5 * p_.inertia[i] * p_.angvel[i].squaredNorm();
+    removed_mass_ += p_.mass[i];
+  }
+  p_.removed[i] = 1;
+  p_.fixed[i] = 1;
+  p_.vel[i].setZero();
+  p_.angvel[i].setZero();
+  p_.external_force[i].setZero();
+  ++removed_count_;
 }
 
 void Simulation::set_pending(const std::vector<std::uint32_t>& indices) {
@@ -415,6 +432,7 @@ void Simulation::attach_histories(const std::vector<ContactHistory>& old,
                params_material_[0] == mat.young_ec && params_material_[1] == mat.stiffness_ratio &&
                params_material_[2] == mat.rolling_beta && params_material_[3] == mat.rolling_eta &&
                params_material_[4] == cfg_.twist_beta && params_material_[5] == cfg_.twist_eta &&
+               params_material_[6] == mat.normal_stiffness_N_m &&
                params_rolling_radius_ == mat.rolling_radius;
   for (std::size_t w = 0; reuse && w < walls_.size(); ++w)
     reuse = params_walls_[w] == (static_cast<int>(walls_[w].spec.shape) << 1 |
@@ -460,7 +478,8 @@ void Simulation::attach_histories(const std::vector<ContactHistory>& old,
     } else {
       params_[k] = contact_params(cfg_.material, ra, rb, cfg_.twist_beta, cfg_.twist_eta);
     }
-    if (disk_thickness_ > 0 && !ws) {  // disks: a line contact of Ec per unit thickness
+    if (disk_thickness_ > 0 && !ws &&
+        !(mat.normal_stiffness_N_m > 0)) {  // disks: a line contact of Ec per unit thickness
       params_[k].kn = mat.young_ec * disk_thickness_;
       params_[k].ks = mat.stiffness_ratio * params_[k].kn;
       params_[k].kr = mat.rolling_beta * params_[k].ks * ra * rb;
@@ -472,8 +491,9 @@ void Simulation::attach_histories(const std::vector<ContactHistory>& old,
   }
   params_key_valid_ = true;
   params_radius_ = p_.radius;
-  params_material_ = {mat.young_ec,    mat.stiffness_ratio, mat.rolling_beta,
-                      mat.rolling_eta, cfg_.twist_beta,     cfg_.twist_eta};
+  params_material_ = {
+      mat.young_ec,    mat.stiffness_ratio, mat.rolling_beta,        mat.rolling_eta,
+      cfg_.twist_beta, cfg_.twist_eta,      mat.normal_stiffness_N_m};
   params_rolling_radius_ = mat.rolling_radius;
   params_walls_.resize(walls_.size());
   for (std::size_t w = 0; w < walls_.size(); ++w)
@@ -576,6 +596,12 @@ void Simulation::set_friction_deg(double friction_deg) {
     if (b < kWallBase || !(walls_[b - kWallBase].spec.friction_deg >= 0))
       params_[k].tan_friction = t;
   }
+}
+
+void Simulation::set_dt(double dt) {
+  if (!(dt > 0) || !std::isfinite(dt))
+    throw std::invalid_argument("time step must be positive, got " + std::to_string(dt));
+  cfg_.dt = dt;
 }
 
 void Simulation::set_wall_active(std::size_t w, bool active) {
@@ -1294,22 +1320,77 @@ double Simulation::unbalanced_force() const {
   return (sum_f / static_cast<double>(nf)) / (sum_c / static_cast<double>(nc));
 }
 
+Eigen::Vector3d Simulation::contact_elastic_energy(std::size_t k) const {
+  const auto& h = hist_[k];
+  const auto& p = params_[k];
+  Eigen::Vector3d e = Eigen::Vector3d::Zero();  // normal, shear, rolling (J)
+  if (cfg_.law == ContactLaw::HertzMindlin) {   // (kn, ks hold kno, kso: Fn = kno·δ^1.5)
+    e[0] = 0.4 * p.kn * std::pow(h.overlap, 2.5);
+    const double ks = p.ks * std::sqrt(h.overlap);
+    if (ks > 0) e[1] = 0.5 * h.shear_force.squaredNorm() / ks;
+    return e;
+  }
+  e[0] = 0.5 * h.fn * h.fn / p.kn;
+  if (p.ks > 0) e[1] = 0.5 * h.shear_force.squaredNorm() / p.ks;
+  if (p.kr > 0) e[2] = 0.5 * h.bending.squaredNorm() / p.kr;
+  return e;
+}
+
+void Simulation::drop_clumps(const std::vector<std::uint8_t>& gone) {
+  std::vector<std::int32_t> renumber(clumps_.size(), -1);
+  std::vector<ClumpBody> kept;
+  for (std::size_t k = 0; k < clumps_.size(); ++k) {
+    if (gone[k]) continue;
+    renumber[k] = static_cast<std::int32_t>(kept.size());
+    kept.push_back(std::move(clumps_[k]));
+  }
+  for (std::size_t i = 0; i < p_.size(); ++i)
+    if (p_.clump[i] >= 0) p_.clump[i] = renumber[static_cast<std::size_t>(p_.clump[i])];
+  clumps_ = std::move(kept);
+}
+
+void Simulation::remove_particles(const std::vector<std::size_t>& indices) {
+  const std::size_t n = p_.size();
+  std::vector<std::uint8_t> gone(n, 0), clump_gone(clumps_.size(), 0);
+  for (const std::size_t i : indices) {
+    if (i >= n) throw std::invalid_argument("no particle " + std::to_string(i));
+    if (p_.removed[i]) continue;
+    gone[i] = 1;
+    if (p_.clump[i] >= 0) {
+      const auto c = static_cast<std::size_t>(p_.clump[i]);
+      clump_gone[c] = 1;
+      for (const std::uint32_t m : clumps_[c].members) gone[m] = 1;
+    }
+  }
+  // The energy they take away: their kinetic energy (a clump's as a rigid body) and the elastic
+  // energy of their contacts, which end now.
+  for (std::size_t k = 0; k < hist_.size(); ++k) {
+    auto& h = hist_[k];
+    if (!h.real || !(gone[h.a] || (h.b < kWallBase && gone[h.b]))) continue;
+    ledger_.outflow += contact_elastic_energy(k).sum();
+    h.real = false;
+  }
+  for (std::size_t c = 0; c < clumps_.size(); ++c) {
+    if (!clump_gone[c]) continue;
+    ledger_.outflow += 0.5 * clumps_[c].mass * clumps_[c].vel.squaredNorm() +
+                       0.5 * clumps_[c].angvel.dot(clumps_[c].angmom);
+    removed_mass_ += clumps_[c].mass;  // (the clump's, not its members' summed)
+  }
+  for (std::size_t i = 0; i < n; ++i)
+    if (gone[i]) retire(i);
+  drop_clumps(clump_gone);
+  invalidate_neighbors();
+}
+
 const EnergyLedger& Simulation::energy() {
   ledger_.kinetic = kinetic_energy();
   ledger_.elastic_normal = ledger_.elastic_shear = ledger_.elastic_rolling = 0;
   for (std::size_t k = 0; k < hist_.size(); ++k) {
-    const auto& h = hist_[k];
-    if (!h.real) continue;
-    const auto& p = params_[k];
-    if (cfg_.law == ContactLaw::HertzMindlin) {  // (kn, ks hold kno, kso: Fn = kno·δ^1.5)
-      ledger_.elastic_normal += 0.4 * p.kn * std::pow(h.overlap, 2.5);
-      const double ks = p.ks * std::sqrt(h.overlap);
-      if (ks > 0) ledger_.elastic_shear += 0.5 * h.shear_force.squaredNorm() / ks;
-      continue;
-    }
-    ledger_.elastic_normal += 0.5 * h.fn * h.fn / p.kn;
-    if (p.ks > 0) ledger_.elastic_shear += 0.5 * h.shear_force.squaredNorm() / p.ks;
-    if (p.kr > 0) ledger_.elastic_rolling += 0.5 * h.bending.squaredNorm() / p.kr;
+    if (!hist_[k].real) continue;
+    const Eigen::Vector3d e = contact_elastic_energy(k);
+    ledger_.elastic_normal += e[0];
+    ledger_.elastic_shear += e[1];
+    ledger_.elastic_rolling += e[2];
   }
   if (!ledger_started_) {
     ledger_started_ = true;
@@ -1625,9 +1706,12 @@ std::string Simulation::load_checkpoint(const std::filesystem::path& path) {
   for (auto& h : real) get(in, h, file);
   std::uint64_t ncl = 0;
   if (!v03) get(in, ncl, file);
-  if (ncl != clumps_.size())
+  // A run that removed clumps (remove_particles) saved fewer than the scene has: those whose
+  // members the saved removal flags mark gone are dropped below, before the counts are compared.
+  if (ncl > clumps_.size())
     throw InputError(file, "checkpoint does not match the scene (clumps)", std::to_string(ncl));
-  for (auto& c : clumps_) {
+  std::vector<ClumpBody> saved(static_cast<std::size_t>(ncl));
+  for (auto& c : saved) {
     get(in, c.pos, file);
     get(in, c.ori, file);
     get(in, c.vel, file);
@@ -1640,6 +1724,23 @@ std::string Simulation::load_checkpoint(const std::filesystem::path& path) {
     get(in, removed, file);
     removed_count_ = static_cast<std::size_t>(removed);
     get(in, removed_mass_, file);
+  }
+  if (ncl < clumps_.size()) {
+    std::vector<std::uint8_t> gone(clumps_.size(), 0);
+    for (std::size_t k = 0; k < clumps_.size(); ++k)
+      gone[k] = std::all_of(clumps_[k].members.begin(), clumps_[k].members.end(),
+                            [&](std::uint32_t i) { return p_.removed[i] == 1; });
+    drop_clumps(gone);
+    if (ncl != clumps_.size())
+      throw InputError(file, "checkpoint does not match the scene (clumps)", std::to_string(ncl));
+  }
+  for (std::size_t k = 0; k < clumps_.size(); ++k) {
+    ClumpBody& c = clumps_[k];
+    c.pos = saved[k].pos;
+    c.ori = saved[k].ori;
+    c.vel = saved[k].vel;
+    c.angvel = saved[k].angvel;
+    c.angmom = saved[k].angmom;
   }
   std::uint8_t periodic = 0;
   if (!v03 && !v04 && !v05) get(in, periodic, file);

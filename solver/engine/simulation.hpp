@@ -90,6 +90,11 @@ class BlowUp : public std::runtime_error {
 /// YADE's PWaveTimeStep: min over spheres of r·sqrt(ρ/E).
 double pwave_timestep(const std::vector<double>& radii, double density, double young);
 
+/// The `dt_s = "auto"` base of a material: pwave_timestep, or with a constant Kn
+/// (Material::normal_stiffness_N_m) min over spheres of sqrt(m/Kn), m = ρ·(4/3)π r³ (the
+/// period of a sphere on one spring over 2π; seed 003's dt = 1.02 µs is 0.58 of it at r = 0.3 mm).
+double material_timestep(const std::vector<double>& radii, const Material& m);
+
 class Simulation {
  public:
   Simulation(SimulationConfig config, const std::vector<Particle>& particles,
@@ -149,6 +154,10 @@ class Simulation {
   /// no friction angle of their own (spec.friction_deg < 0; the others keep theirs).
   void set_friction_deg(double friction_deg);
   void set_damping(double damping) { cfg_.damping = damping; }
+  /// Changes the time step from the next step on (seed 003: a dynamic deposition, then the
+  /// quasi-static stages at a smaller one). Not in checkpoints: a programme that changes it sets
+  /// it again before every step. Throws std::invalid_argument unless positive and finite.
+  void set_dt(double dt);
   void set_gravity(const Eigen::Vector3d& g) { cfg_.gravity = g; }
   /// Switches a wall on or off; contacts with an inactive wall are dropped.
   void set_wall_active(std::size_t w, bool active);
@@ -164,6 +173,11 @@ class Simulation {
   /// energies (their kinetic energy goes to the ledger's outflow term). Clump members are not
   /// removed. Removal survives checkpoints.
   void set_outlet(const Eigen::Vector3d& keep_lo, const Eigen::Vector3d& keep_hi);
+  /// Removes particles for good (seed 003 §2.4's carving), as an outlet does: a member of a
+  /// clump takes its whole clump (the clumps after it are renumbered). Their kinetic energy and
+  /// the elastic energy of their contacts count in the ledger's outflow. Counted in
+  /// removed_count() and removed_mass(). Throws std::invalid_argument on an index out of range.
+  void remove_particles(const std::vector<std::size_t>& indices);
   std::size_t removed_count() const { return removed_count_; }
   double removed_mass() const { return removed_mass_; }  // kg
 
@@ -260,6 +274,14 @@ class Simulation {
   /// Clump loads from their members, the clumps' integration, and the members moved rigidly;
   /// adds the clumps' gravity work and damping to the ledger. False on a non-finite state.
   bool integrate_clumps();
+  /// Takes particle i out for good (removed, fixed, at rest) and counts it; a free sphere's
+  /// kinetic energy goes to the ledger's outflow and its mass to removed_mass (a member's are
+  /// its clump's).
+  void retire(std::size_t i);
+  /// Drops the clumps marked gone (their members already removed), renumbering p_.clump.
+  void drop_clumps(const std::vector<std::uint8_t>& gone);
+  /// Elastic energy (normal, shear, rolling; J) stored in contact k.
+  Eigen::Vector3d contact_elastic_energy(std::size_t k) const;
   void gather_clump_loads();
   /// Wall loads, dissipation and work terms of this step, summed in pair / particle order.
   void accumulate_walls();
@@ -328,7 +350,7 @@ class Simulation {
   std::vector<ContactParams> old_params_;
   bool params_key_valid_ = false;
   std::vector<double> params_radius_;
-  std::array<double, 6> params_material_{};
+  std::array<double, 7> params_material_{};
   RollingRadius params_rolling_radius_ = RollingRadius::Min;
   std::vector<int> params_walls_;
   std::vector<ContactLoads> loads_;

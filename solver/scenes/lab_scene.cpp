@@ -35,14 +35,20 @@ double max_diameter(const std::vector<Particle>& p) {
 
 /// Seeded specimen in the box [0, cloud]: the number of spheres is set by the target box and
 /// void ratio, the cloud is the loose box they are placed in.
+/// `reach`: the spheres are placed as if `reach` times larger (then given their own size back),
+/// so that the clumps replacing them, which reach that far from their centres, do not overlap.
 std::vector<Particle> generate(const Scene& s, const Eigen::Vector3d& cloud,
-                               const Eigen::Vector3d& lo = Eigen::Vector3d::Zero()) {
+                               const Eigen::Vector3d& lo = Eigen::Vector3d::Zero(),
+                               double reach = 1.0) {
   const SpecimenSpec& sp = *s.specimen;
   std::mt19937_64 rng(sp.seed);
   const double solid = sp.size_m.prod() / (1 + sp.void_ratio);
   try {
-    const auto d = draw_diameters(sp.sizes, solid, rng);
-    return random_sequential_packing(d, lo, lo + cloud, rng);
+    auto d = draw_diameters(sp.sizes, solid, rng);
+    for (auto& x : d) x *= reach;
+    auto ps = random_sequential_packing(d, lo, lo + cloud, rng);
+    for (auto& p : ps) p.radius /= reach;
+    return ps;
   } catch (const std::invalid_argument& e) {
     throw InputError(s.file.string(), std::string("[specimen]: ") + e.what());
   }
@@ -86,6 +92,66 @@ std::vector<std::unique_ptr<LoadingProgramme>> scene_programmes(Scene& s) {
       out.push_back(std::make_unique<SiloFlow>(s.silo, idx));
     } catch (const std::invalid_argument& e) {
       throw InputError(s.file.string(), e.what());
+    }
+    return out;
+  }
+  if (s.test == "stress_rotation") {
+    // Seed 003 §2.4: the spheres generated in a box of the specimen's footprint whose floor is
+    // half the bed's height below the polyhedron's centre (the origin), replaced by clumps; the
+    // box's six planes (frictional as the grains, §2.4) and the polyhedron's walls, switched off
+    // until the carving. Both follow the friction the test sets.
+    const SpecimenSpec& sp = *s.specimen;
+    const StressRotationSpec& x = s.stress_rotation;
+    const double half_w = 0.5 * std::min(sp.size_m.x(), sp.size_m.y());
+    try {
+      const TangentialPolyhedron P = tangential_polyhedron(x.sides, x.radius_m);
+      double footprint = 0;  // the polyhedron's largest horizontal radius
+      for (const auto& v : P.vertices) footprint = std::max(footprint, v.head<2>().norm());
+      if (!(half_w > footprint + sp.sizes.dmax_m))
+        throw InputError(s.file.string(),
+                         "specimen.size_m: the box's footprint does not hold the polyhedron (its "
+                         "half-width must exceed " +
+                             value_str(footprint + sp.sizes.dmax_m) + " m)",
+                         value_str(2 * half_w));
+      if (!(0.5 * sp.size_m.z() > x.radius_m + sp.sizes.dmax_m))
+        throw InputError(s.file.string(),
+                         "specimen.size_m: the bed's height does not cover the polyhedron (its "
+                         "half must exceed " +
+                             value_str(x.radius_m + sp.sizes.dmax_m) + " m)",
+                         value_str(sp.size_m.z()));
+      // The clump of a sphere's volume reaches further than the sphere: the spheres are placed
+      // as if that much larger (the cloud as much higher), so that the clumps start apart.
+      double reach = 1.0;
+      if (s.clump_replace) {
+        const auto& shape = s.clump_replace->shape;
+        const MassProperties m = clump_mass_properties(shape, 1.0, ClumpMassModel::Union);
+        double enclosing = 0;
+        for (const auto& c : shape)
+          enclosing = std::max(enclosing, (c.offset - m.centroid).norm() + c.radius);
+        reach = std::max(1.0, std::cbrt(4.0 / 3.0 * M_PI / m.volume) * enclosing);
+      }
+      const double cloud_h =
+          sp.size_m.z() / (1 + sp.void_ratio) / sp.cloud_solid_fraction * reach * reach * reach;
+      const Eigen::Vector3d lo(-0.5 * sp.size_m.x(), -0.5 * sp.size_m.y(), -0.5 * sp.size_m.z());
+      s.particles = generate(s, {sp.size_m.x(), sp.size_m.y(), cloud_h}, lo, reach);
+      replace_spheres_by_clumps(s);
+      s.walls = cuboid_planes(lo, lo + Eigen::Vector3d(sp.size_m.x(), sp.size_m.y(), cloud_h), -1);
+      // The walls start outward by the largest member radius (StressRotation: the carving
+      // keeps members whose centres are inside), off until the carving.
+      double rmax = 0;
+      for (const auto& q : s.particles) rmax = std::max(rmax, q.radius);
+      auto poly = polyhedron_walls(P);
+      for (auto& w : poly) {
+        w.center *= 1.0 + rmax / x.radius_m;
+        w.active = false;
+      }
+      s.stress_rotation.box_first = 0;
+      s.stress_rotation.poly_first = s.walls.size();
+      s.walls.insert(s.walls.end(), poly.begin(), poly.end());
+      out.push_back(
+          std::make_unique<StressRotation>(s.stress_rotation, s.config.material.friction_deg));
+    } catch (const std::invalid_argument& e) {
+      throw InputError(s.file.string(), std::string("[stress_rotation]: ") + e.what());
     }
     return out;
   }

@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <map>
+#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
@@ -14,6 +15,13 @@
 #include "simulation.hpp"
 
 namespace gs::solver {
+
+/// Thrown by a programme that cannot go on (a target the servo cannot reach, a specimen that
+/// does not fit): the message says where it stopped. The run reports it as an input error.
+class ProgrammeError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
 
 class LoadingProgramme {
  public:

@@ -137,9 +137,93 @@ struct Reader {
   }
 };
 
+// [stress_rotation]: seed 003's test (stress_rotation.hpp, docs/rotation.md).
+void read_stress_rotation(const Reader& r, const toml::table& root, Scene& s) {
+  const auto* t = r.table("stress_rotation", true);
+  const std::string sec = "stress_rotation";
+  r.only(t, sec,
+         {"sides",
+          "radius_m",
+          "p_Pa",
+          "eta",
+          "b",
+          "eta_step",
+          "alpha_step_deg",
+          "cycles",
+          "tolerance",
+          "deposition_tolerance",
+          "stress_tolerance",
+          "deposition_gravity_m_s2",
+          "deposition_friction_deg",
+          "deposition_damping",
+          "damping",
+          "min_stage_steps",
+          "check_every",
+          "max_increment_steps",
+          "max_stage_steps",
+          "frame_every_deg",
+          "servo_poisson",
+          "servo_volumetric_gain",
+          "servo_max_strain_step",
+          "servo_relaxation",
+          "servo_modulus_Pa",
+          "quasi_static_dt_s"});
+  auto& x = s.stress_rotation;
+  const std::int64_t n = r.integer(t, sec, "sides", false, x.sides, 4);
+  if (n % 2 != 0 || n > 1000) r.fail(sec + ".sides", "must be even (4 to 1000)", std::to_string(n));
+  x.sides = static_cast<int>(n);
+  x.radius_m = r.positive(t, sec, "radius_m", false, x.radius_m);
+  x.p_Pa = r.positive(t, sec, "p_Pa", false, x.p_Pa);
+  x.eta = r.positive(t, sec, "eta", true, 0);
+  if (!(x.eta < 3))
+    r.fail(sec + ".eta", "must be below 3 (q/p of a compression)", value_str(x.eta));
+  x.b = r.number(t, sec, "b", false, x.b);
+  if (!(x.b >= 0 && x.b <= 1)) r.fail(sec + ".b", "outside [0, 1]", value_str(x.b));
+  x.eta_step = r.positive(t, sec, "eta_step", false, x.eta_step);
+  x.alpha_step_deg = r.positive(t, sec, "alpha_step_deg", false, x.alpha_step_deg);
+  if (!(x.alpha_step_deg <= 90))
+    r.fail(sec + ".alpha_step_deg", "must be at most 90", value_str(x.alpha_step_deg));
+  x.cycles = r.positive(t, sec, "cycles", false, x.cycles);
+  x.tolerance = r.positive(t, sec, "tolerance", false, x.tolerance);
+  x.deposition_tolerance = r.positive(t, sec, "deposition_tolerance", false, x.tolerance);
+  x.stress_tolerance = r.positive(t, sec, "stress_tolerance", false, x.stress_tolerance);
+  x.deposition_gravity = r.vec3(t, sec, "deposition_gravity_m_s2", false, x.deposition_gravity);
+  x.deposition_friction_deg =
+      r.number(t, sec, "deposition_friction_deg", false, x.deposition_friction_deg);
+  if (!(x.deposition_friction_deg >= 0 && x.deposition_friction_deg < 90))
+    r.fail(sec + ".deposition_friction_deg", "outside [0, 90)",
+           value_str(x.deposition_friction_deg));
+  for (const auto& [k, v] :
+       {std::pair{"deposition_damping", &x.deposition_damping}, std::pair{"damping", &x.damping}}) {
+    *v = r.number(t, sec, k, false, *v);
+    if (!(*v >= 0 && *v < 1)) r.fail(sec + "." + k, "outside [0, 1)", value_str(*v));
+  }
+  x.min_stage_steps = r.integer(t, sec, "min_stage_steps", false, x.min_stage_steps, 0);
+  x.check_every = r.integer(t, sec, "check_every", false, x.check_every, 1);
+  x.max_increment_steps = r.integer(t, sec, "max_increment_steps", false, x.max_increment_steps, 1);
+  x.max_stage_steps = r.integer(t, sec, "max_stage_steps", false, x.max_stage_steps, 1);
+  x.frame_every_deg = r.positive(t, sec, "frame_every_deg", false, x.frame_every_deg);
+  x.servo.nu = r.number(t, sec, "servo_poisson", false, x.servo.nu);
+  if (!(x.servo.nu > -1 && x.servo.nu <= 0.5))
+    r.fail(sec + ".servo_poisson", "outside (-1, 0.5]", value_str(x.servo.nu));
+  x.servo.volumetric_gain =
+      r.positive(t, sec, "servo_volumetric_gain", false, x.servo.volumetric_gain);
+  if (x.servo.nu == 0.5 && t->contains("servo_volumetric_gain"))
+    r.fail(sec + ".servo_volumetric_gain",
+           "has no effect with servo_poisson = 0.5 (Eq 15 then has no volumetric part)");
+  x.servo.max_strain_step =
+      r.positive(t, sec, "servo_max_strain_step", false, x.servo.max_strain_step);
+  x.relaxation = r.positive(t, sec, "servo_relaxation", false, x.relaxation);
+  if (t->contains("servo_modulus_Pa")) x.servo.E = r.positive(t, sec, "servo_modulus_Pa", true, 0);
+  if (t->contains("quasi_static_dt_s"))
+    x.quasi_static_dt_s = r.positive(t, sec, "quasi_static_dt_s", true, 0);
+  if (!root.contains("specimen"))
+    r.fail("[specimen]", "missing (the stress rotation test deposits its specimen)");
+}
+
 void read_lab_sections(const Reader& r, const toml::table& root, Scene& s) {
   for (const char* name : {"triaxial", "plane_strain", "direct_shear", "interface_shear",
-                           "biaxial_periodic", "silo"}) {
+                           "biaxial_periodic", "silo", "stress_rotation"}) {
     if (root.contains(name) && s.test != name)
       r.fail(std::string("[") + name + "]", "does not match scene.test", s.test);
   }
@@ -386,11 +470,17 @@ void read_lab_sections(const Reader& r, const toml::table& root, Scene& s) {
     x.end_fraction = r.number(t, sec, "end_fraction", false, x.end_fraction);
     x.frame_every_s = r.number(t, sec, "frame_every_s", false, x.frame_every_s);
     if (!root.contains("fill")) r.fail("[fill]", "missing (the silo is filled in layers)");
+  } else if (s.test == "stress_rotation") {
+    read_stress_rotation(r, root, s);
   }
   const auto* prep = r.table("preparation", false);
+  if (s.test == "stress_rotation" && prep)
+    r.fail("[preparation]",
+           "the stress rotation test prepares its specimen itself (deposition "
+           "and carving: [stress_rotation])");
   if (s.test == "silo" && (prep || s.specimen))
     r.fail(prep ? "[preparation]" : "[specimen]", "the silo is filled by its [fill]; remove it");
-  if (!s.test.empty() && (prep || s.specimen)) {
+  if (!s.test.empty() && s.test != "stress_rotation" && (prep || s.specimen)) {
     auto& p = s.preparation.emplace();
     r.only(prep, "preparation",
            {"pressure_Pa", "void_ratio", "core_inset_m", "friction_start_deg", "friction_factor",
@@ -463,7 +553,7 @@ void replace_spheres_by_clumps(Scene& s) {
   if (s.dt_auto_safety > 0) {
     std::vector<double> radii;
     for (const auto& p : s.particles) radii.push_back(p.radius);
-    s.dt_pwave = pwave_timestep(radii, s.config.material.density, s.config.material.young_ec);
+    s.dt_pwave = material_timestep(radii, s.config.material);
     s.config.dt = s.dt_auto_safety * s.dt_pwave;
   }
 }
@@ -1031,6 +1121,7 @@ Scene load_scene(const std::filesystem::path& path, int sweep_point,
                                      "cell",
                                      "biaxial_periodic",
                                      "silo",
+                                     "stress_rotation",
                                      "sweep"};
     if (std::find(std::begin(sections), std::end(sections), k.str()) == std::end(sections))
       r.fail("[" + std::string(k.str()) + "]", "unknown section");
@@ -1041,10 +1132,10 @@ Scene load_scene(const std::filesystem::path& path, int sweep_point,
   s.test = r.string(scene, "scene", "test", false, "");
   if (!s.test.empty() && s.test != "triaxial" && s.test != "plane_strain" &&
       s.test != "direct_shear" && s.test != "interface_shear" && s.test != "biaxial_periodic" &&
-      s.test != "silo")
+      s.test != "silo" && s.test != "stress_rotation")
     r.fail("scene.test",
            "expected \"triaxial\", \"plane_strain\", \"direct_shear\", \"interface_shear\", "
-           "\"biaxial_periodic\" or \"silo\"",
+           "\"biaxial_periodic\", \"silo\" or \"stress_rotation\"",
            s.test);
   const auto* specimen = r.table("specimen", false);
   const bool has_packing = scene->contains("packing");
@@ -1084,13 +1175,19 @@ Scene load_scene(const std::filesystem::path& path, int sweep_point,
            {"law", "name", "young_Pa", "poisson", "restitution", "friction_deg", "density_kg_m3",
             "wall_radius"});
   else
-    r.only(
-        mat, "material",
-        {"law", "young_Pa", "stiffness_ratio", "friction_deg", "density_kg_m3", "rolling_stiffness",
-         "rolling_limit", "rolling_limit_radius", "twisting_stiffness", "twisting_limit"});
+    r.only(mat, "material",
+           {"law", "young_Pa", "normal_stiffness_N_m", "stiffness_ratio", "friction_deg",
+            "density_kg_m3", "rolling_stiffness", "rolling_limit", "rolling_limit_radius",
+            "twisting_stiffness", "twisting_limit"});
   auto& m = s.config.material;
   s.config.law = hertz ? ContactLaw::HertzMindlin : ContactLaw::CohesiveFrictional;
-  m.young_ec = r.positive(mat, "material", "young_Pa", true, 0);
+  // Seed 003 §2.4's constant stiffness: Kn given in N/m instead of the modulus Ec.
+  if (mat->contains("normal_stiffness_N_m"))
+    m.normal_stiffness_N_m = r.positive(mat, "material", "normal_stiffness_N_m", true, 0);
+  const bool constant_kn = m.normal_stiffness_N_m > 0;
+  if (constant_kn && mat->contains("young_Pa"))
+    r.fail("material.normal_stiffness_N_m", "give either young_Pa or normal_stiffness_N_m");
+  if (!constant_kn) m.young_ec = r.positive(mat, "material", "young_Pa", true, 0);
   if (hertz) {
     m.poisson = r.number(mat, "material", "poisson", true, 0);
     if (!(m.poisson > -1 && m.poisson <= 0.5))
@@ -1489,7 +1586,7 @@ Scene load_scene(const std::filesystem::path& path, int sweep_point,
     std::vector<double> all;
     for (const auto& p : s.particles) all.push_back(p.radius);
     if (s.specimen) all.push_back(0.5 * s.specimen->sizes.dmin_m);
-    s.dt_pwave = pwave_timestep(all, s.config.material.density, s.config.material.young_ec);
+    s.dt_pwave = material_timestep(all, s.config.material);
     if (auto_dt_safety > 0) s.config.dt = auto_dt_safety * s.dt_pwave;
     assign_materials_by_radius(r, s);
     for (const auto id : s.output.track_ids)

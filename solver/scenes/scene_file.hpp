@@ -24,6 +24,7 @@
 #include "snapshot.hpp"
 #include "specimen_generation.hpp"
 #include "specimen_preparation.hpp"
+#include "stress_rotation.hpp"
 #include "triaxial_compression.hpp"
 
 namespace gs::solver {
@@ -115,7 +116,8 @@ struct Scene {
   double dt_auto_safety = 0;  // dt_s = "auto": dt = dt_safety · dt_pwave (0: dt given)
 
   // Laboratory tests (docs/scenes.md): empty `test` is a plain run of `steps` steps.
-  // "", "triaxial", "plane_strain", "direct_shear", "interface_shear", "biaxial_periodic", "silo"
+  // "", "triaxial", "plane_strain", "direct_shear", "interface_shear", "biaxial_periodic", "silo",
+  // "stress_rotation"
   std::string test;
   std::optional<SpecimenSpec> specimen;
   std::optional<PreparationSpec> preparation;
@@ -129,6 +131,7 @@ struct Scene {
   InterfaceSurfaceSpec interface_surface;
   InterfaceShearGeometry interface_geometry;
   SiloSpec silo;
+  StressRotationSpec stress_rotation;
 };
 
 /// Generates the specimen when the scene asks for one, builds the walls of its test and returns

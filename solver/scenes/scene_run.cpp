@@ -575,6 +575,9 @@ RunOutcome run_scene(Scene scene, const RunOptions& a) {
   } catch (const FillError& e) {
     history.flush();
     throw InputError(scene_file, e.what());
+  } catch (const ProgrammeError& e) {
+    history.flush();
+    throw InputError(scene_file, e.what());
   } catch (const BlowUp& e) {
     history.flush();
     throw InputError(scene_file, std::string("blow-up: ") + e.what() +

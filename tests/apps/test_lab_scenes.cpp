@@ -293,7 +293,7 @@ TEST(LabScenes, BadScenesExitTwoWithOneLine) {
       {"unknown test",
        {"test = \"triaxial\"", "test = \"oedometer\"",
         "scene.test: expected \"triaxial\", \"plane_strain\", \"direct_shear\", "
-        "\"interface_shear\", \"biaxial_periodic\" or \"silo\" (oedometer)"}},
+        "\"interface_shear\", \"biaxial_periodic\", \"silo\" or \"stress_rotation\" (oedometer)"}},
   };
   for (const auto& [what, c] : cases) {
     std::string text = base;

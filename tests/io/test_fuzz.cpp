@@ -466,7 +466,7 @@ TEST(HostileInputs, CliThreadsSubcommandsAndImages) {
        "render, dic, analyze"},
       {"analyze frob",
        "unknown analyze subcommand (frob); one of: strain, voidcells, rev, shearzone, invariants, "
-       "fabric, rose, chains, walls, silo, interface, hhd, vortices, materials"},
+       "fabric, rose, chains, walls, silo, rotation, interface, hhd, vortices, materials"},
       {"dic " + png + " " + png + " -o " + (dir / "d.h5").string(),
        png + ": image too large (16000 x 16000 pixels, at most 100000000)"},
       {"dic " + crc + " " + crc + " -o " + (dir / "d.h5").string(),

@@ -138,3 +138,86 @@ def test_materials_equal_the_cli(cli, tmp_path):
     assert py["material1_count"][2] == 25
     assert py["x+z-_material1_count"][2] == np.sum(odd & (x[:, 0] > 0) & (x[:, 2] < 0))
     assert py["material1_com_x_m"][2] == pytest.approx(x[odd, 0].mean(), rel=1e-12)
+
+
+# Dimers (seed 003 §2.4, scaled down) deposited in a 5 mm box, the n = 8 polyhedron of
+# R = 1.5 mm carved out, consolidated to 100 kPa, sheared to eta = 0.3 and sigma_1 turned by 18
+# degrees (the CLI test's small specimen, tests/apps/test_stress_rotation.cpp).
+ROTATION = """[scene]
+name = "sr"
+test = "stress_rotation"
+[specimen]
+size_m = [0.005, 0.005, 0.0052]
+dmin_m = 0.0005
+dmax_m = 0.0007
+void_ratio = 0.6
+seed = 1
+cloud_solid_fraction = 0.35
+[material]
+normal_stiffness_N_m = 1.0e5
+stiffness_ratio = 1.0
+friction_deg = 26.56505117707799
+density_kg_m3 = 2700.0
+[[clump_template]]
+name = "dimer"
+shape = "dimer"
+member_radius_m = 0.0003
+[clumps]
+replace = "dimer"
+mass = "union"
+seed = 1
+[solver]
+dt_s = "auto"
+dt_safety = 0.5
+threads = 1
+[stress_rotation]
+radius_m = 0.0015
+p_Pa = 1.0e5
+eta = 0.3
+eta_step = 0.1
+alpha_step_deg = 3.0
+cycles = 0.1
+frame_every_deg = 6.0
+deposition_gravity_m_s2 = [0.0, 0.0, -5000.0]
+deposition_damping = 0.5
+deposition_tolerance = 5e-3
+tolerance = 5e-3
+stress_tolerance = 0.02
+min_stage_steps = 500
+servo_max_strain_step = 1e-5
+[output]
+every = 100000
+curve_every = 100
+history_every = 1000
+checkpoint_every = 100000
+"""
+
+
+def test_rotation_of_a_simulated_rotation_equals_the_cli(cli, tmp_path):
+    (tmp_path / "sr.toml").write_text(ROTATION)
+    run = gs.Scene(tmp_path / "sr.toml").run(tmp_path / "out")
+    assert run.ended
+    rc, out, err = cli("analyze", "rotation", run.trajectory, "-o", tmp_path / "rot")
+    assert rc == 0, err
+    py = gs.rotation(run.open(), run.curve_path)
+    for table in ("strain", "increments", "fabric", "cycles"):
+        with open(tmp_path / "rot" / f"rotation_{table}.csv") as f:
+            rows = list(csv.DictReader(f))
+        assert len(rows) == len(py[table]["alpha_deg" if table != "cycles" else "cycle"])
+        for name, v in py[table].items():
+            np.testing.assert_allclose([float(r[name]) for r in rows], v, rtol=1e-9,
+                                       atol=1e-300, err_msg=f"{table}.{name}")
+    # The path: 18 degrees in steps of 3, frames at 0, 6, 12 and 18 degrees and the end; the strains counted
+    # from the rotation's start; D_ij deviatoric.
+    assert py["strain"]["alpha_deg"][-1] == 18.0
+    assert py["strain"]["eps_v"][0] == 0.0
+    assert len(py["fabric"]["step"]) == 5  # and the last state
+    assert py["fabric"]["alpha_deg"][0] == 0.0
+    np.testing.assert_allclose(py["fabric"]["Dxx"] + py["fabric"]["Dyy"] + py["fabric"]["Dzz"],
+                               0.0, atol=1e-12)
+    # Windows of at least 3 degrees between curve rows (an increment shorter than curve_every
+    # steps has no row of its own, and its window spans two).
+    mids = py["increments"]["alpha_deg"]
+    assert 4 <= len(mids) <= 6 and np.all(np.diff(mids) >= 3.0 - 1e-9) and mids[-1] <= 18.0
+    with pytest.raises(gs.Error, match=r"window_deg must be positive"):
+        gs.rotation(run.open(), run.curve_path, window_deg=0.0)
