@@ -9,7 +9,8 @@ curve.csv (and preparation.csv) beside the trajectory; nothing when there is non
   principal stress rotation: the six stress and strain components against α, the x-z strain
   trajectory and εv, εyy against cycles (seed 003 Figs 5-7, 9; strains from the rotation's
   start); with `granoscope analyze rotation RUN -o DIR` written beside the run (DIR = the run's
-  `rotation/`), also the non-coaxiality against α and the fabric loop (Figs 10, 14);
+  `rotation/`), also the non-coaxiality, the fabric loop, α − α_F and the orientation fabric of
+  the clumps (Figs 10, 14, 15, 17);
   preparation: void ratio and friction against steps."""
 import csv
 import os
@@ -156,13 +157,15 @@ def rotation(c, title):
 
 
 def rotation_report(here, title):
-    """Non-coaxiality against α and the fabric loop, from `analyze rotation`'s tables."""
+    """Non-coaxiality against α, the fabric loop, α − α_F and the clumps' orientation fabric,
+    from `analyze rotation`'s tables (seed 003 Figs 10, 14, 15, 17)."""
     inc, fab = (os.path.join(here, "rotation", f) for f in
                 ("rotation_increments.csv", "rotation_fabric.csv"))
     if not (os.path.exists(inc) and os.path.exists(fab)):
         return None
     i, f = read(inc), read(fab)
-    fig, (a1, a2) = plt.subplots(1, 2, figsize=(11, 4.5))
+    fig, ax = plt.subplots(2, 2, figsize=(11, 8.5))
+    a1, a2, a3, a4 = ax.flat
     a1.plot(i["alpha_deg"], i["non_coaxiality_deg"], ".-", lw=0.8)
     a1.axhspan(30, 40, color="0.9", label="seed 003: 30–40°")
     a1.set_xlabel("α (°)")
@@ -176,6 +179,17 @@ def rotation_report(here, title):
     a2.set_ylabel("Dxz")
     a2.set_title("contact fabric loop (Fig 14)", fontsize=9)
     a2.set_aspect("equal", adjustable="datalim")
+    a3.plot(f["alpha_deg"], f["alpha_minus_F_deg"], "o-", ms=3, lw=0.8)
+    a3.set_xlabel("α (°)")
+    a3.set_ylabel("α − α_F (°)")
+    a3.set_title("stress against fabric direction (Fig 15)", fontsize=9)
+    for n, lab in (("Dp_xx", "D^p xx"), ("Dp_yy", "D^p yy"), ("Dp_zz", "D^p zz"),
+                   ("Dp_xz", "D^p xz")):
+        a4.plot(f["alpha_deg"], f[n], "o-", ms=3, lw=0.8, label=lab)
+    a4.set_xlabel("α (°)")
+    a4.set_ylabel("particle-orientation fabric")
+    a4.set_title("clump long axes (Fig 17)", fontsize=9)
+    a4.legend(ncol=2, fontsize=8)
     fig.suptitle(title)
     fig.tight_layout()
     return fig
