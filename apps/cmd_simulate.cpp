@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <iostream>
 #include <limits>
@@ -16,6 +17,11 @@
 #include "errors.hpp"
 #include "scene_file.hpp"
 #include "scene_run.hpp"
+#ifdef GRANOSCOPE_MPI
+#include <mpi.h>
+
+#include "mpi_domain.hpp"
+#endif
 
 namespace gs::cli {
 
@@ -37,9 +43,11 @@ using Results = solver::RunResults;
 /// One run; its results when its last programme ended (not when --steps stopped it first).
 /// Progress on stderr: a line rewritten every 0.5 s on a terminal; elsewhere (a log, CI) one
 /// line when a phase starts and at each 10 % of it.
-Results run(const Args& a, int sweep_point = -1) {
+Results run(const Args& a, int sweep_point = -1,
+            std::optional<solver::RunOptions::Parallel> parallel = {}) {
   const solver::Scene scene = solver::load_scene(a.scene, sweep_point);
   solver::RunOptions o;
+  o.parallel = std::move(parallel);
   o.out = a.out;
   if (a.steps >= 0) o.steps = a.steps;
   o.threads = a.threads;
@@ -47,8 +55,10 @@ Results run(const Args& a, int sweep_point = -1) {
   o.provenance = "granoscope simulate " + a.scene;
   o.print = [](const std::string& line) { std::printf("%s\n", line.c_str()); };
   o.warn = [](const std::string& line) { std::cerr << line << "\n"; };
-  const bool tty = isatty(STDERR_FILENO) && !a.quiet;
-  const bool log = !tty && !a.quiet;
+  const bool root = !o.parallel || o.parallel->root;
+  if (!root) o.print = o.warn = {};  // (process 0 speaks for all)
+  const bool tty = root && isatty(STDERR_FILENO) && !a.quiet;
+  const bool log = root && !tty && !a.quiet;
   auto last_print = std::chrono::steady_clock::now() - std::chrono::seconds(1);
   std::size_t logged_phase = std::numeric_limits<std::size_t>::max();
   int logged_tenth = -1;
@@ -152,7 +162,116 @@ void run_sweep(const Args& a, const solver::Scene& first) {
   }
 }
 
+/// Processes in this launch (mpirun sets OMPI_COMM_WORLD_SIZE; other launchers PMI_SIZE).
+int launched_processes() {
+  for (const char* v : {"OMPI_COMM_WORLD_SIZE", "PMI_SIZE"})
+    if (const char* s = std::getenv(v)) return std::max(1, std::atoi(s));
+  return 1;
+}
+
+#ifdef GRANOSCOPE_MPI
+/// A scene run by the processes of an mpirun (docs/scale.md): each steps its slab
+/// (solver/parallel/mpi_domain.hpp); process 0 writes the outputs, the others a scratch copy
+/// that is removed at the end. An error found by every process (the scene, a blow-up) is
+/// reported once by process 0, exit code 2; one process's own error aborts them all.
+void run_mpi(const Args& a) {
+  int provided = 0;
+  MPI_Init_thread(nullptr, nullptr, MPI_THREAD_SERIALIZED, &provided);
+  solver::MpiDomain domain(MPI_COMM_WORLD);
+  const bool root = domain.rank() == 0;
+  fs::path scratch;
+  auto fail = [&](const std::string& line, bool everyone) {
+    if (root || !everyone) std::fprintf(stderr, "error: %s\n", line.c_str());
+    std::fflush(stderr);
+    if (!scratch.empty()) {
+      std::error_code ec;
+      fs::remove_all(scratch, ec);
+    }
+    if (everyone) {
+      MPI_Finalize();
+      std::exit(2);
+    }
+    MPI_Abort(MPI_COMM_WORLD, 2);
+  };
+  // Checks every process makes alike, agreed on before the run starts.
+  std::string error;
+  try {
+    if (provided < MPI_THREAD_SERIALIZED)
+      throw InputError(a.scene, "this MPI does not allow calls from OpenMP threads",
+                       "MPI_THREAD_SERIALIZED");
+    if (solver::scene_has_sweep(a.scene))
+      throw InputError(a.scene, "a [sweep] runs on one process (not under mpirun)", "sweep");
+    (void)solver::load_scene(a.scene);
+  } catch (const std::exception& e) {
+    error = e.what();
+  }
+  if (domain.any(!error.empty()))
+    fail(error.empty() ? a.scene + ": failed on another process" : error, true);
+  Args mine = a;
+  if (!root) {
+    // The other processes run the same loop, writing to a scratch directory (resuming from a
+    // copy of process 0's).
+    const fs::path out =
+        a.out.empty() ? fs::path("out") / solver::load_scene(a.scene).name : fs::path(a.out);
+    scratch = fs::temp_directory_path() /
+              ("granoscope-rank" + std::to_string(domain.rank()) + "-" + std::to_string(getpid()));
+    std::error_code ec;
+    fs::remove_all(scratch, ec);
+    if (a.resume && fs::exists(out))
+      fs::copy(out, scratch, fs::copy_options::recursive, ec);
+    else
+      fs::create_directories(scratch, ec);
+    mine.out = scratch.string();
+  }
+  solver::RunOptions::Parallel par;
+  par.root = root;
+  par.attach = [&](solver::Simulation& sim) {
+    try {
+      domain.attach(sim);
+    } catch (const std::invalid_argument& e) {
+      throw InputError(a.scene, "mpirun", e.what());
+    }
+  };
+  par.gather = [&](solver::Simulation& sim) { domain.gather(sim); };
+  par.release = [&](solver::Simulation& sim) { domain.release(sim); };
+  par.any = [&](bool mine_flag) { return domain.any(mine_flag); };
+  try {
+    run(mine, -1, par);
+  } catch (const InputError& e) {
+    fail(e.what(), true);  // (the scene's, or a blow-up: every process stops at the same step)
+  } catch (const std::exception& e) {
+    fail(e.what(), false);
+  }
+  // What the processes sent each other, summed over them (docs/scale.md).
+  double sent[2] = {static_cast<double>(domain.halo_bytes()),
+                    static_cast<double>(domain.rebuild_bytes())},
+         total[2] = {};
+  MPI_Reduce(sent, total, 2, MPI_DOUBLE, MPI_SUM, 0, MPI_COMM_WORLD);
+  if (root) {
+    std::printf(
+        "mpirun: %d processes, slabs along %c; neighbour-list rebuilds %lld; sent by all "
+        "processes: %.4g MB in halo exchanges (each step), %.4g MB at rebuilds\n",
+        domain.size(), "xyz"[domain.axis()], static_cast<long long>(domain.rebuilds()),
+        total[0] / 1e6, total[1] / 1e6);
+  }
+  if (!scratch.empty()) {
+    std::error_code ec;
+    fs::remove_all(scratch, ec);
+  }
+  MPI_Finalize();
+}
+#endif
+
 void run_scene(const Args& a) {
+  if (launched_processes() > 1) {
+#ifdef GRANOSCOPE_MPI
+    return run_mpi(a);
+#else
+    throw InputError(
+        a.scene, "this granoscope was built without MPI (apt-get install libopenmpi-dev, rebuild)",
+        "mpirun");
+#endif
+  }
   if (solver::scene_has_sweep(a.scene)) return run_sweep(a, solver::load_scene(a.scene));
   run(a);
 }

@@ -142,7 +142,10 @@ void NeighborList::build(const ParticleState& p, const std::vector<WallState>& w
   if (periodic_cell) return build_periodic(p, *periodic_cell, planar_z);
   double rmax = 0;
   const bool removal = p.removed.size() == n;
-  auto gone = [&](std::size_t i) { return removal && p.removed[i] != 0; };
+  const bool masked = absent && absent->size() == n;
+  auto gone = [&](std::size_t i) {
+    return (removal && p.removed[i] != 0) || (masked && (*absent)[i] != 0);
+  };
   std::size_t first = 0;
   while (first < n && gone(first)) ++first;
   if (first == n) return;  // every particle has left

@@ -5,6 +5,7 @@
 
 #include <Eigen/Geometry>
 
+#include "domain.hpp"
 #include "periodic_cell.hpp"
 #include "rigid_clump.hpp"
 #include "simd_level.hpp"
@@ -284,9 +285,10 @@ void integrate_clump_batch(ClumpBatch& b, int count, V3 g, double damping, doubl
   integrate_clumps_generic(b, count, g, damping, dt);
 }
 
-template <bool kMembers>
+template <bool kMembers, bool kRoles = false>
 IntegrationSums integrate_range(ParticleState& p, std::size_t begin, std::size_t end,
-                                const Eigen::Vector3d& gravity, double damping, double dt) {
+                                const Eigen::Vector3d& gravity, double damping, double dt,
+                                const std::uint8_t* roles = nullptr) {
   using F = ParticleBatch::Field;
   IntegrationSums sums;
   ParticleBatch b;
@@ -294,7 +296,14 @@ IntegrationSums integrate_range(ParticleState& p, std::size_t begin, std::size_t
   for (std::size_t next = begin; next < end;) {
     const std::size_t i0 = next;
     int count = 0;
-    if constexpr (kMembers) {
+    if constexpr (kRoles) {
+      // A domain's part: the owned particles in order (each lane's arithmetic is its own, so
+      // a particle gets the same bits in whatever batch it is).
+      static_assert(!kMembers, "clumps are not decomposed");
+      for (; next < end && count < ParticleBatch::kLanes; ++next)
+        if (roles[next] == kOwned) lane_index[count++] = next;
+      if (count == 0) continue;
+    } else if constexpr (kMembers) {
       // The next lanes: the particles in order, fixed clump members apart. A fixed lane keeps
       // its velocities and adds +0 to the sums; of a member the clump update overwrites the
       // position and orientation, so only the rotation vector and the finite check are left.
@@ -314,7 +323,7 @@ IntegrationSums integrate_range(ParticleState& p, std::size_t begin, std::size_t
       next += static_cast<std::size_t>(count);
     }
     auto lane = [&](int j) {
-      if constexpr (kMembers) return lane_index[j];
+      if constexpr (kMembers || kRoles) return lane_index[j];
       return i0 + static_cast<std::size_t>(j);
     };
     auto put = [&](F f, int j, const Eigen::Vector3d& x) {
@@ -371,7 +380,8 @@ IntegrationSums integrate_range(ParticleState& p, std::size_t begin, std::size_t
 
 IntegrationSums integrate_particles(ParticleState& p, std::size_t begin, std::size_t end,
                                     const Eigen::Vector3d& gravity, double damping, double dt,
-                                    bool clump_members) {
+                                    bool clump_members, const std::uint8_t* roles) {
+  if (roles) return integrate_range<false, true>(p, begin, end, gravity, damping, dt, roles);
   return clump_members && p.clump.size() == p.size()
              ? integrate_range<true>(p, begin, end, gravity, damping, dt)
              : integrate_range<false>(p, begin, end, gravity, damping, dt);

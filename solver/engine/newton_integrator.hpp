@@ -33,9 +33,11 @@ struct IntegrationSums {
 /// velocities and only advance their rotation vectors (and count in the finite check): their
 /// positions and orientations are left for the clump update (Simulation::integrate_clumps),
 /// which overwrites them. `clump_members` false: the caller knows there are none (no check).
+/// `roles` (a domain decomposition's ParticleRole per particle, or nullptr): only the owned
+/// particles (2) are integrated; the others are left as they are and add nothing to the sums.
 IntegrationSums integrate_particles(ParticleState& p, std::size_t begin, std::size_t end,
                                     const Eigen::Vector3d& gravity, double damping, double dt,
-                                    bool clump_members = true);
+                                    bool clump_members = true, const std::uint8_t* roles = nullptr);
 
 /// The homogeneous-deformation terms of YADE's NewtonIntegrator in a periodic cell
 /// (Cell.homoDeform = 2), and YADE's 2D emulation blockedDOFs = 'zXY'.

@@ -355,11 +355,72 @@ Eigen::Vector3d Simulation::cell_stiffness() const {
 }
 
 void Simulation::rebuild_neighbors() {
+  if (domain_) return domain_->rebuild(*this);  // (it calls rebuild_local)
   // The old histories and parameters are swapped out (their buffers are reused).
   old_hist_.swap(hist_);
   old_params_.swap(params_);
   nl_.build(p_, walls_, cell_ptr(), planar_);
   attach_histories(old_hist_, &old_params_);
+  classify_walls();
+}
+
+void Simulation::set_domain(Domain* domain) {
+  if (domain) {
+    bool facets = false;
+    for (const auto& w : walls_) facets = facets || w.spec.shape == WallShape::Facets;
+    bool pending = false;
+    for (const auto r : p_.removed) pending = pending || r != 0;
+    const char* what = !clumps_.empty() ? "clumps"
+                       : facets         ? "facet (mesh) walls"
+                       : periodic_      ? "a periodic cell"
+                       : outlet_        ? "an outlet"
+                       : pending        ? "removed or pending particles (filling)"
+                                        : nullptr;
+    if (what)
+      throw std::invalid_argument(std::string("the domain decomposition does not handle ") + what +
+                                  " yet (run on one process)");
+  }
+  domain_ = domain;
+  invalidate_neighbors();
+}
+
+void Simulation::set_roles(std::vector<std::uint8_t> roles) {
+  if (!roles.empty() && roles.size() != p_.size())
+    throw std::invalid_argument("set_roles: one role per particle");
+  roles_ = std::move(roles);
+  absent_.resize(roles_.size());
+  for (std::size_t i = 0; i < roles_.size(); ++i) absent_[i] = roles_[i] == kAbsent;
+}
+
+void Simulation::rebuild_local(const std::vector<ContactHistory>& received, bool keep_reference) {
+  old_hist_.swap(hist_);
+  old_params_.swap(params_);
+  const bool keep = keep_reference && nl_.ref_pos.size() == p_.size();
+  if (keep) {
+    kept_ref_pos_.swap(nl_.ref_pos);
+    kept_wall_ref_ = {nl_.wall_ref, nl_.wall_normal_ref};
+  }
+  nl_.absent = roles_.empty() ? nullptr : &absent_;
+  nl_.build(p_, walls_, cell_ptr(), planar_);
+  nl_.absent = nullptr;
+  if (keep) {
+    nl_.ref_pos.swap(kept_ref_pos_);
+    nl_.wall_ref = kept_wall_ref_.first;
+    nl_.wall_normal_ref = kept_wall_ref_.second;
+  }
+  if (!roles_.empty()) {
+    // Pairs of two ghosts are another process's (their loads would be dropped here).
+    std::erase_if(nl_.pairs, [&](const std::pair<std::uint32_t, std::uint32_t>& pr) {
+      return roles_[pr.first] != kOwned && (pr.second >= kWallBase || roles_[pr.second] != kOwned);
+    });
+  }
+  attach_histories(old_hist_, &old_params_);
+  for (const ContactHistory& h : received) {
+    const auto key = std::make_pair(h.a, h.b);
+    const auto at = std::lower_bound(nl_.pairs.begin(), nl_.pairs.end(), key);
+    if (at != nl_.pairs.end() && *at == key)
+      hist_[static_cast<std::size_t>(at - nl_.pairs.begin())] = h;
+  }
   classify_walls();
 }
 
@@ -940,7 +1001,9 @@ void Simulation::run_law(ContactBatch& batch, int count, double dt) const {
 void Simulation::step() {
   if (periodic_) cell_.integrate(cfg_.dt);  // (YADE: Scene::moveToNextTimeStep, before engines)
   if (walls_dirty_) classify_walls();
-  if (nl_.stale(p_, walls_, cell_ptr(), &moving_walls_)) rebuild_neighbors();
+  bool stale = nl_.stale(p_, walls_, cell_ptr(), &moving_walls_);
+  if (domain_) stale = domain_->stale(stale);
+  if (stale) rebuild_neighbors();
   admit_deferred();
   const double dt = cfg_.dt;
   const std::size_t np = nl_.pairs.size();
@@ -1080,7 +1143,13 @@ void Simulation::step() {
 
 #pragma omp single
     {
-      accumulate_walls();
+      if (domain_) {
+        zero_all_walls_ = true;  // (a wall loaded elsewhere has loads here after the sum)
+        accumulate_walls();
+        domain_->reduce_walls(walls_);
+      } else {
+        accumulate_walls();
+      }
       update_servos();
       if (!clumps_.empty()) gather_clump_loads();  // (before the integration moves members)
       if (periodic_) {
@@ -1110,15 +1179,17 @@ void Simulation::step() {
     for (std::size_t c = 0; c < chunks; ++c) {
       double fr = 0, ro = 0;
       const std::size_t begin = c * kChunk, end = std::min(n, (c + 1) * kChunk);
+      const std::uint8_t* roles = roles_.empty() ? nullptr : roles_.data();
       for (std::size_t i = begin; i < end; ++i) {
+        if (roles && roles[i] != kOwned) continue;  // (a ghost's are its owner's to count)
         fr += particle_dissipation_[2 * i];
         ro += particle_dissipation_[2 * i + 1];
       }
-      const IntegrationSums sums = periodic_ || planar_
-                                       ? integrate_particles_homogeneous(
-                                             p_, begin, end, cfg_.gravity, cfg_.damping, dt, field_)
-                                       : integrate_particles(p_, begin, end, cfg_.gravity,
-                                                             cfg_.damping, dt, !clumps_.empty());
+      const IntegrationSums sums =
+          periodic_ || planar_ ? integrate_particles_homogeneous(p_, begin, end, cfg_.gravity,
+                                                                 cfg_.damping, dt, field_)
+                               : integrate_particles(p_, begin, end, cfg_.gravity, cfg_.damping, dt,
+                                                     !clumps_.empty(), roles);
       finite = finite && sums.finite;
       chunk_sums_[kSums * c] = fr;
       chunk_sums_[kSums * c + 1] = ro;
@@ -1162,6 +1233,7 @@ void Simulation::step() {
     }
     cell_.set_velocity_gradient(l);
   }
+  if (domain_) domain_->agree(max_overlap_ratio, finite);
   if (!(max_overlap_ratio <= cfg_.max_overlap_ratio))
     throw BlowUp("step " + std::to_string(step_) + ": overlap of " +
                  std::to_string(max_overlap_ratio) + " radius exceeds " +
@@ -1188,6 +1260,7 @@ void Simulation::step() {
   for (const std::uint32_t w : timed_walls_)
     if (walls_[w].active && time_ >= walls_[w].spec.off_at_s) set_wall_active(w, false);
   if (outlet_) remove_outflow();
+  if (domain_) domain_->exchange(*this);
 }
 
 void Simulation::run(std::int64_t steps) {
@@ -1398,8 +1471,12 @@ const EnergyLedger& Simulation::energy() {
     if (step_ == 0) {
       // Overlaps present in the initial packing become contacts in the first step: their
       // normal elastic energy ½·Kn·u² belongs to the initial state.
-      if (nl_.stale(p_, walls_, cell_ptr(), walls_dirty_ ? nullptr : &moving_walls_))
-        rebuild_neighbors();
+      if (nl_.stale(p_, walls_, cell_ptr(), walls_dirty_ ? nullptr : &moving_walls_)) {
+        if (domain_)
+          rebuild_local({}, true);  // (this process's own: not a collective rebuild)
+        else
+          rebuild_neighbors();
+      }
       for (std::size_t k = 0; k < nl_.pairs.size(); ++k) {
         ContactGeometry g;
         BodyMotion m1, m2;

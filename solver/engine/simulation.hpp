@@ -13,6 +13,7 @@
 #include "cohesive_frictional_law.hpp"
 #include "contact_geometry.hpp"
 #include "dem_types.hpp"
+#include "domain.hpp"
 #include "neighbor_list.hpp"
 #include "newton_integrator.hpp"
 #include "periodic_cell.hpp"
@@ -230,6 +231,28 @@ class Simulation {
   /// Forces a neighbour-list rebuild before the next step.
   void invalidate_neighbors() { nl_.ref_pos.clear(); }
 
+  /// Domain decomposition (issue 23, docs/scale.md): `domain` gets the step's collective calls
+  /// (nullptr: none). Spheres between planes and boxes only: throws std::invalid_argument with
+  /// clumps, facet walls, a periodic cell, an outlet or filling, which it does not handle yet.
+  void set_domain(Domain* domain);
+  /// The part of the scene this process steps: per particle a ParticleRole. Pairs are kept
+  /// where at least one body is owned; only owned particles are integrated and counted in the
+  /// ledger's particle terms. Empty: every particle owned. Takes effect at the next rebuild.
+  void set_roles(std::vector<std::uint8_t> roles);
+  const std::vector<std::uint8_t>& roles() const { return roles_; }
+  /// Rebuilds the neighbour list now, for the roles set; the histories in `received` (pairs
+  /// other processes computed until now; sorted or not) replace those of the same pairs.
+  /// `keep_reference`: the list's reference positions stay those of the last rebuild (the next
+  /// rebuild comes when the particles have moved half the skin since then, as on every process).
+  void rebuild_local(const std::vector<ContactHistory>& received, bool keep_reference = false);
+  /// The candidate pairs (sorted by (a, b)) and their histories, parallel.
+  const std::vector<std::pair<std::uint32_t, std::uint32_t>>& pairs() const { return nl_.pairs; }
+  const std::vector<ContactHistory>& histories() const { return hist_; }
+  /// The ledger's cumulative terms, for a domain to sum them over processes.
+  EnergyLedger& ledger_terms() { return ledger_; }
+  /// The Verlet skin (m).
+  double skin() const { return nl_.skin; }
+
   /// Complete state, for bit-for-bit resumption. `extra` is stored alongside (the state of a
   /// scene's loading programme) and returned by load_checkpoint.
   void save_checkpoint(const std::filesystem::path& path, const std::string& extra = {}) const;
@@ -302,6 +325,11 @@ class Simulation {
 
   SimulationConfig cfg_;
   ParticleState p_;
+  Domain* domain_ = nullptr;
+  std::vector<std::uint8_t> roles_;            // ParticleRole per particle; empty: all owned
+  std::vector<std::uint8_t> absent_;           // roles_ == kAbsent (the neighbour list's mask)
+  std::vector<Eigen::Vector3d> kept_ref_pos_;  // rebuild_local(…, keep_reference) scratch
+  std::pair<std::vector<Eigen::Vector3d>, std::vector<Eigen::Vector3d>> kept_wall_ref_;
   std::vector<WallState> walls_;
   void remove_outflow();
 

@@ -311,6 +311,11 @@ RunOutcome run_scene(Scene scene, const RunOptions& a) {
   };
   auto programmes = scene_programmes(scene);
   if (a.threads > 0) scene.config.threads = a.threads;
+  const RunOptions::Parallel* par = a.parallel ? &*a.parallel : nullptr;
+  if (par && (!scene.test.empty() || scene.fill))
+    throw InputError(scene_file,
+                     "under mpirun only plain scenes run yet (no scene.test, no [fill])",
+                     scene.test.empty() ? "fill" : scene.test);
   // Where the run stops at the latest: `steps`, or a plain scene's own number of steps.
   std::optional<std::int64_t> stop_at = a.steps;
   if (scene.test.empty() && !scene.fill) {
@@ -385,14 +390,43 @@ RunOutcome run_scene(Scene scene, const RunOptions& a) {
       last_curve_step = sim.step_count();
     }
   };
-  auto write_frame = [&] {
+  // Under a domain decomposition, what reads the whole state runs after a gather (process 0
+  // then holds it) and before the release.
+  auto whole = [&](auto&& fn) {
+    if (!par) return fn();
+    par->gather(sim);
+    fn();
+    par->release(sim);
+  };
+  // The ledger's check on the whole (process 0), its verdict shared by every process.
+  auto check_energy = [&] {
+    if (!par) return sim.check_energy();
+    std::string error;
+    if (par->root) {
+      try {
+        sim.check_energy();
+      } catch (const BlowUp& e) {
+        error = e.what();
+      }
+    }
+    if (par->any(!error.empty()))
+      throw BlowUp(error.empty() ? "energy ledger out of bounds (process 0)" : error);
+  };
+  auto history_append = [&](bool check) {
+    whole([&] {
+      if (check) check_energy();
+      history.append(history_row(sim, scene.output.track_ids));
+    });
+  };
+  auto write_frame_now = [&] {
     if (!writer) writer.emplace(traj, meta, TrajectoryWriter::Options{.discard_unfinished = false});
     Frame f = sim.frame();
     if (!scene.output.contacts) f.contacts.clear();
     writer->append(f);
     last_frame_step = sim.step_count();
   };
-  auto checkpoint = [&](std::int64_t s) {
+  auto write_frame = [&] { whole(write_frame_now); };
+  auto checkpoint_now = [&](std::int64_t s) {
     // Everything the index counts reaches the disk before the index does (power loss).
     history.sync();
     if (curve.open()) curve.sync();
@@ -413,6 +447,7 @@ RunOutcome run_scene(Scene scene, const RunOptions& a) {
     if (ck.count("state") && ck["state"] != next["state"]) fs::remove(out / ck["state"], ec);
     ck = next;
   };
+  auto checkpoint = [&](std::int64_t s) { whole([&] { checkpoint_now(s); }); };
 
   if (a.resume) {
     if (!fs::exists(ckpt_index)) {
@@ -454,6 +489,7 @@ RunOutcome run_scene(Scene scene, const RunOptions& a) {
       throw InputError(ckpt_index.string(), "checkpoint programme not in the scene",
                        ck["programme"]);
     programmes[k]->load_state(extra);
+    if (par) par->attach(sim);
     last_frame = as_int(ck, "last_frame", ckpt_index);
     last_frame_step = as_int(ck, "last_frame_step", ckpt_index);
     last_curve_step = as_int(ck, "last_curve_step", ckpt_index);
@@ -484,10 +520,11 @@ RunOutcome run_scene(Scene scene, const RunOptions& a) {
       }
       copy.commit();
     }
+    if (par) par->attach(sim);
     history.create(history_header(sim, scene.output.track_ids));
     programmes[0]->start(sim);
     open_curve(0);
-    history.append(history_row(sim, scene.output.track_ids));
+    history_append(false);
     curve_row();
     if (programmes[0]->name() != "preparation") {
       last_frame = programmes[0]->frame_index(sim);
@@ -522,8 +559,13 @@ RunOutcome run_scene(Scene scene, const RunOptions& a) {
       stop_requested = true;
     }
   };
+  // (under a decomposition every process stops at the same step when one is asked to)
+  auto report_all = [&](bool phase_start) {
+    report(phase_start);
+    if (par) stop_requested = par->any(stop_requested);
+  };
   const std::int64_t every = std::max<std::int64_t>(1, a.progress_every);
-  report(true);
+  report_all(true);
   bool ended = false;
   try {
     while (!stop_requested) {
@@ -549,7 +591,7 @@ RunOutcome run_scene(Scene scene, const RunOptions& a) {
         curve_row();
         last_frame = programmes[k]->frame_index(sim);
         write_frame();
-        report(true);
+        report_all(true);
         continue;
       }
       if (stop_at && sim.step_count() >= *stop_at) break;
@@ -557,10 +599,7 @@ RunOutcome run_scene(Scene scene, const RunOptions& a) {
       if (programmes[k]->finished(sim)) continue;  // ended by its control (a stage check)
       sim.step();
       const std::int64_t s = sim.step_count();
-      if (s % scene.output.history_every == 0) {
-        sim.check_energy();
-        history.append(history_row(sim, scene.output.track_ids));
-      }
+      if (s % scene.output.history_every == 0) history_append(true);
       if (s % scene.output.curve_every == 0) curve_row();
       if (programmes[k]->name() != "preparation") {
         const std::int64_t fi = programmes[k]->frame_index(sim);
@@ -570,7 +609,7 @@ RunOutcome run_scene(Scene scene, const RunOptions& a) {
         }
       }
       if (s % scene.output.checkpoint_every == 0) checkpoint(s);
-      if (s % every == 0) report(false);
+      if (s % every == 0) report_all(false);
     }
   } catch (const FillError& e) {
     history.flush();
@@ -600,9 +639,11 @@ RunOutcome run_scene(Scene scene, const RunOptions& a) {
     if (thrown) std::rethrow_exception(thrown);
     return outcome;
   }
-  // Final rows and frame, unless the last step already wrote them.
+  // Final rows and frame, unless the last step already wrote them (the whole state stays on
+  // process 0 from here).
+  if (par) par->gather(sim);
   if (s % scene.output.history_every != 0) history.append(history_row(sim, scene.output.track_ids));
-  if (programmes[k]->name() != "preparation" && last_frame_step != s) write_frame();
+  if (programmes[k]->name() != "preparation" && last_frame_step != s) write_frame_now();
   history.finish();
   curve.finish();
   prep_curve.finish();

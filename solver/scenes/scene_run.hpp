@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "scene_file.hpp"
+#include "simulation.hpp"
 
 namespace gs::solver {
 
@@ -43,6 +44,18 @@ struct RunOptions {
   std::int64_t progress_every = 64;
   /// Lines for the user: summaries (print) and warnings / notices (warn). Default: dropped.
   std::function<void(const std::string&)> print, warn;
+  /// A domain decomposition over processes (`mpirun`; solver/parallel/): `attach` is called
+  /// with the simulation once it is set up (or loaded from a checkpoint), `gather` before each
+  /// output (history row, frame, checkpoint, the end: process 0's simulation then holds the
+  /// whole state) and `release` after it; `any` is an OR over processes (stops, blow-ups). Every
+  /// process runs the same loop; only process 0's outputs count (`root`: the others write to a
+  /// scratch directory). Plain scenes only.
+  struct Parallel {
+    bool root = true;
+    std::function<void(Simulation&)> attach, gather, release;
+    std::function<bool(bool)> any;
+  };
+  std::optional<Parallel> parallel;
 };
 
 using RunResults = std::vector<std::pair<std::string, double>>;

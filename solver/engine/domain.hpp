@@ -1,0 +1,40 @@
+// What the engine asks of a domain decomposition during a step (issue 23): the collective calls
+// a process makes so that its part of the scene steps as the whole would. Implemented over MPI
+// in solver/parallel/mpi_domain.hpp; without one (the default) a Simulation owns every particle.
+#pragma once
+
+#include <vector>
+
+#include "dem_types.hpp"
+
+namespace gs::solver {
+
+class Simulation;
+
+/// Roles of particles in a process (Simulation::set_roles).
+enum ParticleRole : unsigned char {
+  kAbsent = 0,  // held by other processes only: not in this process's contacts
+  kGhost = 1,   // a copy of another process's particle, refreshed every step
+  kOwned = 2,   // integrated here; the loads on it are complete here
+};
+
+class Domain {
+ public:
+  virtual ~Domain() = default;
+  /// Whether the neighbour lists are rebuilt this step: when any process's own is stale
+  /// (`mine`), so that every process rebuilds, and particles migrate, at the same steps.
+  virtual bool stale(bool mine) = 0;
+  /// The neighbour-list rebuild: particles migrate to their new owners, roles are set, the list
+  /// is rebuilt (Simulation::rebuild_local) with the contact histories other processes held.
+  virtual void rebuild(Simulation& sim) = 0;
+  /// The walls' loads summed over processes (each process summed its own particles' contacts).
+  virtual void reduce_walls(std::vector<WallState>& walls) = 0;
+  /// The largest overlap ratio and whether every state is finite, over processes (so that a
+  /// blow-up stops every process at the same step).
+  virtual void agree(double& max_overlap_ratio, bool& finite) = 0;
+  /// After the integration: the owned particles' new states to the processes holding them as
+  /// ghosts.
+  virtual void exchange(Simulation& sim) = 0;
+};
+
+}  // namespace gs::solver

@@ -1,0 +1,431 @@
+#include "mpi_domain.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+namespace gs::solver {
+
+namespace {
+
+// A particle's state as the contact law and the integrator read it: position, velocity,
+// angular velocity, rotation vector, orientation (w, x, y, z).
+constexpr int kState = 16;
+// With the loads (for output on process 0).
+constexpr int kFullState = kState + 6;
+// A contact history.
+constexpr int kHistory = 23;
+
+void put3(double*& o, const Eigen::Vector3d& v) {
+  *o++ = v[0];
+  *o++ = v[1];
+  *o++ = v[2];
+}
+Eigen::Vector3d get3(const double*& i) {
+  const Eigen::Vector3d v(i[0], i[1], i[2]);
+  i += 3;
+  return v;
+}
+
+void pack_state(const ParticleState& p, std::size_t k, double*& o, bool loads) {
+  put3(o, p.pos[k]);
+  put3(o, p.vel[k]);
+  put3(o, p.angvel[k]);
+  put3(o, p.rot[k]);
+  const Eigen::Quaterniond& q = p.ori[k];
+  *o++ = q.w();
+  *o++ = q.x();
+  *o++ = q.y();
+  *o++ = q.z();
+  if (loads) {
+    put3(o, p.force[k]);
+    put3(o, p.torque[k]);
+  }
+}
+
+void unpack_state(ParticleState& p, std::size_t k, const double*& i, bool loads) {
+  p.pos[k] = get3(i);
+  p.vel[k] = get3(i);
+  p.angvel[k] = get3(i);
+  p.rot[k] = get3(i);
+  p.ori[k] = Eigen::Quaterniond(i[0], i[1], i[2], i[3]);
+  i += 4;
+  if (loads) {
+    p.force[k] = get3(i);
+    p.torque[k] = get3(i);
+  }
+}
+
+void pack_history(const ContactHistory& h, std::vector<double>& o) {
+  const std::size_t at = o.size();
+  o.resize(at + kHistory);
+  double* x = o.data() + at;
+  *x++ = h.a;
+  *x++ = h.b;
+  *x++ = h.real ? 1.0 : 0.0;
+  put3(x, h.normal);
+  put3(x, h.shear_force);
+  put3(x, h.bending);
+  put3(x, h.twist);
+  put3(x, h.point);
+  *x++ = h.fn;
+  *x++ = h.overlap;
+  *x++ = h.kn;
+  *x++ = h.ks;
+  *x++ = h.kr;
+}
+
+std::vector<ContactHistory> unpack_histories(const std::vector<double>& in) {
+  std::vector<ContactHistory> out(in.size() / kHistory);
+  const double* x = in.data();
+  for (ContactHistory& h : out) {
+    h.a = static_cast<std::uint32_t>(x[0]);
+    h.b = static_cast<std::uint32_t>(x[1]);
+    h.real = x[2] != 0;
+    x += 3;
+    h.normal = get3(x);
+    h.shear_force = get3(x);
+    h.bending = get3(x);
+    h.twist = get3(x);
+    h.point = get3(x);
+    h.fn = *x++;
+    h.overlap = *x++;
+    h.kn = *x++;
+    h.ks = *x++;
+    h.kr = *x++;
+  }
+  return out;
+}
+
+void check(int code, const char* what) {
+  if (code != MPI_SUCCESS) throw std::runtime_error(std::string("MPI: ") + what + " failed");
+}
+
+/// Every process's `mine` to every process, concatenated in process order.
+std::vector<double> all_gather(MPI_Comm comm, int size, const std::vector<double>& mine) {
+  const int n = static_cast<int>(mine.size());
+  std::vector<int> counts(static_cast<std::size_t>(size)), displs(static_cast<std::size_t>(size));
+  check(MPI_Allgather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, comm), "allgather");
+  int total = 0;
+  for (int r = 0; r < size; ++r) {
+    displs[static_cast<std::size_t>(r)] = total;
+    total += counts[static_cast<std::size_t>(r)];
+  }
+  std::vector<double> all(static_cast<std::size_t>(total));
+  check(MPI_Allgatherv(mine.data(), n, MPI_DOUBLE, all.data(), counts.data(), displs.data(),
+                       MPI_DOUBLE, comm),
+        "allgatherv");
+  return all;
+}
+
+/// `to[r]` sent to process r; returns what every process sent to this one, in process order.
+std::vector<double> all_to_all(MPI_Comm comm, int size, const std::vector<std::vector<double>>& to,
+                               std::uint64_t& bytes) {
+  const auto n = static_cast<std::size_t>(size);
+  std::vector<int> sc(n), sd(n), rc(n), rd(n);
+  std::vector<double> flat;
+  for (std::size_t r = 0; r < n; ++r) {
+    sd[r] = static_cast<int>(flat.size());
+    sc[r] = static_cast<int>(to[r].size());
+    flat.insert(flat.end(), to[r].begin(), to[r].end());
+    bytes += to[r].size() * sizeof(double);
+  }
+  check(MPI_Alltoall(sc.data(), 1, MPI_INT, rc.data(), 1, MPI_INT, comm), "alltoall");
+  int total = 0;
+  for (std::size_t r = 0; r < n; ++r) {
+    rd[r] = total;
+    total += rc[r];
+  }
+  std::vector<double> in(static_cast<std::size_t>(total));
+  check(MPI_Alltoallv(flat.data(), sc.data(), sd.data(), MPI_DOUBLE, in.data(), rc.data(),
+                      rd.data(), MPI_DOUBLE, comm),
+        "alltoallv");
+  return in;
+}
+
+}  // namespace
+
+MpiDomain::MpiDomain(MPI_Comm comm) : comm_(comm) {
+  check(MPI_Comm_rank(comm_, &rank_), "comm_rank");
+  check(MPI_Comm_size(comm_, &size_), "comm_size");
+}
+
+int MpiDomain::slab_of(double x) const {
+  return static_cast<int>(std::upper_bound(cuts_.begin(), cuts_.end(), x) - cuts_.begin());
+}
+
+bool MpiDomain::near_slab(double x, int r) const {
+  const double lo = r == 0 ? -HUGE_VAL : cuts_[static_cast<std::size_t>(r - 1)];
+  const double hi = r == size_ - 1 ? HUGE_VAL : cuts_[static_cast<std::size_t>(r)];
+  return x > lo - ghost_width_ && x < hi + ghost_width_;
+}
+
+void MpiDomain::attach(Simulation& sim) {
+  const ParticleState& p = sim.particles();
+  const std::size_t n = p.size();
+  // The slabs: along the longest side of the particles' box, cut at equal counts (midway
+  // between neighbouring centres). Every process computes the same from the same particles.
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(HUGE_VAL), hi = -lo;
+  double rmax = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    lo = lo.cwiseMin(p.pos[i]);
+    hi = hi.cwiseMax(p.pos[i]);
+    rmax = std::max(rmax, p.radius[i]);
+  }
+  if (n > 0) (hi - lo).maxCoeff(&axis_);
+  std::vector<double> x(n);
+  for (std::size_t i = 0; i < n; ++i) x[i] = p.pos[i][axis_];
+  std::sort(x.begin(), x.end());
+  cuts_.clear();
+  for (int r = 1; r < size_; ++r) {
+    const std::size_t at = n * static_cast<std::size_t>(r) / static_cast<std::size_t>(size_);
+    cuts_.push_back(at == 0 ? -HUGE_VAL : at >= n ? HUGE_VAL : 0.5 * (x[at - 1] + x[at]));
+  }
+  // A pair is a candidate when its centres are closer than r_a + r_b + skin: the ghosts of a
+  // slab are the particles within 2 r_max + skin of it (a hair more, for the candidates' own
+  // relative slack).
+  ghost_width_ = (2 * rmax + sim.skin()) * (1 + 1e-9);
+  owner_.assign(n, 0);
+  for (std::size_t i = 0; i < n; ++i) owner_[i] = slab_of(p.pos[i][axis_]);
+  // The ledger's particle terms: process 0 keeps the totals (those of a checkpoint too), the
+  // others count what they add from now on (summed on process 0 at each gather).
+  if (rank_ != 0) {
+    EnergyLedger& e = sim.ledger_terms();
+    e.friction_dissipation = e.rolling_dissipation = e.damping_dissipation = 0;
+    e.viscous_dissipation = e.gravity_work = e.external_work = 0;
+  }
+  split_ = false;
+  send_.assign(static_cast<std::size_t>(size_), {});
+  recv_.assign(static_cast<std::size_t>(size_), {});
+  sim.set_domain(this);  // (throws for what is not handled; the first step rebuilds)
+}
+
+bool MpiDomain::stale(bool mine) {
+  return any(mine || !split_);
+}  // (the first step splits)
+
+bool MpiDomain::any(bool mine) {
+  int v = mine ? 1 : 0, all = 0;
+  check(MPI_Allreduce(&v, &all, 1, MPI_INT, MPI_LOR, comm_), "allreduce");
+  return all != 0;
+}
+
+void MpiDomain::agree(double& max_overlap_ratio, bool& finite) {
+  double in[2] = {max_overlap_ratio, finite ? 0.0 : 1.0}, out[2];
+  // (a NaN overlap ratio means a blow-up: counted as infinite)
+  if (!(in[0] == in[0])) in[0] = HUGE_VAL;
+  check(MPI_Allreduce(in, out, 2, MPI_DOUBLE, MPI_MAX, comm_), "allreduce");
+  max_overlap_ratio = out[0];
+  finite = out[1] == 0;
+}
+
+void MpiDomain::reduce_walls(std::vector<WallState>& walls) {
+  // Each process's sums to all, added in process order: the same bits on every process (the
+  // walls move by them, on every process alike).
+  constexpr int kW = 8;
+  std::vector<double> mine(walls.size() * kW);
+  double* o = mine.data();
+  for (const WallState& w : walls) {
+    put3(o, w.force);
+    put3(o, w.torque);
+    *o++ = w.contact_stiffness;
+    *o++ = static_cast<double>(w.contacts);
+  }
+  std::vector<double> all(mine.size() * static_cast<std::size_t>(size_));
+  check(MPI_Allgather(mine.data(), static_cast<int>(mine.size()), MPI_DOUBLE, all.data(),
+                      static_cast<int>(mine.size()), MPI_DOUBLE, comm_),
+        "allgather");
+  for (std::size_t w = 0; w < walls.size(); ++w) {
+    double s[kW] = {};
+    for (int r = 0; r < size_; ++r)
+      for (int j = 0; j < kW; ++j)
+        s[j] += all[static_cast<std::size_t>(r) * mine.size() + w * kW + j];
+    WallState& ws = walls[w];
+    ws.force = Eigen::Vector3d(s[0], s[1], s[2]);
+    ws.torque = Eigen::Vector3d(s[3], s[4], s[5]);
+    ws.contact_stiffness = s[6];
+    ws.contacts = static_cast<std::size_t>(s[7]);
+  }
+}
+
+void MpiDomain::set_lists(const Simulation& sim) {
+  const ParticleState& p = sim.particles();
+  send_.assign(static_cast<std::size_t>(size_), {});
+  recv_.assign(static_cast<std::size_t>(size_), {});
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const double x = p.pos[i][axis_];
+    const int o = owner_[i];
+    if (o == rank_) {
+      for (int r = 0; r < size_; ++r)
+        if (r != rank_ && near_slab(x, r))
+          send_[static_cast<std::size_t>(r)].push_back(static_cast<std::uint32_t>(i));
+    } else if (near_slab(x, rank_)) {
+      recv_[static_cast<std::size_t>(o)].push_back(static_cast<std::uint32_t>(i));
+    }
+  }
+}
+
+void MpiDomain::rebuild(Simulation& sim) {
+  ParticleState& p = sim.particles();
+  const std::size_t n = p.size();
+  ++rebuilds_;
+  split_ = true;
+  // 1. Every owned state to every process (the particles may change hands).
+  std::vector<double> mine;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (owner_[i] != rank_) continue;
+    const std::size_t at = mine.size();
+    mine.resize(at + 1 + kState);
+    double* o = mine.data() + at;
+    *o++ = static_cast<double>(i);
+    pack_state(p, i, o, false);
+  }
+  rebuild_bytes_ += mine.size() * sizeof(double) * static_cast<std::size_t>(size_ - 1);
+  const std::vector<double> all = all_gather(comm_, size_, mine);
+  for (const double* x = all.data(); x < all.data() + all.size();) {
+    const auto i = static_cast<std::size_t>(*x++);
+    if (owner_[i] == rank_) {
+      x += kState;
+      continue;
+    }
+    unpack_state(p, i, x, false);
+  }
+  // 2. The new owners, by the slab each particle is in now.
+  std::vector<int> owner(n);
+  for (std::size_t i = 0; i < n; ++i) owner[i] = slab_of(p.pos[i][axis_]);
+  // 3. Contact histories to the processes that compute their pairs from now on: each pair goes
+  //    from the old owner of its first body (who computed it) to the new owners of its bodies.
+  std::vector<std::vector<double>> to(static_cast<std::size_t>(size_));
+  const auto& pairs = sim.pairs();
+  const auto& hist = sim.histories();
+  for (std::size_t k = 0; k < pairs.size(); ++k) {
+    const auto [a, b] = pairs[k];
+    if (!hist[k].real || owner_[a] != rank_) continue;
+    const int ta = owner[a], tb = b < kWallBase ? owner[b] : ta;
+    if (ta != rank_) pack_history(hist[k], to[static_cast<std::size_t>(ta)]);
+    if (tb != ta && tb != rank_) pack_history(hist[k], to[static_cast<std::size_t>(tb)]);
+  }
+  const std::vector<ContactHistory> received =
+      unpack_histories(all_to_all(comm_, size_, to, rebuild_bytes_));
+  // 4. This process's part, its list, and whom it exchanges ghosts with until the next rebuild.
+  owner_ = std::move(owner);
+  std::vector<std::uint8_t> roles(n);
+  for (std::size_t i = 0; i < n; ++i)
+    roles[i] = owner_[i] == rank_ ? kOwned : near_slab(p.pos[i][axis_], rank_) ? kGhost : kAbsent;
+  sim.set_roles(std::move(roles));
+  sim.rebuild_local(received);
+  set_lists(sim);
+}
+
+void MpiDomain::exchange(Simulation& sim) {
+  ParticleState& p = sim.particles();
+  const auto n = static_cast<std::size_t>(size_);
+  std::size_t send_total = 0, recv_total = 0;
+  for (std::size_t r = 0; r < n; ++r) {
+    send_total += send_[r].size();
+    recv_total += recv_[r].size();
+  }
+  send_buf_.resize(send_total * kState);
+  recv_buf_.resize(recv_total * kState);
+  std::vector<MPI_Request> requests;
+  requests.reserve(2 * n);
+  std::size_t at = 0;
+  for (std::size_t r = 0; r < n; ++r) {
+    if (recv_[r].empty()) continue;
+    requests.emplace_back();
+    check(MPI_Irecv(recv_buf_.data() + at, static_cast<int>(recv_[r].size() * kState), MPI_DOUBLE,
+                    static_cast<int>(r), 7, comm_, &requests.back()),
+          "irecv");
+    at += recv_[r].size() * kState;
+  }
+  at = 0;
+  for (std::size_t r = 0; r < n; ++r) {
+    if (send_[r].empty()) continue;
+    double* o = send_buf_.data() + at;
+    for (const std::uint32_t i : send_[r]) pack_state(p, i, o, false);
+    requests.emplace_back();
+    check(MPI_Isend(send_buf_.data() + at, static_cast<int>(send_[r].size() * kState), MPI_DOUBLE,
+                    static_cast<int>(r), 7, comm_, &requests.back()),
+          "isend");
+    at += send_[r].size() * kState;
+  }
+  halo_bytes_ += send_total * kState * sizeof(double);
+  check(MPI_Waitall(static_cast<int>(requests.size()), requests.data(), MPI_STATUSES_IGNORE),
+        "waitall");
+  const double* x = recv_buf_.data();
+  for (std::size_t r = 0; r < n; ++r)
+    for (const std::uint32_t i : recv_[r]) unpack_state(p, i, x, false);
+}
+
+void MpiDomain::gather(Simulation& sim) {
+  ParticleState& p = sim.particles();
+  const std::size_t n = p.size();
+  // The owned states with their loads, and the real contacts whose first body is owned here.
+  std::vector<double> states, hist;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (owner_[i] != rank_) continue;
+    const std::size_t at = states.size();
+    states.resize(at + 1 + kFullState);
+    double* o = states.data() + at;
+    *o++ = static_cast<double>(i);
+    pack_state(p, i, o, true);
+  }
+  const auto& pairs = sim.pairs();
+  const auto& h = sim.histories();
+  for (std::size_t k = 0; k < pairs.size(); ++k)
+    if (h[k].real && owner_[pairs[k].first] == rank_) pack_history(h[k], hist);
+  auto gather_to_root = [&](const std::vector<double>& mine) {
+    const int c = static_cast<int>(mine.size());
+    std::vector<int> counts(static_cast<std::size_t>(size_)),
+        displs(static_cast<std::size_t>(size_));
+    check(MPI_Gather(&c, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, comm_), "gather");
+    int total = 0;
+    for (int r = 0; r < size_; ++r) {
+      displs[static_cast<std::size_t>(r)] = total;
+      total += counts[static_cast<std::size_t>(r)];
+    }
+    std::vector<double> all(rank_ == 0 ? static_cast<std::size_t>(total) : 0);
+    check(MPI_Gatherv(mine.data(), c, MPI_DOUBLE, all.data(), counts.data(), displs.data(),
+                      MPI_DOUBLE, 0, comm_),
+          "gatherv");
+    return all;
+  };
+  const std::vector<double> all_states = gather_to_root(states);
+  const std::vector<double> all_hist = gather_to_root(hist);
+  // The ledger's particle terms (each process counted its own particles and their contacts);
+  // the walls' work is the same on every process, from the summed wall loads.
+  EnergyLedger& e = sim.ledger_terms();
+  double terms[6] = {e.friction_dissipation, e.rolling_dissipation, e.damping_dissipation,
+                     e.viscous_dissipation,  e.gravity_work,        e.external_work};
+  double sums[6] = {};
+  check(MPI_Reduce(terms, sums, 6, MPI_DOUBLE, MPI_SUM, 0, comm_), "reduce");
+  if (rank_ != 0) {
+    // (counted on process 0 from now on)
+    e.friction_dissipation = e.rolling_dissipation = e.damping_dissipation = 0;
+    e.viscous_dissipation = e.gravity_work = e.external_work = 0;
+    return;
+  }
+  e.friction_dissipation = sums[0];
+  e.rolling_dissipation = sums[1];
+  e.damping_dissipation = sums[2];
+  e.viscous_dissipation = sums[3];
+  e.gravity_work = sums[4];
+  e.external_work = sums[5];
+  for (const double* x = all_states.data(); x < all_states.data() + all_states.size();) {
+    const auto i = static_cast<std::size_t>(*x++);
+    unpack_state(p, i, x, true);
+  }
+  my_roles_ = sim.roles();
+  sim.set_roles({});
+  sim.rebuild_local(unpack_histories(all_hist), true);
+}
+
+void MpiDomain::release(Simulation& sim) {
+  if (rank_ != 0) return;
+  sim.set_roles(my_roles_);
+  sim.rebuild_local({}, true);
+}
+
+}  // namespace gs::solver
