@@ -99,6 +99,13 @@ std::vector<ContactHistory> unpack_histories(const std::vector<double>& in) {
   return out;
 }
 
+/// The ledger's terms summed over particles and contacts (the walls' work is the same on every
+/// process, from the summed wall loads).
+void zero_particle_terms(EnergyLedger& e) {
+  e.friction_dissipation = e.rolling_dissipation = e.damping_dissipation = 0;
+  e.viscous_dissipation = e.gravity_work = e.external_work = 0;
+}
+
 void check(int code, const char* what) {
   if (code != MPI_SUCCESS) throw std::runtime_error(std::string("MPI: ") + what + " failed");
 }
@@ -191,11 +198,7 @@ void MpiDomain::attach(Simulation& sim) {
   for (std::size_t i = 0; i < n; ++i) owner_[i] = slab_of(p.pos[i][axis_]);
   // The ledger's particle terms: process 0 keeps the totals (those of a checkpoint too), the
   // others count what they add from now on (summed on process 0 at each gather).
-  if (rank_ != 0) {
-    EnergyLedger& e = sim.ledger_terms();
-    e.friction_dissipation = e.rolling_dissipation = e.damping_dissipation = 0;
-    e.viscous_dissipation = e.gravity_work = e.external_work = 0;
-  }
+  if (rank_ != 0) zero_particle_terms(sim.ledger_terms());
   split_ = false;
   send_.assign(static_cast<std::size_t>(size_), {});
   recv_.assign(static_cast<std::size_t>(size_), {});
@@ -401,12 +404,7 @@ void MpiDomain::gather(Simulation& sim) {
                      e.viscous_dissipation,  e.gravity_work,        e.external_work};
   double sums[6] = {};
   check(MPI_Reduce(terms, sums, 6, MPI_DOUBLE, MPI_SUM, 0, comm_), "reduce");
-  if (rank_ != 0) {
-    // (counted on process 0 from now on)
-    e.friction_dissipation = e.rolling_dissipation = e.damping_dissipation = 0;
-    e.viscous_dissipation = e.gravity_work = e.external_work = 0;
-    return;
-  }
+  if (rank_ != 0) return zero_particle_terms(e);  // (counted on process 0 from now on)
   e.friction_dissipation = sums[0];
   e.rolling_dissipation = sums[1];
   e.damping_dissipation = sums[2];

@@ -60,30 +60,42 @@ inline void expect_rejected(const CliResult& r, const std::string& file) {
   EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
 }
 
-/// Starts `granoscope simulate SCENE -q -o OUT` and kills it (SIGKILL) once a checkpoint past
-/// `step` is on disk; false if the run ended first.
-inline bool run_and_kill(const std::string& scene, const std::filesystem::path& out, long step) {
+/// Starts the program `argv` (stdout and stderr to /dev/null) in a process group of its own,
+/// and sends the group `sig` once a checkpoint at or past `step` is in `out`; false if the
+/// program ended first (exit code 0).
+inline bool stop_at_checkpoint(const std::vector<std::string>& argv,
+                               const std::filesystem::path& out, long step, int sig) {
+  std::vector<char*> args;
+  for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
+  args.push_back(nullptr);
   const pid_t pid = fork();
   if (pid < 0) return false;
   if (pid == 0) {
+    setpgid(0, 0);
     const int devnull = ::open("/dev/null", O_WRONLY);
     dup2(devnull, 1);
     dup2(devnull, 2);
-    execl(kGranoscope.c_str(), kGranoscope.c_str(), "simulate", scene.c_str(), "-q", "-o",
-          out.c_str(), nullptr);
+    execvp(args[0], args.data());
     _exit(127);
   }
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
   while (std::chrono::steady_clock::now() < deadline) {
     const std::string idx = slurp(out / "checkpoint.txt");
     const auto k = idx.find("\nstep ");
     if (k != std::string::npos && std::stol(idx.substr(k + 6)) >= step) break;
     std::this_thread::sleep_for(std::chrono::microseconds(200));
   }
-  kill(pid, SIGKILL);
+  kill(-pid, sig);
   int status = 0;
   waitpid(pid, &status, 0);
-  return WIFSIGNALED(status);
+  return !(WIFEXITED(status) && WEXITSTATUS(status) == 0);
+}
+
+/// Starts `granoscope simulate SCENE -q -o OUT` and kills it (SIGKILL) once a checkpoint past
+/// `step` is on disk; false if the run ended first.
+inline bool run_and_kill(const std::string& scene, const std::filesystem::path& out, long step) {
+  return stop_at_checkpoint({kGranoscope, "simulate", scene, "-q", "-o", out.string()}, out, step,
+                            SIGKILL);
 }
 
 /// A CSV file of numbers as its header and rows.

@@ -6,13 +6,10 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-#include <fcntl.h>
-
-#include <chrono>
 #include <cmath>
 #include <fstream>
+#include <sstream>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include "../io/test_util.hpp"
@@ -32,17 +29,10 @@ const std::string kExe = std::string(GS_BINARY_DIR) + "/bin/granoscope";
 const std::string kMpirun =
     "mpirun --allow-run-as-root --oversubscribe --mca btl_vader_single_copy_mechanism none -np ";
 
-std::vector<std::string> argv_of(const std::string& cmd) {
+std::vector<std::string> words(const std::string& cmd) {
   std::vector<std::string> out;
-  std::string w;
-  for (const char c : cmd + " ") {
-    if (c == ' ') {
-      if (!w.empty()) out.push_back(w);
-      w.clear();
-    } else {
-      w += c;
-    }
-  }
+  std::istringstream in(cmd);
+  for (std::string w; in >> w;) out.push_back(w);
   return out;
 }
 
@@ -53,36 +43,6 @@ int run(const std::string& cmd, std::string* err = nullptr) {
   if (err) *err = slurp(e);
   fs::remove(e);
   return WIFEXITED(status) ? WEXITSTATUS(status) : 128;
-}
-
-/// Starts `cmd`, and stops it (SIGTERM: mpirun passes it on to its processes) once a
-/// checkpoint at or past `step` is in `out`. False if the run ended first.
-bool stop_after_checkpoint(const std::string& cmd, const fs::path& out, long step) {
-  const std::vector<std::string> args = argv_of(cmd);
-  std::vector<char*> argv;
-  for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
-  argv.push_back(nullptr);
-  const pid_t pid = fork();
-  if (pid == 0) {
-    setpgid(0, 0);
-    const int devnull = ::open("/dev/null", O_WRONLY);
-    dup2(devnull, 1);
-    dup2(devnull, 2);
-    execvp(argv[0], argv.data());
-    _exit(127);
-  }
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
-  while (std::chrono::steady_clock::now() < deadline) {
-    const std::string idx = slurp(out / "checkpoint.txt");
-    const auto k = idx.find("\nstep ");
-    if (k != std::string::npos && std::stol(idx.substr(k + 6)) >= step) break;
-    std::this_thread::sleep_for(std::chrono::microseconds(200));
-  }
-  kill(-pid, SIGTERM);
-  int status = 0;
-  waitpid(pid, &status, 0);
-  // (mpirun reports its processes' deaths with an exit code)
-  return !(WIFEXITED(status) && WEXITSTATUS(status) == 0);
 }
 
 /// Particles and contacts the same to the bit; walls' loads (sums over processes in another
@@ -112,30 +72,28 @@ bool mpirun_present() {
 
 }  // namespace
 
-// The shared YADE oedometer (883 spheres, five box walls, the top one moving): 2 000 steps on one
-// process and on two (slabs along z, particles migrating between them).
-TEST(Mpi, TwoProcessesStepTheOedometerAsOneBitForBit) {
-  if (!mpirun_present()) GTEST_SKIP() << "mpirun not installed (apt-get install openmpi-bin)";
-  gs::test::ScratchDir dir("mpi_oedometer");
-  const std::string scene = (kScenes / "oedometer_yade.toml").string();
-  const std::string args = " simulate " + scene + " -q --steps 2000 --threads 1 -o ";
+/// `SCENE` (with `extra` options) on one process and on two: the same runs.
+void one_against_two(const std::string& scene, const std::string& extra, const std::string& h5) {
+  gs::test::ScratchDir dir("mpi_one_two");
+  const std::string args = " simulate " + scene + " -q --threads 1 " + extra + " -o ";
   ASSERT_EQ(run(kExe + args + (dir / "one").string()), 0);
   std::string err;
   ASSERT_EQ(run(kMpirun + "2 " + kExe + args + (dir / "two").string(), &err), 0) << err;
-  expect_same_run(dir / "one" / "oedometer_yade.h5", dir / "two" / "oedometer_yade.h5");
+  expect_same_run(dir / "one" / h5, dir / "two" / h5);
+}
+
+// The shared YADE oedometer (883 spheres, five box walls, the top one moving): 2 000 steps on one
+// process and on two (slabs along z).
+TEST(Mpi, TwoProcessesStepTheOedometerAsOneBitForBit) {
+  if (!mpirun_present()) GTEST_SKIP() << "mpirun not installed (apt-get install openmpi-bin)";
+  one_against_two((kScenes / "oedometer_yade.toml").string(), "--steps 2000", "oedometer_yade.h5");
 }
 
 // The same packing dropped onto its floor under a strong, slanted gravity: 6 000 steps with ~90
 // neighbour-list rebuilds, particles and their contacts moving between the processes.
 TEST(Mpi, TwoProcessesStepAFallingPackingAsOneBitForBit) {
   if (!mpirun_present()) GTEST_SKIP() << "mpirun not installed (apt-get install openmpi-bin)";
-  gs::test::ScratchDir dir("mpi_fall");
-  const std::string scene = (kData / "scenes" / "oedometer_fall.toml").string();
-  const std::string args = " simulate " + scene + " -q --threads 1 -o ";
-  ASSERT_EQ(run(kExe + args + (dir / "one").string()), 0);
-  std::string err;
-  ASSERT_EQ(run(kMpirun + "2 " + kExe + args + (dir / "two").string(), &err), 0) << err;
-  expect_same_run(dir / "one" / "oedometer_fall.h5", dir / "two" / "oedometer_fall.h5");
+  one_against_two((kData / "scenes" / "oedometer_fall.toml").string(), "", "oedometer_fall.h5");
 }
 
 // A checkpoint is one process's format whatever wrote it: a two-process run stopped after a
@@ -147,10 +105,12 @@ TEST(Mpi, CheckpointsResumeOnAnyNumberOfProcesses) {
   const std::string args = " simulate " + scene + " -q --threads 1 -o ";
   ASSERT_EQ(run(kExe + args + (dir / "straight").string()), 0);
   const fs::path two_then_one = dir / "two_then_one", one_then_two = dir / "one_then_two";
-  ASSERT_TRUE(stop_after_checkpoint(kMpirun + "2 " + kExe + args + two_then_one.string(),
-                                    two_then_one, 3000))
+  // (SIGTERM: mpirun passes it on to its processes)
+  ASSERT_TRUE(gs::test::stop_at_checkpoint(
+      words(kMpirun + "2 " + kExe + args + two_then_one.string()), two_then_one, 3000, SIGTERM))
       << "the run ended before it could be stopped";
-  ASSERT_TRUE(stop_after_checkpoint(kExe + args + one_then_two.string(), one_then_two, 3000));
+  ASSERT_TRUE(gs::test::stop_at_checkpoint(words(kExe + args + one_then_two.string()), one_then_two,
+                                           3000, SIGTERM));
   std::string err;
   ASSERT_EQ(run(kExe + args + two_then_one.string() + " --resume", &err), 0) << err;
   ASSERT_EQ(run(kMpirun + "2 " + kExe + args + one_then_two.string() + " --resume", &err), 0)
