@@ -1,5 +1,7 @@
 #include "scene_file.hpp"
 
+#include <omp.h>
+
 #include <toml++/toml.h>
 #include <algorithm>
 #include <array>
@@ -1044,6 +1046,12 @@ void apply_override(const Reader& r, toml::table& root, const std::string& key,
 
 }  // namespace
 
+int auto_threads(std::size_t particles) {
+  if (particles < kAutoThreadsFrom) return 1;
+  const int cores = omp_get_num_procs();
+  return std::clamp(cores, 1, kMaxThreads);
+}
+
 Scene load_scene(const std::filesystem::path& path, int sweep_point,
                  const SceneOverrides& overrides) {
   const std::string file = path.string();
@@ -1329,7 +1337,15 @@ Scene load_scene(const std::filesystem::path& path, int sweep_point,
     r.fail("solver.damping", "outside [0, 1)", value_str(s.config.damping));
   s.config.gravity = r.vec3(sol, "solver", "gravity_m_s2", false, Eigen::Vector3d::Zero());
   s.steps = r.integer(sol, "solver", "steps", s.test.empty(), 0, 0);
-  const std::int64_t threads = r.integer(sol, "solver", "threads", false, 1, 1);
+  // "auto" (and the default): chosen by the run from the number of particles (auto_threads).
+  std::int64_t threads = 0;
+  if (sol->contains("threads") && (*sol)["threads"].is_string()) {
+    if (r.string(sol, "solver", "threads", true, "") != "auto")
+      r.fail("solver.threads", "expected a number or \"auto\"",
+             r.string(sol, "solver", "threads", true, ""));
+  } else {
+    threads = r.integer(sol, "solver", "threads", false, 0, 1);
+  }
   if (threads > kMaxThreads)
     r.fail("solver.threads", "must be at most " + std::to_string(kMaxThreads),
            std::to_string(threads));

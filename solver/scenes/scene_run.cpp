@@ -312,6 +312,9 @@ RunOutcome run_scene(Scene scene, const RunOptions& a) {
   auto programmes = scene_programmes(scene);
   if (a.threads > 0) scene.config.threads = a.threads;
   const RunOptions::Parallel* par = a.parallel ? &*a.parallel : nullptr;
+  const bool threads_by_size = scene.config.threads == 0;
+  if (threads_by_size)  // "auto"; under mpirun one thread a process (the processes take the cores)
+    scene.config.threads = par ? 1 : auto_threads(scene.particles.size());
   if (par && (!scene.test.empty() || scene.fill))
     throw InputError(scene_file,
                      "under mpirun only plain scenes run yet (no scene.test, no [fill])",
@@ -659,9 +662,10 @@ RunOutcome run_scene(Scene scene, const RunOptions& a) {
   const auto& e = sim.energy();
   char buf[512];
   std::snprintf(buf, sizeof buf,
-                "%s: %lld steps of %zu particles in %.2f s (%.3g particle-steps/s, %d thread(s))",
+                "%s: %lld steps of %zu particles in %.2f s (%.3g particle-steps/s, %d thread(s)%s)",
                 scene.name.c_str(), static_cast<long long>(s - first), sim.particles().size(), el,
-                ps / std::max(el, 1e-9), scene.config.threads);
+                ps / std::max(el, 1e-9), scene.config.threads,
+                threads_by_size ? ", picked by size" : "");
   print(buf);
   std::snprintf(
       buf, sizeof buf,

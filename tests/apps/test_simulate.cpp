@@ -126,6 +126,8 @@ TEST(Simulate, BadScenesGiveOneLineAndExit2) {
        "material.young_MPa: unknown key"},
       {variant("steps.toml", "steps = 8000", "steps = -5"),
        "solver.steps: must be at least 0 (-5)"},
+      {variant("threads.toml", "threads = 1", "threads = \"many\""),
+       "solver.threads: expected a number or \"auto\" (many)"},
   };
   const std::string syntax = variant("syntax.toml", "[solver]", "[solver");
   cases.push_back({syntax, "TOML syntax error at line " + std::to_string(line) + " (", true});
@@ -219,6 +221,27 @@ TEST(Simulate, OneAndTwoThreadsWriteIdenticalOutputs) {
   for (std::size_t i = 0; i < a.frames.size(); ++i)
     gs::test::expect_same_frame(a.frames[i], b.frames[i]);
   EXPECT_GT(a.frames.back().contacts.size(), 100u);  // the loads split between the threads
+}
+
+// `threads = "auto"` (and a scene without the key) picks one thread below 5 000 particles and
+// says so in the summary line.
+TEST(Simulate, AutoThreadsPickOneThreadForASmallScene) {
+  gs::test::ScratchDir dir("simulate_auto_threads");
+  std::string text = slurp(kData / "scenes" / "drop.toml");
+  const std::string t = "threads = 1";
+  ASSERT_NE(text.find(t), std::string::npos);
+  std::filesystem::copy_file(kData / "scenes" / "drop_packing.csv", dir / "drop_packing.csv");
+  for (const char* with : {"threads = \"auto\"", ""}) {
+    std::string scene = text;
+    scene.replace(scene.find(t), t.size(), with);
+    std::ofstream(dir / "auto.toml") << scene;
+    const auto r = gs::test::run_cli(
+        "simulate " + (dir / "auto.toml").string() + " -q --steps 100 -o " + (dir / "o").string(),
+        dir.path);
+    ASSERT_EQ(r.rc, 0) << r.err;
+    EXPECT_NE(r.out.find("150 particles"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find(", 1 thread(s), picked by size)"), std::string::npos) << r.out;
+  }
 }
 
 namespace {

@@ -2,6 +2,7 @@
 // plain code (bit for bit), the Verlet list against an all-pairs search, box–sphere geometry
 // against hand-computed values, and dt = "auto" against its documented formula.
 #include <gtest/gtest.h>
+#include <omp.h>
 
 #include <unistd.h>
 
@@ -679,3 +680,12 @@ TEST(SceneFile, AutoTimeStepIsSafetyTimesPWaveStep) {
 }
 
 }  // namespace
+
+// `threads = "auto"`: one thread below kAutoThreadsFrom particles (two were slower than one on
+// 883 and 2 000 spheres here, docs/scale.md), the machine's cores from there.
+TEST(AutoThreads, OneBelowTheThresholdTheCoresFromIt) {
+  EXPECT_EQ(auto_threads(0), 1);
+  EXPECT_EQ(auto_threads(kAutoThreadsFrom - 1), 1);
+  EXPECT_EQ(auto_threads(kAutoThreadsFrom), std::clamp(omp_get_num_procs(), 1, kMaxThreads));
+  EXPECT_EQ(auto_threads(1000000), auto_threads(kAutoThreadsFrom));
+}
