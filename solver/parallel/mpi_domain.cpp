@@ -110,20 +110,60 @@ void check(int code, const char* what) {
   if (code != MPI_SUCCESS) throw std::runtime_error(std::string("MPI: ") + what + " failed");
 }
 
-/// Every process's `mine` to every process, concatenated in process order.
-std::vector<double> all_gather(MPI_Comm comm, int size, const std::vector<double>& mine) {
+/// This process's owned particles: each its index and state (with the loads: for output).
+std::vector<double> pack_owned(const ParticleState& p, const std::vector<int>& owner, int rank,
+                               bool loads) {
+  std::vector<double> out;
+  const int width = 1 + (loads ? kFullState : kState);
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    if (owner[i] != rank) continue;
+    const std::size_t at = out.size();
+    out.resize(at + static_cast<std::size_t>(width));
+    double* o = out.data() + at;
+    *o++ = static_cast<double>(i);
+    pack_state(p, i, o, loads);
+  }
+  return out;
+}
+
+/// Counts of `mine` from every process and their offsets (what the v-collectives take).
+int counts_of(MPI_Comm comm, int size, int root, const std::vector<double>& mine,
+              std::vector<int>& counts, std::vector<int>& displs) {
   const int n = static_cast<int>(mine.size());
-  std::vector<int> counts(static_cast<std::size_t>(size)), displs(static_cast<std::size_t>(size));
-  check(MPI_Allgather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, comm), "allgather");
+  counts.assign(static_cast<std::size_t>(size), 0);
+  displs.assign(static_cast<std::size_t>(size), 0);
+  if (root < 0)
+    check(MPI_Allgather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, comm), "allgather");
+  else
+    check(MPI_Gather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, root, comm), "gather");
   int total = 0;
   for (int r = 0; r < size; ++r) {
     displs[static_cast<std::size_t>(r)] = total;
     total += counts[static_cast<std::size_t>(r)];
   }
-  std::vector<double> all(static_cast<std::size_t>(total));
-  check(MPI_Allgatherv(mine.data(), n, MPI_DOUBLE, all.data(), counts.data(), displs.data(),
-                       MPI_DOUBLE, comm),
+  return total;
+}
+
+/// Every process's `mine` to every process, concatenated in process order.
+std::vector<double> all_gather(MPI_Comm comm, int size, const std::vector<double>& mine) {
+  std::vector<int> counts, displs;
+  std::vector<double> all(
+      static_cast<std::size_t>(counts_of(comm, size, -1, mine, counts, displs)));
+  check(MPI_Allgatherv(mine.data(), static_cast<int>(mine.size()), MPI_DOUBLE, all.data(),
+                       counts.data(), displs.data(), MPI_DOUBLE, comm),
         "allgatherv");
+  return all;
+}
+
+/// Every process's `mine` on process 0, concatenated in process order (empty elsewhere).
+std::vector<double> gather_at_root(MPI_Comm comm, int size, int rank,
+                                   const std::vector<double>& mine) {
+  std::vector<int> counts, displs;
+  const int total = counts_of(comm, size, 0, mine, counts, displs);
+  std::vector<double> all(rank == 0 ? static_cast<std::size_t>(total) : 0);
+  check(MPI_Gatherv(mine.data(), static_cast<int>(mine.size()), MPI_DOUBLE, all.data(),
+                    counts.data(), displs.data(), MPI_DOUBLE, 0, comm),
+        "gatherv");
   return all;
 }
 
@@ -276,15 +316,7 @@ void MpiDomain::rebuild(Simulation& sim) {
   ++rebuilds_;
   split_ = true;
   // 1. Every owned state to every process (the particles may change hands).
-  std::vector<double> mine;
-  for (std::size_t i = 0; i < n; ++i) {
-    if (owner_[i] != rank_) continue;
-    const std::size_t at = mine.size();
-    mine.resize(at + 1 + kState);
-    double* o = mine.data() + at;
-    *o++ = static_cast<double>(i);
-    pack_state(p, i, o, false);
-  }
+  const std::vector<double> mine = pack_owned(p, owner_, rank_, false);
   rebuild_bytes_ += mine.size() * sizeof(double) * static_cast<std::size_t>(size_ - 1);
   const std::vector<double> all = all_gather(comm_, size_, mine);
   for (const double* x = all.data(); x < all.data() + all.size();) {
@@ -364,39 +396,15 @@ void MpiDomain::exchange(Simulation& sim) {
 
 void MpiDomain::gather(Simulation& sim) {
   ParticleState& p = sim.particles();
-  const std::size_t n = p.size();
   // The owned states with their loads, and the real contacts whose first body is owned here.
-  std::vector<double> states, hist;
-  for (std::size_t i = 0; i < n; ++i) {
-    if (owner_[i] != rank_) continue;
-    const std::size_t at = states.size();
-    states.resize(at + 1 + kFullState);
-    double* o = states.data() + at;
-    *o++ = static_cast<double>(i);
-    pack_state(p, i, o, true);
-  }
+  const std::vector<double> states = pack_owned(p, owner_, rank_, true);
+  std::vector<double> hist;
   const auto& pairs = sim.pairs();
   const auto& h = sim.histories();
   for (std::size_t k = 0; k < pairs.size(); ++k)
     if (h[k].real && owner_[pairs[k].first] == rank_) pack_history(h[k], hist);
-  auto gather_to_root = [&](const std::vector<double>& mine) {
-    const int c = static_cast<int>(mine.size());
-    std::vector<int> counts(static_cast<std::size_t>(size_)),
-        displs(static_cast<std::size_t>(size_));
-    check(MPI_Gather(&c, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, comm_), "gather");
-    int total = 0;
-    for (int r = 0; r < size_; ++r) {
-      displs[static_cast<std::size_t>(r)] = total;
-      total += counts[static_cast<std::size_t>(r)];
-    }
-    std::vector<double> all(rank_ == 0 ? static_cast<std::size_t>(total) : 0);
-    check(MPI_Gatherv(mine.data(), c, MPI_DOUBLE, all.data(), counts.data(), displs.data(),
-                      MPI_DOUBLE, 0, comm_),
-          "gatherv");
-    return all;
-  };
-  const std::vector<double> all_states = gather_to_root(states);
-  const std::vector<double> all_hist = gather_to_root(hist);
+  const std::vector<double> all_states = gather_at_root(comm_, size_, rank_, states);
+  const std::vector<double> all_hist = gather_at_root(comm_, size_, rank_, hist);
   // The ledger's particle terms (each process counted its own particles and their contacts);
   // the walls' work is the same on every process, from the summed wall loads.
   EnergyLedger& e = sim.ledger_terms();
