@@ -29,6 +29,9 @@ class Domain {
   virtual void rebuild(Simulation& sim) = 0;
   /// The walls' loads summed over processes (each process summed its own particles' contacts).
   virtual void reduce_walls(std::vector<WallState>& walls) = 0;
+  /// A periodic cell's stress (and affine stiffness, if not null) summed over processes, each
+  /// having summed its owned contacts (before the division by the volume).
+  virtual void reduce_cell(Eigen::Matrix3d& stress, Eigen::Vector3d* stiffness) = 0;
   /// The largest overlap ratio and whether every state is finite, over processes (so that a
   /// blow-up stops every process at the same step).
   virtual void agree(double& max_overlap_ratio, bool& finite) = 0;

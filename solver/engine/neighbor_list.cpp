@@ -17,16 +17,19 @@ bool NeighborList::stale(const ParticleState& p, const std::vector<WallState>& w
     // build), M = ΔH·H_ref⁻¹ (|M|₂ ≤ |M|_F): a pair farther than r_a + r_b + skin at the
     // build stays apart while 2·max|u| + |M|·(2 r_max + skin) < skin.
     moved = HUGE_VAL;  // (no facet walls in a periodic cell)
+    // (a domain's absent particles are not moved here: their affine part is not theirs)
+    const std::uint8_t* out = absent && absent->size() == p.size() ? absent->data() : nullptr;
     if (cell->hsize == h_ref) {
       double d2 = 0;
       for (std::size_t i = 0; i < p.size(); ++i)
-        d2 = std::max(d2, (p.pos[i] - ref_pos[i]).squaredNorm());
+        if (!out || !out[i]) d2 = std::max(d2, (p.pos[i] - ref_pos[i]).squaredNorm());
       return 2 * std::sqrt(d2) > skin;
     }
     const Eigen::Matrix3d m = (cell->hsize - h_ref) * h_ref.inverse();
     double d2 = 0;
     for (std::size_t i = 0; i < p.size(); ++i)
-      d2 = std::max(d2, (p.pos[i] - ref_pos[i] - m * ref_pos[i]).squaredNorm());
+      if (!out || !out[i])
+        d2 = std::max(d2, (p.pos[i] - ref_pos[i] - m * ref_pos[i]).squaredNorm());
     return 2 * std::sqrt(d2) + m.norm() * (2 * max_radius + skin) > skin;
   }
   double dmax2 = 0;
@@ -392,6 +395,10 @@ void NeighborList::build_periodic(const ParticleState& p, const PeriodicCell& ce
   const std::size_t n = p.size();
   const bool removal = p.removed.size() == n;
   auto gone = [&](std::size_t i) { return removal && p.removed[i] != 0; };
+  // (a domain's absent particles are not binned, but count in r_max: the bins, and the
+  // staleness bound from it, are then those of every process and of one process alone)
+  const bool masked = absent && absent->size() == n;
+  auto skipped = [&](std::size_t i) { return gone(i) || (masked && (*absent)[i] != 0); };
   h_ref = cell.hsize;
   double rmax = 0;
   for (std::size_t i = 0; i < n; ++i)
@@ -426,7 +433,7 @@ void NeighborList::build_periodic(const ParticleState& p, const PeriodicCell& ce
   cell_start_.assign(ncells + 1, 0);
   wrapped_.resize(n);
   for (std::size_t i = 0; i < n; ++i) {
-    if (gone(i)) continue;
+    if (skipped(i)) continue;
     Eigen::Vector3d s = inv * p.pos[i];
     Eigen::Array3i c;
     for (int k = 0; k < 3; ++k) {
@@ -444,7 +451,7 @@ void NeighborList::build_periodic(const ParticleState& p, const PeriodicCell& ce
   slots_.resize(cell_start_[ncells]);
   const bool clumped = p.clump.size() == n;
   for (std::size_t i = 0; i < n; ++i) {
-    if (gone(i)) continue;
+    if (skipped(i)) continue;
     const Eigen::Vector3d& x = wrapped_[i];
     slots_[cell_fill_[cell_of_particle_[i]]++] = {
         x[0], x[1], x[2], p.radius[i], static_cast<std::uint32_t>(i), clumped ? p.clump[i] : -1};

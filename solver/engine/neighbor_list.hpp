@@ -42,8 +42,8 @@ struct NeighborList {
   /// last build (m), i.e. on how much any pair's gap can have closed.
   mutable double moved = 0;
   mutable double walls_moved = 0;  // the same for the walls alone (m)
-  /// Particles the build leaves out (1), as it does removed ones: those of other processes
-  /// (Simulation::set_roles). nullptr or empty: none.
+  /// Particles the build leaves out (1), as it does removed ones, and a cell's staleness test
+  /// ignores: those of other processes (Simulation::set_roles). nullptr or empty: none.
   const std::vector<std::uint8_t>* absent = nullptr;
 
   /// True when some pair may have come within contact since the last build.

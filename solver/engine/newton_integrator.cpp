@@ -432,12 +432,14 @@ void integrate_clump_bodies(ClumpBody* clumps, const ClumpLoad* loads, std::size
 IntegrationSums integrate_particles_homogeneous(ParticleState& p, std::size_t begin,
                                                 std::size_t end, const Eigen::Vector3d& gravity,
                                                 double damping, double dt,
-                                                const HomogeneousField& field) {
+                                                const HomogeneousField& field,
+                                                const std::uint8_t* roles) {
   IntegrationSums sums;
   const V3 g(gravity);
   const bool planar = field.planar;
   const V3 d_spin(field.d_spin);
   for (std::size_t i = begin; i < end; ++i) {
+    if (roles && roles[i] != kOwned) continue;  // (another process's to move)
     const V3 pos0(p.pos[i]);
     V3 vel(p.vel[i]), angvel(p.angvel[i]);
     if (!p.fixed[i]) {

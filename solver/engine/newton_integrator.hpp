@@ -53,9 +53,11 @@ struct HomogeneousField {
 /// term a += L_prev·v, v += dt·a, then v += ΔL·x and x += dt·v; ω += dt·α, then ω += Δspin and
 /// the orientation turned by |ω|·dt (AngleAxis, as leapfrogSphericalRotate). Blocked degrees of
 /// freedom get no acceleration (their velocities keep what the field gives them). No clumps.
+/// `roles` as in integrate_particles: only the owned particles move (and count in the sums).
 IntegrationSums integrate_particles_homogeneous(ParticleState& p, std::size_t begin,
                                                 std::size_t end, const Eigen::Vector3d& gravity,
                                                 double damping, double dt,
-                                                const HomogeneousField& field);
+                                                const HomogeneousField& field,
+                                                const std::uint8_t* roles = nullptr);
 
 }  // namespace gs::solver

@@ -271,6 +271,8 @@ void Simulation::set_periodic(const Eigen::Matrix3d& hsize, bool planar) {
   invalidate_neighbors();
   nl_.build(p_, walls_, cell_ptr(), planar_);  // (throws PeriodicTooSmall now, not at step 1)
   invalidate_neighbors();
+  nl_.pairs.clear();  // (pairs and histories go together: the first step finds them)
+  nl_.cell_dist.clear();
 }
 
 void Simulation::set_cell_servo(const CellServo& servo) {
@@ -320,12 +322,14 @@ void Simulation::set_velocity_gradient(const Eigen::Matrix3d& l) {
   cell_.set_velocity_gradient(l);
 }
 
-void Simulation::cell_sums(Eigen::Matrix3d& stress, Eigen::Vector3d* stiffness) const {
+void Simulation::cell_sums(Eigen::Matrix3d& stress, Eigen::Vector3d* stiffness,
+                           bool over_domain) const {
   stress.setZero();
   if (stiffness) stiffness->setZero();
   for (std::size_t k = 0; k < hist_.size(); ++k) {
     const auto& h = hist_[k];
     if (!h.real || h.b >= kWallBase) continue;
+    if (over_domain && roles_[h.a] != kOwned) continue;  // (the owner of a's counts it)
     Eigen::Vector3d branch = p_.pos[h.a] - p_.pos[h.b];
     if (periodic_) branch -= cell_.hsize * nl_.cell_dist[k].cast<double>();
     stress += (h.fn * h.normal + h.shear_force) * branch.transpose();
@@ -335,6 +339,8 @@ void Simulation::cell_sums(Eigen::Matrix3d& stress, Eigen::Vector3d* stiffness) 
           branch.array().square() * (params_[k].kn * n2 + params_[k].ks * (1 - n2));
     }
   }
+  // (over a domain: every process's sums, added in process order; collective)
+  if (over_domain) domain_->reduce_cell(stress, stiffness);
   const double volume = periodic_ ? cell_.volume() : 0.0;
   if (!(volume > 0)) return;
   stress /= volume;
@@ -372,7 +378,6 @@ void Simulation::set_domain(Domain* domain) {
     for (const auto r : p_.removed) pending = pending || r != 0;
     const char* what = !clumps_.empty() ? "clumps"
                        : facets         ? "facet (mesh) walls"
-                       : periodic_      ? "a periodic cell"
                        : outlet_        ? "an outlet"
                        : pending        ? "removed or pending particles (filling)"
                                         : nullptr;
@@ -390,6 +395,7 @@ void Simulation::set_roles(std::vector<std::uint8_t> roles) {
   roles_ = std::move(roles);
   absent_.resize(roles_.size());
   for (std::size_t i = 0; i < roles_.size(); ++i) absent_[i] = roles_[i] == kAbsent;
+  nl_.absent = roles_.empty() ? nullptr : &absent_;
 }
 
 void Simulation::rebuild_local(const std::vector<ContactHistory>& received, bool keep_reference) {
@@ -400,19 +406,29 @@ void Simulation::rebuild_local(const std::vector<ContactHistory>& received, bool
     kept_ref_pos_.swap(nl_.ref_pos);
     kept_wall_ref_ = {nl_.wall_ref, nl_.wall_normal_ref};
   }
+  const Eigen::Matrix3d h_ref = nl_.h_ref;
   nl_.absent = roles_.empty() ? nullptr : &absent_;
   nl_.build(p_, walls_, cell_ptr(), planar_);
-  nl_.absent = nullptr;
   if (keep) {
     nl_.ref_pos.swap(kept_ref_pos_);
     nl_.wall_ref = kept_wall_ref_.first;
     nl_.wall_normal_ref = kept_wall_ref_.second;
+    nl_.h_ref = h_ref;  // (the cell's staleness is measured from the last real build too)
   }
   if (!roles_.empty()) {
     // Pairs of two ghosts are another process's (their loads would be dropped here).
-    std::erase_if(nl_.pairs, [&](const std::pair<std::uint32_t, std::uint32_t>& pr) {
-      return roles_[pr.first] != kOwned && (pr.second >= kWallBase || roles_[pr.second] != kOwned);
-    });
+    // (a cell's periods go with their pairs)
+    const bool periods = nl_.cell_dist.size() == nl_.pairs.size();
+    std::size_t kept = 0;
+    for (std::size_t k = 0; k < nl_.pairs.size(); ++k) {
+      const auto [a, b] = nl_.pairs[k];
+      if (roles_[a] != kOwned && (b >= kWallBase || roles_[b] != kOwned)) continue;
+      nl_.pairs[kept] = nl_.pairs[k];
+      if (periods) nl_.cell_dist[kept] = nl_.cell_dist[k];
+      ++kept;
+    }
+    nl_.pairs.resize(kept);
+    if (periods) nl_.cell_dist.resize(kept);
   }
   attach_histories(old_hist_, &old_params_);
   for (const ContactHistory& h : received) {
@@ -1001,6 +1017,7 @@ void Simulation::run_law(ContactBatch& batch, int count, double dt) const {
 void Simulation::step() {
   if (periodic_) cell_.integrate(cfg_.dt);  // (YADE: Scene::moveToNextTimeStep, before engines)
   if (walls_dirty_) classify_walls();
+  nl_.absent = roles_.empty() ? nullptr : &absent_;  // (a copied Simulation points at its own)
   bool stale = nl_.stale(p_, walls_, cell_ptr(), &moving_walls_);
   if (domain_) stale = domain_->stale(stale);
   if (stale) rebuild_neighbors();
@@ -1187,7 +1204,7 @@ void Simulation::step() {
       }
       const IntegrationSums sums =
           periodic_ || planar_ ? integrate_particles_homogeneous(p_, begin, end, cfg_.gravity,
-                                                                 cfg_.damping, dt, field_)
+                                                                 cfg_.damping, dt, field_, roles)
                                : integrate_particles(p_, begin, end, cfg_.gravity, cfg_.damping, dt,
                                                      !clumps_.empty(), roles);
       finite = finite && sums.finite;
@@ -1208,6 +1225,9 @@ void Simulation::step() {
     ledger_.damping_dissipation += chunk_sums_[kSums * c + 4];
   }
   if (!clumps_.empty()) finite = integrate_clumps() && finite;
+  // The owners' new states to the processes holding them as ghosts (before the cell's stress,
+  // whose branch vectors need them).
+  if (domain_) domain_->exchange(*this);
   if (periodic_) cell_.prev_vel_grad = cell_.vel_grad;  // (NewtonIntegrator's end)
   if (cell_servo_) {
     // The next step's diagonal from this step's stress (forces of this step, positions and
@@ -1215,7 +1235,7 @@ void Simulation::step() {
     const CellServo& sv = *cell_servo_;
     Eigen::Matrix3d sigma;
     Eigen::Vector3d k;  // (one pass over the contacts for the stress and the stiffness)
-    cell_sums(sigma, sv.stiffness_fraction > 0 ? &k : nullptr);
+    cell_sums(sigma, sv.stiffness_fraction > 0 ? &k : nullptr, domain_ && !roles_.empty());
     Eigen::Matrix3d l = servo_base_gradient_;
     Eigen::Vector3d gain = Eigen::Vector3d::Constant(sv.gain);
     if (sv.stiffness_fraction > 0) {
@@ -1260,7 +1280,6 @@ void Simulation::step() {
   for (const std::uint32_t w : timed_walls_)
     if (walls_[w].active && time_ >= walls_[w].spec.off_at_s) set_wall_active(w, false);
   if (outlet_) remove_outflow();
-  if (domain_) domain_->exchange(*this);
 }
 
 void Simulation::run(std::int64_t steps) {

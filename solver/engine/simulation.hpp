@@ -232,8 +232,9 @@ class Simulation {
   void invalidate_neighbors() { nl_.ref_pos.clear(); }
 
   /// Domain decomposition (issue 23, docs/scale.md): `domain` gets the step's collective calls
-  /// (nullptr: none). Spheres between planes and boxes only: throws std::invalid_argument with
-  /// clumps, facet walls, a periodic cell, an outlet or filling, which it does not handle yet.
+  /// (nullptr: none). Spheres between planes and boxes, or in a periodic cell: throws
+  /// std::invalid_argument with clumps, facet walls, an outlet or filling, which it does not
+  /// handle yet.
   void set_domain(Domain* domain);
   /// The part of the scene this process steps: per particle a ParticleRole. Pairs are kept
   /// where at least one body is owned; only owned particles are integrated and counted in the
@@ -340,7 +341,9 @@ class Simulation {
   HomogeneousField field_;  // this step's homogeneous terms of the integration
   std::optional<CellServo> cell_servo_;
   /// The cell's Love–Weber stress and, if asked for, its affine stiffness, in one pass.
-  void cell_sums(Eigen::Matrix3d& stress, Eigen::Vector3d* stiffness) const;
+  /// `over_domain`: this process's owned contacts, summed over the domain's processes.
+  void cell_sums(Eigen::Matrix3d& stress, Eigen::Vector3d* stiffness,
+                 bool over_domain = false) const;
   /// Kinetic energy of all bodies, or of those marked in `touching`.
   double kinetic_energy_of(const std::vector<std::uint8_t>* touching) const;
   Eigen::Matrix3d servo_base_gradient_ = Eigen::Matrix3d::Zero();  // its off-diagonal part

@@ -204,9 +204,32 @@ int MpiDomain::slab_of(double x) const {
 }
 
 bool MpiDomain::near_slab(double x, int r) const {
+  if (periodic_) {  // slabs of [0, 1), the first next to the last: x and its two images
+    const double lo = r == 0 ? 0.0 : cuts_[static_cast<std::size_t>(r - 1)];
+    const double hi = r == size_ - 1 ? 1.0 : cuts_[static_cast<std::size_t>(r)];
+    for (const double y : {x, x - 1, x + 1})
+      if (y > lo - reach_ && y < hi + reach_) return true;
+    return false;
+  }
   const double lo = r == 0 ? -HUGE_VAL : cuts_[static_cast<std::size_t>(r - 1)];
   const double hi = r == size_ - 1 ? HUGE_VAL : cuts_[static_cast<std::size_t>(r)];
-  return x > lo - ghost_width_ && x < hi + ghost_width_;
+  return x > lo - reach_ && x < hi + reach_;
+}
+
+double MpiDomain::coord(const Eigen::Vector3d& x) const {
+  if (!periodic_) return x[axis_];
+  const double s = inv_row_.dot(x.transpose());
+  return s - std::floor(s);
+}
+
+void MpiDomain::update_cell(const Simulation& sim) {
+  if (!periodic_) {
+    reach_ = ghost_width_;
+    return;
+  }
+  // The planes s_k = const are 1/|row k of H⁻¹| apart: a distance d is d·|row k| in s_k.
+  inv_row_ = sim.cell().hsize.inverse().row(axis_);
+  reach_ = ghost_width_ * inv_row_.norm();
 }
 
 void MpiDomain::attach(Simulation& sim) {
@@ -222,8 +245,17 @@ void MpiDomain::attach(Simulation& sim) {
     rmax = std::max(rmax, p.radius[i]);
   }
   if (n > 0) (hi - lo).maxCoeff(&axis_);
+  periodic_ = sim.periodic();
+  if (periodic_) {
+    // A cell: along its widest base vector that wraps (the third of a planar cell does not).
+    const Eigen::Vector3d w = sim.cell().widths();
+    axis_ = w[1] > w[0] ? 1 : 0;
+    if (!sim.planar() && w[2] > w[axis_]) axis_ = 2;
+  }
+  ghost_width_ = (2 * rmax + sim.skin()) * (1 + 1e-9);
+  update_cell(sim);
   std::vector<double> x(n);
-  for (std::size_t i = 0; i < n; ++i) x[i] = p.pos[i][axis_];
+  for (std::size_t i = 0; i < n; ++i) x[i] = coord(p.pos[i]);
   std::sort(x.begin(), x.end());
   cuts_.clear();
   for (int r = 1; r < size_; ++r) {
@@ -232,10 +264,9 @@ void MpiDomain::attach(Simulation& sim) {
   }
   // A pair is a candidate when its centres are closer than r_a + r_b + skin: the ghosts of a
   // slab are the particles within 2 r_max + skin of it (a hair more, for the candidates' own
-  // relative slack).
-  ghost_width_ = (2 * rmax + sim.skin()) * (1 + 1e-9);
+  // relative slack; ghost_width_ above).
   owner_.assign(n, 0);
-  for (std::size_t i = 0; i < n; ++i) owner_[i] = slab_of(p.pos[i][axis_]);
+  for (std::size_t i = 0; i < n; ++i) owner_[i] = slab_of(coord(p.pos[i]));
   // The ledger's particle terms: process 0 keeps the totals (those of a checkpoint too), the
   // others count what they add from now on (summed on process 0 at each gather).
   if (rank_ != 0) zero_particle_terms(sim.ledger_terms());
@@ -262,6 +293,22 @@ void MpiDomain::agree(double& max_overlap_ratio, bool& finite) {
   check(MPI_Allreduce(in, out, 2, MPI_DOUBLE, MPI_MAX, comm_), "allreduce");
   max_overlap_ratio = out[0];
   finite = out[1] == 0;
+}
+
+void MpiDomain::reduce_cell(Eigen::Matrix3d& stress, Eigen::Vector3d* stiffness) {
+  // As the walls': each process's sums to all, added in process order.
+  constexpr int kC = 12;
+  double mine[kC] = {};
+  for (int k = 0; k < 9; ++k) mine[k] = stress(k / 3, k % 3);
+  if (stiffness)
+    for (int k = 0; k < 3; ++k) mine[9 + k] = (*stiffness)[k];
+  std::vector<double> all(kC * static_cast<std::size_t>(size_));
+  check(MPI_Allgather(mine, kC, MPI_DOUBLE, all.data(), kC, MPI_DOUBLE, comm_), "allgather");
+  double s[kC] = {};
+  for (int r = 0; r < size_; ++r)
+    for (int k = 0; k < kC; ++k) s[k] += all[static_cast<std::size_t>(r) * kC + k];
+  for (int k = 0; k < 9; ++k) stress(k / 3, k % 3) = s[k];
+  if (stiffness) *stiffness = Eigen::Vector3d(s[9], s[10], s[11]);
 }
 
 void MpiDomain::reduce_walls(std::vector<WallState>& walls) {
@@ -293,12 +340,11 @@ void MpiDomain::reduce_walls(std::vector<WallState>& walls) {
   }
 }
 
-void MpiDomain::set_lists(const Simulation& sim) {
-  const ParticleState& p = sim.particles();
+void MpiDomain::set_lists(const std::vector<double>& coords) {
   send_.assign(static_cast<std::size_t>(size_), {});
   recv_.assign(static_cast<std::size_t>(size_), {});
-  for (std::size_t i = 0; i < p.size(); ++i) {
-    const double x = p.pos[i][axis_];
+  for (std::size_t i = 0; i < coords.size(); ++i) {
+    const double x = coords[i];
     const int o = owner_[i];
     if (o == rank_) {
       for (int r = 0; r < size_; ++r)
@@ -327,9 +373,12 @@ void MpiDomain::rebuild(Simulation& sim) {
     }
     unpack_state(p, i, x, false);
   }
-  // 2. The new owners, by the slab each particle is in now.
+  // 2. The new owners, by the slab each particle is in now (in a cell: as it is now).
+  update_cell(sim);
+  std::vector<double> x(n);
+  for (std::size_t i = 0; i < n; ++i) x[i] = coord(p.pos[i]);
   std::vector<int> owner(n);
-  for (std::size_t i = 0; i < n; ++i) owner[i] = slab_of(p.pos[i][axis_]);
+  for (std::size_t i = 0; i < n; ++i) owner[i] = slab_of(x[i]);
   // 3. Contact histories to the processes that compute their pairs from now on: each pair goes
   //    from the old owner of its first body (who computed it) to the new owners of its bodies.
   std::vector<std::vector<double>> to(static_cast<std::size_t>(size_));
@@ -348,10 +397,10 @@ void MpiDomain::rebuild(Simulation& sim) {
   owner_ = std::move(owner);
   std::vector<std::uint8_t> roles(n);
   for (std::size_t i = 0; i < n; ++i)
-    roles[i] = owner_[i] == rank_ ? kOwned : near_slab(p.pos[i][axis_], rank_) ? kGhost : kAbsent;
+    roles[i] = owner_[i] == rank_ ? kOwned : near_slab(x[i], rank_) ? kGhost : kAbsent;
   sim.set_roles(std::move(roles));
   sim.rebuild_local(received);
-  set_lists(sim);
+  set_lists(x);
 }
 
 void MpiDomain::exchange(Simulation& sim) {

@@ -1,8 +1,9 @@
 // Domain decomposition over MPI (issue 23; docs/scale.md): the particles are split into slabs
-// along the longest axis of the packing, each process owns the particles in its slab and holds
-// those within 2 r_max + skin of it as ghosts. Every process builds the same Simulation from the
-// scene (the particle arrays are replicated, indexed as in a one-process run), and steps only
-// its part:
+// along the longest axis of the packing (in a periodic cell: along its widest base vector, in
+// the fractional coordinate, the last slab next to the first across the boundary), each process
+// owns the particles in its slab and holds those within 2 r_max + skin of it as ghosts. Every
+// process builds the same Simulation from the scene (the particle arrays are replicated, indexed as
+// in a one-process run), and steps only its part:
 //  * each step, the owners send their ghosts' new states to the processes that hold them;
 //  * at each neighbour-list rebuild (when any process's list is stale), the owned states are
 //    gathered by all, particles migrate to the slab they are in, and the contact histories go to
@@ -34,9 +35,12 @@ class MpiDomain : public Domain {
   /// Throws std::invalid_argument for what the decomposition does not handle (see
   /// Simulation::set_domain).
   void attach(Simulation& sim);
-  /// The slab boundaries (m) along axis(): size() - 1 increasing values.
+  /// The slab boundaries along axis(): size() - 1 increasing values, in m; in a periodic cell
+  /// in the fractional coordinate s_k = (H⁻¹·x)_k of the cell's base vector k = axis(), wrapped
+  /// into [0, 1) (the slabs deform with the cell, and the first and last are neighbours).
   const std::vector<double>& cuts() const { return cuts_; }
   int axis() const { return axis_; }
+  bool periodic() const { return periodic_; }
   double ghost_width() const { return ghost_width_; }
   /// Owning process of each particle (as of the last rebuild).
   const std::vector<int>& owners() const { return owner_; }
@@ -58,6 +62,7 @@ class MpiDomain : public Domain {
   bool stale(bool mine) override;
   void rebuild(Simulation& sim) override;
   void reduce_walls(std::vector<WallState>& walls) override;
+  void reduce_cell(Eigen::Matrix3d& stress, Eigen::Vector3d* stiffness) override;
   void agree(double& max_overlap_ratio, bool& finite) override;
   void exchange(Simulation& sim) override;
 
@@ -65,13 +70,23 @@ class MpiDomain : public Domain {
   int slab_of(double x) const;
   /// Whether a particle at coordinate x is within the ghost width of process r's slab.
   bool near_slab(double x, int r) const;
-  void set_lists(const Simulation& sim);
+  /// The coordinate the slabs cut: x_k, or in a cell the wrapped s_k (with the cell of the
+  /// last rebuild: update_cell()).
+  double coord(const Eigen::Vector3d& x) const;
+  /// In a cell: H⁻¹ and the ghost width in s_k from the cell as it is now.
+  void update_cell(const Simulation& sim);
+  /// Whom this process sends its ghosts to and receives its ghosts from (coords: coord() of
+  /// each particle).
+  void set_lists(const std::vector<double>& coords);
 
   MPI_Comm comm_;
   int rank_ = 0, size_ = 1;
   int axis_ = 0;
   std::vector<double> cuts_;
   double ghost_width_ = 0;
+  bool periodic_ = false;
+  Eigen::RowVector3d inv_row_ = Eigen::RowVector3d::Zero();  // row axis_ of H⁻¹ (a cell)
+  double reach_ = 0;  // the ghost width in the coordinate the slabs cut
   std::vector<int> owner_;
   std::vector<std::uint8_t> my_roles_;                   // process 0's part, kept while gathered
   std::vector<std::vector<std::uint32_t>> send_, recv_;  // per process: particle indices
