@@ -372,12 +372,9 @@ void Simulation::rebuild_neighbors() {
 
 void Simulation::set_domain(Domain* domain) {
   if (domain) {
-    bool facets = false;
-    for (const auto& w : walls_) facets = facets || w.spec.shape == WallShape::Facets;
     bool pending = false;
     for (const auto r : p_.removed) pending = pending || r != 0;
     const char* what = !clumps_.empty() ? "clumps"
-                       : facets         ? "facet (mesh) walls"
                        : outlet_        ? "an outlet"
                        : pending        ? "removed or pending particles (filling)"
                                         : nullptr;

@@ -232,9 +232,8 @@ class Simulation {
   void invalidate_neighbors() { nl_.ref_pos.clear(); }
 
   /// Domain decomposition (issue 23, docs/scale.md): `domain` gets the step's collective calls
-  /// (nullptr: none). Spheres between planes and boxes, or in a periodic cell: throws
-  /// std::invalid_argument with clumps, facet walls, an outlet or filling, which it does not
-  /// handle yet.
+  /// (nullptr: none). Spheres between planes, boxes and meshes, or in a periodic cell: throws
+  /// std::invalid_argument with clumps, an outlet or filling, which it does not handle yet.
   void set_domain(Domain* domain);
   /// The part of the scene this process steps: per particle a ParticleRole. Pairs are kept
   /// where at least one body is owned; only owned particles are integrated and counted in the

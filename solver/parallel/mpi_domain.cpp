@@ -454,6 +454,27 @@ void MpiDomain::gather(Simulation& sim) {
     if (h[k].real && owner_[pairs[k].first] == rank_) pack_history(h[k], hist);
   const std::vector<double> all_states = gather_at_root(comm_, size_, rank_, states);
   const std::vector<double> all_hist = gather_at_root(comm_, size_, rank_, hist);
+  // The meshes' per-triangle forces (for output), summed in process order; the step clears
+  // and sums them anew, so process 0's own part need not be kept.
+  std::vector<double> facets;
+  for (const WallState& w : sim.walls())
+    for (const Eigen::Vector3d& f : w.facet_force)
+      facets.insert(facets.end(), f.data(), f.data() + 3);
+  if (!facets.empty()) {
+    const std::vector<double> all = gather_at_root(comm_, size_, rank_, facets);
+    if (rank_ == 0) {
+      std::fill(facets.begin(), facets.end(), 0.0);
+      for (int r = 0; r < size_; ++r)
+        for (std::size_t j = 0; j < facets.size(); ++j)
+          facets[j] += all[static_cast<std::size_t>(r) * facets.size() + j];
+      std::size_t j = 0;
+      for (WallState& w : sim.mutable_walls())
+        for (Eigen::Vector3d& f : w.facet_force) {
+          f = Eigen::Vector3d(facets[j], facets[j + 1], facets[j + 2]);
+          j += 3;
+        }
+    }
+  }
   // The ledger's particle terms (each process counted its own particles and their contacts);
   // the walls' work is the same on every process, from the summed wall loads.
   EnergyLedger& e = sim.ledger_terms();

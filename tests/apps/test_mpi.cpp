@@ -237,6 +237,62 @@ TEST(Mpi, AServoedCellStaysWithinTheOneUlpDivergence) {
                                   << " m/s)";
 }
 
+// The falling packing with two triangle meshes for walls: a saw-tooth floor (one contact per
+// sphere and flat region, the default) and a saw-tooth side wall with YADE's facets (a wall
+// per triangle), which the slanted gravity presses the packing against; per-triangle forces
+// written. Particles and contacts to the bit; the walls' and triangles' loads to round-off.
+TEST(Mpi, TwoProcessesStepMeshWallsAsOne) {
+  if (!mpirun_present()) GTEST_SKIP() << "mpirun not installed (apt-get install openmpi-bin)";
+  gs::test::ScratchDir dir("mpi_mesh");
+  ASSERT_EQ(run(kExe +
+                " surface sawtooth --length 0.029 --width 0.029 --height 0.001 --spacing "
+                "0.004 --origin -0.002,-0.002,-0.004 --along 1,0,0 --normal 0,0,1 -o " +
+                (dir / "floor.stl").string()),
+            0);
+  ASSERT_EQ(run(kExe +
+                " surface sawtooth --length 0.029 --width 0.1 --height 0.0005 --spacing "
+                "0.002 --origin 0.025,-0.002,-0.004 --along 0,1,0 --normal -1,0,0 -o " +
+                (dir / "side.stl").string()),
+            0);
+  std::string text = slurp(kData / "scenes" / "oedometer_fall.toml");
+  auto cut = [&](const std::string& what, const std::string& with) {
+    const auto at = text.find(what);
+    ASSERT_NE(at, std::string::npos) << what;
+    text.replace(at, what.size(), with);
+  };
+  cut("../../../data/oedometer/packing.csv",
+      (fs::path(GS_SOURCE_DIR) / "data" / "oedometer" / "packing.csv").string());
+  cut("[[walls]]\nname = \"bottom\"\nshape = \"box\"\ncenter_m = [0.0125, 0.0125, -0.006]\n"
+      "half_extents_m = [0.025, 0.025, 0.002]\n",
+      "");
+  cut("[[walls]]\nname = \"x+\"\nshape = \"box\"\ncenter_m = [0.027, 0.0125, 0.05]\n"
+      "half_extents_m = [0.002, 0.025, 0.1]\n",
+      "");
+  cut("checkpoint_every = 1000\n", "checkpoint_every = 1000\nfacet_forces = true\n");
+  text +=
+      "\n[[mesh]]\nfile = \"floor.stl\"\nname = \"floor\"\n\n[[mesh]]\nfile = "
+      "\"side.stl\"\nname = \"side\"\ncontact = \"yade\"\n";
+  std::ofstream(dir / "mesh.toml") << text;
+  const std::string args = " simulate " + (dir / "mesh.toml").string() + " -q --threads 1 -o ";
+  ASSERT_EQ(run(kExe + args + (dir / "one").string()), 0);
+  std::string err;
+  ASSERT_EQ(run(kMpirun + "2 " + kExe + args + (dir / "two").string(), &err), 0) << err;
+  expect_same_run(dir / "one" / "oedometer_fall.h5", dir / "two" / "oedometer_fall.h5");
+  const auto a = gs::read_hdf5_trajectory(dir / "one" / "oedometer_fall.h5");
+  const auto b = gs::read_hdf5_trajectory(dir / "two" / "oedometer_fall.h5");
+  ASSERT_EQ(a.frames.size(), b.frames.size());
+  std::size_t loaded = 0;
+  for (std::size_t i = 0; i < a.frames.size(); ++i) {
+    const auto &p = a.frames[i].facet_loads, &q = b.frames[i].facet_loads;
+    ASSERT_EQ(p.size(), q.size());
+    for (std::size_t k = 0; k < p.size(); ++k) {
+      EXPECT_LE((p[k].force - q[k].force).norm(), 1e-12 * (1 + p[k].force.norm()));
+      loaded += p[k].force.norm() > 0;
+    }
+  }
+  EXPECT_GT(loaded, 50u);
+}
+
 // A checkpoint is one process's format whatever wrote it: a two-process run stopped after a
 // checkpoint resumes on one process, and a one-process run's on two, to the uninterrupted run.
 TEST(Mpi, CheckpointsResumeOnAnyNumberOfProcesses) {
