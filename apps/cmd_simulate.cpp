@@ -181,6 +181,21 @@ void run_mpi(const Args& a) {
   const bool root = domain.rank() == 0;
   fs::path scratch;
   auto fail = [&](const std::string& line, bool everyone) {
+    if (everyone) {
+      // An error every process should meet at the same point (a scene error, a blow-up, which
+      // the processes agree on) is confirmed by a barrier all of them reach within a few
+      // seconds; one this process met alone (a file it read) leaves the others waiting
+      // elsewhere, and then aborts them instead of leaving them to hang.
+      MPI_Request all;
+      MPI_Ibarrier(MPI_COMM_WORLD, &all);
+      int reached = 0;
+      const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+      while (!reached && std::chrono::steady_clock::now() < until) {
+        MPI_Test(&all, &reached, MPI_STATUS_IGNORE);
+        if (!reached) usleep(1000);
+      }
+      everyone = reached != 0;
+    }
     if (root || !everyone) std::fprintf(stderr, "error: %s\n", line.c_str());
     std::fflush(stderr);
     if (!scratch.empty()) {
@@ -223,6 +238,9 @@ void run_mpi(const Args& a) {
       fs::create_directories(scratch, ec);
     mine.out = scratch.string();
   }
+  // (process 0 cuts its outputs back to the checkpoint when it resumes: not before the others
+  // have copied them)
+  MPI_Barrier(MPI_COMM_WORLD);
   solver::RunOptions::Parallel par;
   par.root = root;
   par.attach = [&](solver::Simulation& sim) {

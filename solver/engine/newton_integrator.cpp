@@ -293,30 +293,34 @@ IntegrationSums integrate_range(ParticleState& p, std::size_t begin, std::size_t
   IntegrationSums sums;
   ParticleBatch b;
   std::size_t lane_index[ParticleBatch::kLanes];
+  // Of a clump member the clump update overwrites the position and orientation, so only the
+  // rotation vector and the finite check are left (true: it was one).
+  auto member = [&](std::size_t i) {
+    if constexpr (kMembers) {
+      if (p.clump[i] >= 0 && p.fixed[i]) {
+        const V3 vel(p.vel[i]), angvel(p.angvel[i]);
+        add_to(p.rot[i], angvel * dt);
+        sums.finite = sums.finite && squared_norm(vel) < HUGE_VAL &&
+                      squared_norm(V3(p.pos[i]) + vel * dt) < HUGE_VAL;
+        return true;
+      }
+    }
+    return false;
+  };
   for (std::size_t next = begin; next < end;) {
     const std::size_t i0 = next;
     int count = 0;
     if constexpr (kRoles) {
       // A domain's part: the owned particles in order (each lane's arithmetic is its own, so
-      // a particle gets the same bits in whatever batch it is).
-      static_assert(!kMembers, "clumps are not decomposed");
+      // a particle gets the same bits in whatever batch it is), clump members apart.
       for (; next < end && count < ParticleBatch::kLanes; ++next)
-        if (roles[next] == kOwned) lane_index[count++] = next;
+        if (roles[next] == kOwned && !member(next)) lane_index[count++] = next;
       if (count == 0) continue;
     } else if constexpr (kMembers) {
       // The next lanes: the particles in order, fixed clump members apart. A fixed lane keeps
-      // its velocities and adds +0 to the sums; of a member the clump update overwrites the
-      // position and orientation, so only the rotation vector and the finite check are left.
-      for (; next < end && count < ParticleBatch::kLanes; ++next) {
-        if (p.clump[next] >= 0 && p.fixed[next]) {
-          const V3 vel(p.vel[next]), angvel(p.angvel[next]);
-          add_to(p.rot[next], angvel * dt);
-          sums.finite = sums.finite && squared_norm(vel) < HUGE_VAL &&
-                        squared_norm(V3(p.pos[next]) + vel * dt) < HUGE_VAL;
-          continue;
-        }
-        lane_index[count++] = next;
-      }
+      // its velocities and adds +0 to the sums.
+      for (; next < end && count < ParticleBatch::kLanes; ++next)
+        if (!member(next)) lane_index[count++] = next;
       if (count == 0) continue;
     } else {
       count = static_cast<int>(std::min<std::size_t>(ParticleBatch::kLanes, end - next));
@@ -381,10 +385,12 @@ IntegrationSums integrate_range(ParticleState& p, std::size_t begin, std::size_t
 IntegrationSums integrate_particles(ParticleState& p, std::size_t begin, std::size_t end,
                                     const Eigen::Vector3d& gravity, double damping, double dt,
                                     bool clump_members, const std::uint8_t* roles) {
-  if (roles) return integrate_range<false, true>(p, begin, end, gravity, damping, dt, roles);
-  return clump_members && p.clump.size() == p.size()
-             ? integrate_range<true>(p, begin, end, gravity, damping, dt)
-             : integrate_range<false>(p, begin, end, gravity, damping, dt);
+  const bool members = clump_members && p.clump.size() == p.size();
+  if (roles)
+    return members ? integrate_range<true, true>(p, begin, end, gravity, damping, dt, roles)
+                   : integrate_range<false, true>(p, begin, end, gravity, damping, dt, roles);
+  return members ? integrate_range<true>(p, begin, end, gravity, damping, dt)
+                 : integrate_range<false>(p, begin, end, gravity, damping, dt);
 }
 
 void integrate_clump_bodies(ClumpBody* clumps, const ClumpLoad* loads, std::size_t count,

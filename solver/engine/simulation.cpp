@@ -147,9 +147,15 @@ void Simulation::set_clumps(std::vector<ClumpBody> clumps) {
   invalidate_neighbors();
 }
 
+bool Simulation::clump_owned(std::size_t k) const {
+  // (a domain gives a clump's members its owner: the process of its centre of mass)
+  return roles_.empty() || clumps_[k].members.empty() || roles_[clumps_[k].members[0]] == kOwned;
+}
+
 void Simulation::gather_clump_loads() {
   clump_loads_.resize(clumps_.size());
   for (std::size_t k = 0; k < clumps_.size(); ++k) {
+    if (!clump_owned(k)) continue;  // (its members' loads are complete at its owner only)
     const ClumpBody& c = clumps_[k];
     // YADE's Clump::addForceTorqueFromMembers, in member order, with the member positions the
     // contact loads were computed at.
@@ -167,11 +173,24 @@ bool Simulation::integrate_clumps() {
   const double dt = cfg_.dt;
   bool finite = true;
   double gravity_power = 0, damping = 0;
-  for (const ClumpBody& c : clumps_) gravity_power += c.mass * cfg_.gravity.dot(c.vel);
+  for (std::size_t k = 0; k < clumps_.size(); ++k)
+    if (clump_owned(k)) gravity_power += clumps_[k].mass * cfg_.gravity.dot(clumps_[k].vel);
   clump_damping_.resize(clumps_.size());
-  integrate_clump_bodies(clumps_.data(), clump_loads_.data(), clumps_.size(), cfg_.gravity,
-                         cfg_.damping, dt, clump_damping_.data());
+  // Under a domain, each run of owned clumps (the integration is lane by lane: the same bits
+  // in runs as in one batch).
+  for (std::size_t k0 = 0; k0 < clumps_.size();) {
+    if (!clump_owned(k0)) {
+      ++k0;
+      continue;
+    }
+    std::size_t k1 = k0 + 1;
+    while (k1 < clumps_.size() && clump_owned(k1)) ++k1;
+    integrate_clump_bodies(clumps_.data() + k0, clump_loads_.data() + k0, k1 - k0, cfg_.gravity,
+                           cfg_.damping, dt, clump_damping_.data() + k0);
+    k0 = k1;
+  }
   for (std::size_t k = 0; k < clumps_.size(); ++k) {
+    if (!clump_owned(k)) continue;  // (its members are ghosts here, or absent)
     const ClumpBody& c = clumps_[k];
     damping += clump_damping_[k];
     finite = finite && c.pos.allFinite() && c.vel.allFinite() && c.angmom.allFinite();
@@ -374,10 +393,9 @@ void Simulation::set_domain(Domain* domain) {
   if (domain) {
     bool pending = false;
     for (const auto r : p_.removed) pending = pending || r != 0;
-    const char* what = !clumps_.empty() ? "clumps"
-                       : outlet_        ? "an outlet"
-                       : pending        ? "removed or pending particles (filling)"
-                                        : nullptr;
+    const char* what = outlet_   ? "an outlet"
+                       : pending ? "removed or pending particles (filling)"
+                                 : nullptr;
     if (what)
       throw std::invalid_argument(std::string("the domain decomposition does not handle ") + what +
                                   " yet (run on one process)");

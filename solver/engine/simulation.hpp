@@ -168,6 +168,9 @@ class Simulation {
   /// two clumps.
   void set_clumps(std::vector<ClumpBody> clumps);
   const std::vector<ClumpBody>& clumps() const { return clumps_; }
+  /// The clumps' states, for a domain decomposition to move between processes (the members
+  /// and mass properties are not to be changed).
+  std::vector<ClumpBody>& clump_states() { return clumps_; }
 
   /// Outlet: after each step, particles whose centre has left the box [lo, hi] are removed (seed
   /// 004 §5.2, silo discharge): frozen where they left, in no contact, no longer in frames or
@@ -232,8 +235,9 @@ class Simulation {
   void invalidate_neighbors() { nl_.ref_pos.clear(); }
 
   /// Domain decomposition (issue 23, docs/scale.md): `domain` gets the step's collective calls
-  /// (nullptr: none). Spheres between planes, boxes and meshes, or in a periodic cell: throws
-  /// std::invalid_argument with clumps, an outlet or filling, which it does not handle yet.
+  /// (nullptr: none). Spheres and clumps between planes, boxes and meshes, or spheres in a
+  /// periodic cell: throws std::invalid_argument with an outlet or filling, which it does not
+  /// handle yet. A domain gives each clump's members the owner of the clump.
   void set_domain(Domain* domain);
   /// The part of the scene this process steps: per particle a ParticleRole. Pairs are kept
   /// where at least one body is owned; only owned particles are integrated and counted in the
@@ -306,6 +310,8 @@ class Simulation {
   /// Elastic energy (normal, shear, rolling; J) stored in contact k.
   Eigen::Vector3d contact_elastic_energy(std::size_t k) const;
   void gather_clump_loads();
+  /// Whether clump k is this process's to integrate (always, without a domain).
+  bool clump_owned(std::size_t k) const;
   /// Wall loads, dissipation and work terms of this step, summed in pair / particle order.
   void accumulate_walls();
   /// Sorts the walls into the lists below (after a build, and after mutable_walls()).

@@ -126,6 +126,45 @@ std::vector<double> pack_owned(const ParticleState& p, const std::vector<int>& o
   return out;
 }
 
+/// A clump's state (what the integrator advances): index, centre of mass, velocity, spin,
+/// angular momentum, orientation (w, x, y, z).
+constexpr int kClump = 1 + 16;
+
+/// This process's clumps (a clump is its first member's owner's): each its index and state.
+std::vector<double> pack_owned_clumps(const std::vector<ClumpBody>& clumps,
+                                      const std::vector<int>& owner, int rank) {
+  std::vector<double> out;
+  for (std::size_t k = 0; k < clumps.size(); ++k) {
+    const ClumpBody& c = clumps[k];
+    if (c.members.empty() || owner[c.members[0]] != rank) continue;
+    const std::size_t at = out.size();
+    out.resize(at + kClump);
+    double* o = out.data() + at;
+    *o++ = static_cast<double>(k);
+    put3(o, c.pos);
+    put3(o, c.vel);
+    put3(o, c.angvel);
+    put3(o, c.angmom);
+    *o++ = c.ori.w();
+    *o++ = c.ori.x();
+    *o++ = c.ori.y();
+    *o++ = c.ori.z();
+  }
+  return out;
+}
+
+void unpack_clumps(std::vector<ClumpBody>& clumps, const std::vector<double>& in) {
+  for (const double* i = in.data(); i < in.data() + in.size();) {
+    ClumpBody& c = clumps[static_cast<std::size_t>(*i++)];
+    c.pos = get3(i);
+    c.vel = get3(i);
+    c.angvel = get3(i);
+    c.angmom = get3(i);
+    c.ori = Eigen::Quaterniond(i[0], i[1], i[2], i[3]);
+    i += 4;
+  }
+}
+
 /// Counts of `mine` from every process and their offsets (what the v-collectives take).
 int counts_of(MPI_Comm comm, int size, int root, const std::vector<double>& mine,
               std::vector<int>& counts, std::vector<int>& displs) {
@@ -216,6 +255,17 @@ bool MpiDomain::near_slab(double x, int r) const {
   return x > lo - reach_ && x < hi + reach_;
 }
 
+std::vector<int> MpiDomain::owners_of(const Simulation& sim) const {
+  const ParticleState& p = sim.particles();
+  std::vector<int> owner(p.size());
+  for (std::size_t i = 0; i < p.size(); ++i) owner[i] = slab_of(coord(p.pos[i]));
+  for (const ClumpBody& c : sim.clumps()) {
+    const int o = slab_of(coord(c.pos));
+    for (const std::uint32_t m : c.members) owner[m] = o;
+  }
+  return owner;
+}
+
 double MpiDomain::coord(const Eigen::Vector3d& x) const {
   if (!periodic_) return x[axis_];
   const double s = inv_row_.dot(x.transpose());
@@ -252,7 +302,12 @@ void MpiDomain::attach(Simulation& sim) {
     axis_ = w[1] > w[0] ? 1 : 0;
     if (!sim.planar() && w[2] > w[axis_]) axis_ = 2;
   }
-  ghost_width_ = (2 * rmax + sim.skin()) * (1 + 1e-9);
+  // A clump's members are owned with it (by the process of its centre of mass), so a member
+  // may lie up to the clump's extent outside its owner's slab: the ghost layer grows by it.
+  double extent = 0;
+  for (const ClumpBody& c : sim.clumps())
+    for (const std::uint32_t m : c.members) extent = std::max(extent, (p.pos[m] - c.pos).norm());
+  ghost_width_ = (2 * rmax + sim.skin() + extent) * (1 + 1e-9);
   update_cell(sim);
   std::vector<double> x(n);
   for (std::size_t i = 0; i < n; ++i) x[i] = coord(p.pos[i]);
@@ -265,8 +320,7 @@ void MpiDomain::attach(Simulation& sim) {
   // A pair is a candidate when its centres are closer than r_a + r_b + skin: the ghosts of a
   // slab are the particles within 2 r_max + skin of it (a hair more, for the candidates' own
   // relative slack; ghost_width_ above).
-  owner_.assign(n, 0);
-  for (std::size_t i = 0; i < n; ++i) owner_[i] = slab_of(coord(p.pos[i]));
+  owner_ = owners_of(sim);
   // The ledger's particle terms: process 0 keeps the totals (those of a checkpoint too), the
   // others count what they add from now on (summed on process 0 at each gather).
   if (rank_ != 0) zero_particle_terms(sim.ledger_terms());
@@ -373,12 +427,17 @@ void MpiDomain::rebuild(Simulation& sim) {
     }
     unpack_state(p, i, x, false);
   }
-  // 2. The new owners, by the slab each particle is in now (in a cell: as it is now).
+  if (!sim.clumps().empty()) {  // and the clumps' (every process then has every state)
+    const std::vector<double> mine_c = pack_owned_clumps(sim.clumps(), owner_, rank_);
+    rebuild_bytes_ += mine_c.size() * sizeof(double) * static_cast<std::size_t>(size_ - 1);
+    unpack_clumps(sim.clump_states(), all_gather(comm_, size_, mine_c));
+  }
+  // 2. The new owners, by the slab each particle (each clump's centre of mass) is in now (in a
+  //    cell: as it is now).
   update_cell(sim);
   std::vector<double> x(n);
   for (std::size_t i = 0; i < n; ++i) x[i] = coord(p.pos[i]);
-  std::vector<int> owner(n);
-  for (std::size_t i = 0; i < n; ++i) owner[i] = slab_of(x[i]);
+  std::vector<int> owner = owners_of(sim);
   // 3. Contact histories to the processes that compute their pairs from now on: each pair goes
   //    from the old owner of its first body (who computed it) to the new owners of its bodies.
   std::vector<std::vector<double>> to(static_cast<std::size_t>(size_));
@@ -454,6 +513,11 @@ void MpiDomain::gather(Simulation& sim) {
     if (h[k].real && owner_[pairs[k].first] == rank_) pack_history(h[k], hist);
   const std::vector<double> all_states = gather_at_root(comm_, size_, rank_, states);
   const std::vector<double> all_hist = gather_at_root(comm_, size_, rank_, hist);
+  if (!sim.clumps().empty()) {
+    const std::vector<double> all_clumps =
+        gather_at_root(comm_, size_, rank_, pack_owned_clumps(sim.clumps(), owner_, rank_));
+    if (rank_ == 0) unpack_clumps(sim.clump_states(), all_clumps);
+  }
   // The meshes' per-triangle forces (for output), summed in process order; the step clears
   // and sums them anew, so process 0's own part need not be kept.
   std::vector<double> facets;

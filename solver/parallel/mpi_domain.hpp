@@ -9,6 +9,8 @@
 //    gathered by all, particles migrate to the slab they are in, and the contact histories go to
 //    the processes that compute their pairs from then on;
 //  * the walls' loads are summed over processes each step, so that servos see the whole.
+// A clump is owned by the process of its centre of mass, with its members (ghosted by their
+// own positions; the ghost layer is wider by the clumps' extent).
 // A pair is computed by the owner of each of its bodies, from the same states and history, and
 // each particle's loads are summed in pair order as in one process: the trajectories are the
 // one-process run's bit for bit. Output (gather) puts the whole state on process 0.
@@ -73,6 +75,9 @@ class MpiDomain : public Domain {
   /// The coordinate the slabs cut: x_k, or in a cell the wrapped s_k (with the cell of the
   /// last rebuild: update_cell()).
   double coord(const Eigen::Vector3d& x) const;
+  /// Each particle's owner now: its slab's process, a clump member its clump's (the process of
+  /// the clump's centre of mass).
+  std::vector<int> owners_of(const Simulation& sim) const;
   /// In a cell: H⁻¹ and the ghost width in s_k from the cell as it is now.
   void update_cell(const Simulation& sim);
   /// Whom this process sends its ghosts to and receives its ghosts from (coords: coord() of

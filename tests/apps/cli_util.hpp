@@ -86,8 +86,18 @@ inline bool stop_at_checkpoint(const std::vector<std::string>& argv,
     std::this_thread::sleep_for(std::chrono::microseconds(200));
   }
   kill(-pid, sig);
+  // (a launcher such as mpirun that does not end within a minute of the signal is killed, so
+  // that a test fails rather than hangs)
   int status = 0;
-  waitpid(pid, &status, 0);
+  const auto grace = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (waitpid(pid, &status, WNOHANG) == 0) {
+    if (std::chrono::steady_clock::now() > grace) {
+      kill(-pid, SIGKILL);
+      waitpid(pid, &status, 0);
+      break;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
   return !(WIFEXITED(status) && WEXITSTATUS(status) == 0);
 }
 

@@ -26,8 +26,10 @@ const fs::path kScenes = fs::path(GS_SOURCE_DIR) / "data" / "scenes";
 const std::string kExe = std::string(GS_BINARY_DIR) + "/bin/granoscope";
 // Root is allowed (CI runs as root); more processes than cores are allowed; shared-memory
 // transport without the kernel's cross-memory attach, which containers often forbid.
+// A run that hangs fails after 5 minutes instead (timeout's SIGTERM, which mpirun passes on).
 const std::string kMpirun =
-    "mpirun --allow-run-as-root --oversubscribe --mca btl_vader_single_copy_mechanism none -np ";
+    "timeout 300 mpirun --allow-run-as-root --oversubscribe --mca btl_vader_single_copy_mechanism "
+    "none -np ";
 
 std::vector<std::string> words(const std::string& cmd) {
   std::vector<std::string> out;
@@ -55,6 +57,15 @@ void expect_same_run(const fs::path& a_file, const fs::path& b_file) {
   for (std::size_t i = 0; i < a.frames.size(); ++i) {
     gs::test::expect_same_frame(a.frames[i], b.frames[i], false);
     contacts += a.frames[i].contacts.size();
+    const auto &ca = a.frames[i].clumps, &cb = b.frames[i].clumps;
+    ASSERT_EQ(ca.size(), cb.size());
+    for (std::size_t k = 0; k < ca.size(); ++k) {  // the clump bodies, to the bit
+      EXPECT_EQ(ca[k].id, cb[k].id);
+      EXPECT_EQ(ca[k].position, cb[k].position) << "clump " << k;
+      EXPECT_EQ(ca[k].orientation.coeffs(), cb[k].orientation.coeffs()) << "clump " << k;
+      EXPECT_EQ(ca[k].velocity, cb[k].velocity) << "clump " << k;
+      EXPECT_EQ(ca[k].angular_velocity, cb[k].angular_velocity) << "clump " << k;
+    }
     ASSERT_EQ(a.frames[i].walls.size(), b.frames[i].walls.size());
     for (std::size_t w = 0; w < a.frames[i].walls.size(); ++w) {
       const auto &p = a.frames[i].walls[w], &q = b.frames[i].walls[w];
@@ -291,6 +302,106 @@ TEST(Mpi, TwoProcessesStepMeshWallsAsOne) {
     }
   }
   EXPECT_GT(loaded, 50u);
+}
+
+// Clumps: 234 rods of four overlapping spheres (r = 0.6 mm, 1 mm apart: each member up to
+// 1.5 mm from the centre of mass, more than 2 r_max + skin) dropped into a 60 mm long trough,
+// so that the slabs (along x) cut through the settled pile. A clump is owned, with its members,
+// by the process of its centre of mass; the ghost layer is wider by the clumps' extent (without
+// that, the runs part by millimetres: checked). Two processes with two threads each and three
+// processes equal one process to the bit, and a two-process run stopped after a checkpoint
+// resumes on one process to the uninterrupted run.
+TEST(Mpi, ProcessesStepClumpsAsOneBitForBit) {
+  if (!mpirun_present()) GTEST_SKIP() << "mpirun not installed (apt-get install openmpi-bin)";
+  gs::test::ScratchDir dir("mpi_clumps");
+  {
+    std::ofstream csv(dir / "rods.csv");
+    csv.precision(17);
+    csv << "template,x,y,z,qw,qx,qy,qz\n";
+    int n = 0;
+    for (int k = 0; k < 6; ++k)
+      for (int j = 0; j < 3; ++j)
+        for (int i = 0; i < 13; ++i, ++n) {  // a turn of a about a unit axis u, from n
+          const double a = 0.7 * n + 0.3, b = 1.3 * n, c = 0.37 * n;
+          const Eigen::Vector3d u(std::sin(b) * std::cos(c), std::sin(b) * std::sin(c),
+                                  std::cos(b));
+          csv << "rod," << 0.0022 + 0.0044 * i << "," << 0.0022 + 0.0044 * j << ","
+              << 0.0022 + 0.0044 * k << "," << std::cos(a) << "," << std::sin(a) * u[0] << ","
+              << std::sin(a) * u[1] << "," << std::sin(a) * u[2] << "\n";
+        }
+  }
+  std::ofstream(dir / "rods.toml") << R"([scene]
+name = "rods"
+[material]
+young_Pa = 3.0e7
+stiffness_ratio = 0.3
+friction_deg = 18.0
+density_kg_m3 = 2550.0
+rolling_stiffness = 0.7
+rolling_limit = 0.4
+[solver]
+dt_s = 1.0e-6
+damping = 0.08
+gravity_m_s2 = [100.0, 0.0, -2000.0]
+steps = 10000
+max_overlap_ratio = 0.5
+[output]
+trajectory = "rods.h5"
+every = 1000
+history_every = 100
+checkpoint_every = 1000
+[[walls]]
+name = "floor"
+shape = "plane"
+point_m = [0.0, 0.0, 0.0]
+normal = [0.0, 0.0, 1.0]
+[[walls]]
+name = "x-"
+shape = "plane"
+point_m = [0.0, 0.0, 0.0]
+normal = [1.0, 0.0, 0.0]
+[[walls]]
+name = "x+"
+shape = "box"
+center_m = [0.062, 0.0125, 0.05]
+half_extents_m = [0.002, 0.025, 0.1]
+[[walls]]
+name = "y-"
+shape = "plane"
+point_m = [0.0, 0.0, 0.0]
+normal = [0.0, 1.0, 0.0]
+[[walls]]
+name = "y+"
+shape = "plane"
+point_m = [0.0, 0.0132, 0.0]
+normal = [0.0, -1.0, 0.0]
+[[clump_template]]
+name = "rod"
+members = [[-0.0015, 0.0, 0.0, 0.0006], [-0.0005, 0.0, 0.0, 0.0006], [0.0005, 0.0, 0.0, 0.0006],
+           [0.0015, 0.0, 0.0, 0.0006]]
+[clumps]
+packing = "rods.csv"
+mass = "union"
+)";
+  const std::string scene = (dir / "rods.toml").string();
+  const std::string args = " simulate " + scene + " -q -o ";
+  ASSERT_EQ(run(kExe + args + (dir / "one").string() + " --threads 1"), 0);
+  std::string err;
+  ASSERT_EQ(run(kMpirun + "2 " + kExe + args + (dir / "two").string() + " --threads 2", &err), 0)
+      << err;
+  ASSERT_EQ(run(kMpirun + "3 " + kExe + args + (dir / "three").string() + " --threads 1", &err), 0)
+      << err;
+  expect_same_run(dir / "one" / "rods.h5", dir / "two" / "rods.h5");
+  expect_same_run(dir / "one" / "rods.h5", dir / "three" / "rods.h5");
+  const auto t = gs::read_hdf5_trajectory(dir / "three" / "rods.h5");
+  EXPECT_EQ(t.frames.back().clumps.size(), 234u);
+  const fs::path resumed = dir / "resumed";
+  ASSERT_TRUE(gs::test::stop_at_checkpoint(
+      words(kMpirun + "2 " + kExe + args + resumed.string() + " --threads 1"), resumed, 5000,
+      SIGTERM))
+      << "the run ended before it could be stopped";
+  ASSERT_EQ(run(kExe + args + resumed.string() + " --threads 1 --resume", &err), 0) << err;
+  expect_same_run(dir / "one" / "rods.h5", resumed / "rods.h5");
 }
 
 // A checkpoint is one process's format whatever wrote it: a two-process run stopped after a
