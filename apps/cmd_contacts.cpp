@@ -19,6 +19,7 @@
 #include "fabric_report.hpp"
 #include "field_output.hpp"
 #include "force_chains.hpp"
+#include "frame_series.hpp"
 #include "love_weber_stress.hpp"
 #include "rose_report.hpp"
 #include "wall_stress.hpp"
@@ -43,6 +44,7 @@ std::vector<double> flat(const Eigen::Vector3d& x) {
 
 struct FabricArgs {
   FrameArgs in;
+  FrameSeriesArgs series;
   SelectionArgs sel;
   std::string output, csv;
 };
@@ -99,6 +101,7 @@ void run_fabric(const FabricArgs& a) {
 
 struct RoseArgs {
   FrameArgs in;
+  FrameSeriesArgs series;
   SelectionArgs sel;
   std::string output, csv;
   ga::RoseSpec spec;
@@ -155,6 +158,7 @@ void run_rose(const RoseArgs& a) {
 
 struct ChainArgs {
   FrameArgs in;
+  FrameSeriesArgs series;
   SelectionArgs sel;
   std::string output, vtp;
   double threshold = -1.0, mean_factor = 1.0;
@@ -221,6 +225,7 @@ void run_chains(const ChainArgs& a) {
 
 struct WallArgs {
   FrameArgs in;
+  FrameSeriesArgs series;
   std::string output, csv;
   std::vector<double> up{0.0, 0.0, 1.0};
   std::optional<double> bin, bin_d50, width;
@@ -318,7 +323,18 @@ void register_analyze_contacts(CLI::App& app) {
     a->sel.add_to(*s);
     s->add_option("-o,--output", a->output, "output HDF5 (format granoscope-fabric)")->required();
     s->add_option("--csv", a->csv, "also write one CSV row");
-    s->callback([a] { run_fabric(*a); });
+    a->series.add_to(*s);
+    s->callback([a] {
+      if (!a->series.active()) return run_fabric(*a);
+      run_frame_series("fabric", a->in.input, a->series, a->output,
+                       [a](long frame, const std::string& out) {
+                         FabricArgs b = *a;
+                         b.in.frame = frame;
+                         b.output = out;
+                         b.csv.clear();
+                         run_fabric(b);
+                       });
+    });
   }
   {
     auto a = std::make_shared<RoseArgs>();
@@ -340,7 +356,18 @@ void register_analyze_contacts(CLI::App& app) {
         ->expected(2);
     s->add_flag("--walls", a->spec.walls, "include particle-wall contacts");
     s->add_option("--csv", a->csv, "also write the 2D rose as CSV");
-    s->callback([a] { run_rose(*a); });
+    a->series.add_to(*s);
+    s->callback([a] {
+      if (!a->series.active()) return run_rose(*a);
+      run_frame_series("rose", a->in.input, a->series, a->output,
+                       [a](long frame, const std::string& out) {
+                         RoseArgs b = *a;
+                         b.in.frame = frame;
+                         b.output = out;
+                         b.csv.clear();
+                         run_rose(b);
+                       });
+    });
   }
   {
     auto a = std::make_shared<ChainArgs>();
@@ -355,7 +382,18 @@ void register_analyze_contacts(CLI::App& app) {
     s->add_option("--mean-factor", a->mean_factor, "strong above factor x mean |Fn| (default 1)");
     s->add_flag("--walls", a->walls, "include particle-wall contacts");
     s->add_option("--vtp", a->vtp, "also write the strong network as VTP polylines");
-    s->callback([a] { run_chains(*a); });
+    a->series.add_to(*s);
+    s->callback([a] {
+      if (!a->series.active()) return run_chains(*a);
+      run_frame_series("chains", a->in.input, a->series, a->output,
+                       [a](long frame, const std::string& out) {
+                         ChainArgs b = *a;
+                         b.in.frame = frame;
+                         b.output = out;
+                         b.vtp.clear();
+                         run_chains(b);
+                       });
+    });
   }
   {
     auto a = std::make_shared<WallArgs>();
@@ -374,7 +412,18 @@ void register_analyze_contacts(CLI::App& app) {
     s->add_option("--particle-density", a->particle_density,
                   "kg/m^3 for particles of unknown mass (default 2650)");
     s->add_option("--csv", a->csv, "also write the distributions as CSV");
-    s->callback([a] { run_walls(*a); });
+    a->series.add_to(*s);
+    s->callback([a] {
+      if (!a->series.active()) return run_walls(*a);
+      run_frame_series("walls", a->in.input, a->series, a->output,
+                       [a](long frame, const std::string& out) {
+                         WallArgs b = *a;
+                         b.in.frame = frame;
+                         b.output = out;
+                         b.csv.clear();
+                         run_walls(b);
+                       });
+    });
   }
 }
 

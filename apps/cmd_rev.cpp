@@ -18,6 +18,7 @@
 #include "commands.hpp"
 #include "errors.hpp"
 #include "field_output.hpp"
+#include "frame_series.hpp"
 #include "rev_map.hpp"
 #include "specimen_stress.hpp"
 #include "tensor_invariants.hpp"
@@ -55,6 +56,7 @@ void write_grid(H5FieldFile& h, const ga::RevGrid& g) {
 
 struct RevArgs {
   FrameArgs in;
+  FrameSeriesArgs series;
   SelectionArgs sel;
   std::string output, vti, csv;
   GridArgs grid;
@@ -113,6 +115,7 @@ void run_rev(const RevArgs& a) {
 
 struct ShearArgs {
   FrameArgs in;
+  FrameSeriesArgs series;
   SelectionArgs sel;
   std::string output, csv, field = "rotation";
   GridArgs grid;
@@ -177,6 +180,7 @@ void run_shearzone(const ShearArgs& a) {
 
 struct InvArgs {
   FrameArgs in;
+  FrameSeriesArgs series;
   SelectionArgs sel;
   std::string output, csv;
   std::vector<double> stress, gradient;
@@ -316,7 +320,19 @@ void register_analyze_rev(CLI::App& app) {
     s->add_option("--csv", a->csv, "also write a CSV: all cells, or the --profile");
     s->add_option("--profile", a->profile, "line x0 y0 z0 x1 y1 z1 for a CSV profile")->expected(6);
     s->add_option("--profile-points", a->profile_points, "points on the profile (default s/2)");
-    s->callback([a] { run_rev(*a); });
+    a->series.add_to(*s);
+    s->callback([a] {
+      if (!a->series.active()) return run_rev(*a);
+      run_frame_series("rev", a->in.input, a->series, a->output,
+                       [a](long frame, const std::string& out) {
+                         RevArgs b = *a;
+                         b.in.frame = frame;
+                         b.output = out;
+                         b.vti.clear();
+                         b.csv.clear();
+                         run_rev(b);
+                       });
+    });
   }
   {
     auto a = std::make_shared<ShearArgs>();
@@ -332,7 +348,18 @@ void register_analyze_rev(CLI::App& app) {
                   "rotation (about the slab normal, default) or shear (needs --to)");
     a->grid.add_to(*s);
     s->add_option("--csv", a->csv, "also write the profile across the band as CSV");
-    s->callback([a] { run_shearzone(*a); });
+    a->series.add_to(*s);
+    s->callback([a] {
+      if (!a->series.active()) return run_shearzone(*a);
+      run_frame_series("shearzone", a->in.input, a->series, a->output,
+                       [a](long frame, const std::string& out) {
+                         ShearArgs b = *a;
+                         b.in.frame = frame;
+                         b.output = out;
+                         b.csv.clear();
+                         run_shearzone(b);
+                       });
+    });
   }
   {
     auto a = std::make_shared<InvArgs>();
@@ -351,7 +378,18 @@ void register_analyze_rev(CLI::App& app) {
         ->expected(9);
     s->add_option("--gradient", a->gradient, "evaluate this F11 F12 ... F33 instead")->expected(9);
     s->add_option("--csv", a->csv, "also write one CSV row of all values");
-    s->callback([a] { run_invariants(*a); });
+    a->series.add_to(*s);
+    s->callback([a] {
+      if (!a->series.active()) return run_invariants(*a);
+      run_frame_series("invariants", a->in.input, a->series, a->output,
+                       [a](long frame, const std::string& out) {
+                         InvArgs b = *a;
+                         b.in.frame = frame;
+                         b.output = out;
+                         b.csv.clear();
+                         run_invariants(b);
+                       });
+    });
   }
 }
 

@@ -8,8 +8,11 @@
 #   YADE 2023.02a -j1 and -j2 (yade_scale_case.py: the same law and material);
 #   LIGGGHTS 3.8 on 1 and 2 MPI ranks (liggghts_case.py: hooke + rolling friction, same Ec, ρ, dt).
 # Prints particle-steps/s with ratios to granoscope 1 × 1, the largest memory (max RSS) per
-# sphere, and the cost of output: the 1 × 1 run again with a frame with contacts every STEPS/4
-# steps, as a fraction of its run time.
+# sphere, and the cost of output. Every code's time leaves out the first step (the initial
+# neighbour search and contacts): YADE and LIGGGHTS time a run after one step; granoscope's
+# rate is STEPS·N over the difference of a (1 + STEPS)-step and a 1-step run. Output: the 1 × 1
+# run again with a frame with contacts every STEPS/4 steps, giving the time of one frame, and
+# from it the fraction of a run that frames every 1 000 steps would take.
 #   bench/solver/run_scale_bench.sh [BUILD_DIR]
 #   SIZES="50000 500000 1000000" STEPS="200 40 20" BASELINES=1 (0: granoscope only)
 # (needs: apt-get install libopenmpi-dev openmpi-bin; --no-install-recommends yade liggghts)
@@ -38,7 +41,6 @@ wait "$prep" 2> /dev/null || true
 dt=$("$py" -c "import csv,sys; r=list(csv.DictReader(open(sys.argv[1])))[-1]; print(repr(float(r['time_s'])/int(r['step'])))" "$work/prep/preparation.csv")
 echo "prepared specimen: $("$py" -c "import h5py,sys; print(len(h5py.File(sys.argv[1])['particles/radius']))" "$work/prep/specimen.h5") spheres; dt = $dt s"
 
-rate() { sed -n 's/.*(\([0-9.e+]*\) particle-steps\/s.*/\1/p' "$1"; }
 secs() { sed -n 's/.* particles in \([0-9.e+]*\) s .*/\1/p' "$1"; }
 scene() {  # csv lx ly lz steps every out.toml
   "$py" - "$@" "$dt" <<'PY'
@@ -78,13 +80,22 @@ for k in "${!sizes[@]}"; do
   target=${sizes[$k]}
   steps=${stepss[$k]:-${stepss[-1]}}
   read -r n lx ly lz tiles <<< "$("$py" "$here/make_tiled_specimen.py" "$work/prep/specimen.h5" "$target" "$work/p.csv")"
-  scene "$work/p.csv" "$lx" "$ly" "$lz" "$steps" 1000000000 "$work/s.toml"
-  scene "$work/p.csv" "$lx" "$ly" "$lz" "$steps" $((steps / 4)) "$work/o.toml"
+  scene "$work/p.csv" "$lx" "$ly" "$lz" $((steps + 1)) 1000000000 "$work/s.toml"
+  scene "$work/p.csv" "$lx" "$ly" "$lz" $((steps + 1)) $((steps / 4)) "$work/o.toml"
   echo
   echo "== $n spheres ($tiles copies), box $lx x $ly x $lz m, $steps steps"
-  /usr/bin/time -f %M -o "$work/m11" "$gs" simulate "$work/s.toml" --threads 1 -q -o "$work/r" > "$work/t11"
-  "$gs" simulate "$work/s.toml" --threads 2 -q -o "$work/r" > "$work/t12"
-  $mpi -np 2 sh -c "/usr/bin/time -f %M -o $work/m21.\$OMPI_COMM_WORLD_RANK $gs simulate $work/s.toml --threads 1 -q -o $work/r" > "$work/t21"
+  # (each rate from a 1-step and a (1 + STEPS)-step run: the first step left out)
+  ours() {  # label threads launcher...
+    local label=$1 threads=$2
+    shift 2
+    "$@" "$gs" simulate "$work/s.toml" --threads "$threads" --steps 1 -q -o "$work/r" > "$work/$label.1"
+    "$@" "$gs" simulate "$work/s.toml" --threads "$threads" -q -o "$work/r" > "$work/$label.n"
+    "$py" -c "import sys; print($n*$steps/(float(sys.argv[2])-float(sys.argv[1])))" \
+      "$(secs "$work/$label.1")" "$(secs "$work/$label.n")"
+  }
+  r11=$(ours t11 1 /usr/bin/time -f %M -o "$work/m11")
+  r12=$(ours t12 2)
+  r21=$(ours t21 1 $mpi -np 2 sh -c "/usr/bin/time -f %M -o $work/m21.\$OMPI_COMM_WORLD_RANK \"\$0\" \"\$@\"")
   "$gs" simulate "$work/o.toml" --threads 1 -q -o "$work/ro" > "$work/to"
   out_mb=$(du -sm "$work/ro" | cut -f1)
   y1=0 y2=0 ym=0 l1=0 l2=0 lm=0
@@ -102,8 +113,8 @@ for k in "${!sizes[@]}"; do
     l2=$("$py" -c "print($n*$steps/$(loop "$work/lig/log2.txt"))")
     lm=$(cat "$work/ml")
   fi
-  "$py" - "$n" "$steps" "$(rate "$work/t11")" "$(rate "$work/t12")" "$(rate "$work/t21")" \
-    "$(cat "$work/m11")" "$(cat "$work/m21.0")" "$(cat "$work/m21.1")" "$(secs "$work/t11")" "$(secs "$work/to")" \
+  "$py" - "$n" "$steps" "$r11" "$r12" "$r21" \
+    "$(cat "$work/m11")" "$(cat "$work/m21.0")" "$(cat "$work/m21.1")" "$(secs "$work/t11.n")" "$(secs "$work/to")" \
     "$out_mb" "$y1" "$y2" "$ym" "$l1" "$l2" "$lm" <<'PY'
 import sys
 n, steps = int(sys.argv[1]), int(sys.argv[2])
@@ -120,7 +131,12 @@ if y1:
 for label, r, m in rows:
     print("  %-40s %16.3g %7.2fx %14s" % (label, r, r / r11, "%.2f" % (m / n) if m else ""))
 print("  (memory: the largest resident set of the process, or of either process, over the run)")
-print("  output: %d frames with contacts (%d MB) cost %.1f %% of the run (%.2f s against %.2f s)"
-      % (5, out_mb, 100 * (to - t11) / to, to, t11))
+# The frames run: 4 more frames than the plain run (every STEPS/4 and the last; step 0's is
+# written before the timer starts in both).
+frame = (to - t11) / 4
+step = n / r11
+print("  output: a frame with contacts takes %.3g s (%.3g MB; %.3g steps' time); frames every"
+      " 1 000 steps would take %.1f %% of a run" % (frame, out_mb / 6, frame / step,
+                                                    100 * frame / (frame + 1000 * step)))
 PY
 done

@@ -12,6 +12,8 @@
 #include <string>
 #include <vector>
 
+#include <hdf5.h>
+
 #include "../io/test_util.hpp"
 #include "cli_util.hpp"
 #include "hdf5_trajectory.hpp"
@@ -75,6 +77,23 @@ void expect_same_run(const fs::path& a_file, const fs::path& b_file) {
     }
   }
   EXPECT_GT(contacts, 100u);
+}
+
+/// A dataset of an HDF5 file as doubles (empty when missing).
+std::vector<double> read_dataset(const fs::path& file, const char* name) {
+  std::vector<double> v;
+  const hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  if (f < 0) return v;
+  const hid_t d = H5Dopen2(f, name, H5P_DEFAULT);
+  if (d >= 0) {
+    const hid_t s = H5Dget_space(d);
+    v.resize(static_cast<std::size_t>(H5Sget_simple_extent_npoints(s)));
+    H5Dread(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data());
+    H5Sclose(s);
+    H5Dclose(d);
+  }
+  H5Fclose(f);
+  return v;
 }
 
 bool mpirun_present() {
@@ -425,6 +444,32 @@ TEST(Mpi, CheckpointsResumeOnAnyNumberOfProcesses) {
       << err;
   expect_same_run(dir / "straight" / "oedometer_fall.h5", two_then_one / "oedometer_fall.h5");
   expect_same_run(dir / "straight" / "oedometer_fall.h5", one_then_two / "oedometer_fall.h5");
+}
+
+// `analyze … --frames` under mpirun: the processes share the frames, process 0 merges them;
+// the series equals the one made by worker processes (every dataset, to the bit).
+TEST(Mpi, AnalysesOverFramesShareTheFramesBetweenProcesses) {
+  if (!mpirun_present()) GTEST_SKIP() << "mpirun not installed (apt-get install openmpi-bin)";
+  gs::test::ScratchDir dir("mpi_frames");
+  ASSERT_EQ(run(kExe + " simulate " + (kData / "scenes" / "oedometer_fall.toml").string() +
+                " -q -o " + (dir / "run").string()),
+            0);
+  const std::string traj = (dir / "run" / "oedometer_fall.h5").string();
+  std::string err;
+  ASSERT_EQ(run(kExe + " analyze fabric " + traj + " --frames 1:7:2 --jobs 2 -o " +
+                (dir / "jobs.h5").string()),
+            0);
+  ASSERT_EQ(run(kMpirun + "2 " + kExe + " analyze fabric " + traj + " --frames 1:7:2 -o " +
+                    (dir / "mpi.h5").string(),
+                &err),
+            0)
+      << err;
+  for (const char* name : {"/frame", "/M", "/D", "/attributes/omega", "/attributes/contacts"}) {
+    const auto a = read_dataset(dir / "jobs.h5", name), b = read_dataset(dir / "mpi.h5", name);
+    EXPECT_EQ(a, b) << name;
+    EXPECT_FALSE(a.empty()) << name;
+  }
+  EXPECT_EQ(read_dataset(dir / "mpi.h5", "/frame"), (std::vector<double>{1, 3, 5}));
 }
 
 // What the decomposition does not handle yet, and a scene error, are one line from process 0
