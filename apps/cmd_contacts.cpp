@@ -323,18 +323,7 @@ void register_analyze_contacts(CLI::App& app) {
     a->sel.add_to(*s);
     s->add_option("-o,--output", a->output, "output HDF5 (format granoscope-fabric)")->required();
     s->add_option("--csv", a->csv, "also write one CSV row");
-    a->series.add_to(*s);
-    s->callback([a] {
-      if (!a->series.active()) return run_fabric(*a);
-      run_frame_series("fabric", a->in.input, a->series, a->output,
-                       [a](long frame, const std::string& out) {
-                         FabricArgs b = *a;
-                         b.in.frame = frame;
-                         b.output = out;
-                         b.csv.clear();
-                         run_fabric(b);
-                       });
-    });
+    add_frame_series(*s, a, "fabric", &run_fabric);
   }
   {
     auto a = std::make_shared<RoseArgs>();
@@ -356,18 +345,7 @@ void register_analyze_contacts(CLI::App& app) {
         ->expected(2);
     s->add_flag("--walls", a->spec.walls, "include particle-wall contacts");
     s->add_option("--csv", a->csv, "also write the 2D rose as CSV");
-    a->series.add_to(*s);
-    s->callback([a] {
-      if (!a->series.active()) return run_rose(*a);
-      run_frame_series("rose", a->in.input, a->series, a->output,
-                       [a](long frame, const std::string& out) {
-                         RoseArgs b = *a;
-                         b.in.frame = frame;
-                         b.output = out;
-                         b.csv.clear();
-                         run_rose(b);
-                       });
-    });
+    add_frame_series(*s, a, "rose", &run_rose);
   }
   {
     auto a = std::make_shared<ChainArgs>();
@@ -382,18 +360,7 @@ void register_analyze_contacts(CLI::App& app) {
     s->add_option("--mean-factor", a->mean_factor, "strong above factor x mean |Fn| (default 1)");
     s->add_flag("--walls", a->walls, "include particle-wall contacts");
     s->add_option("--vtp", a->vtp, "also write the strong network as VTP polylines");
-    a->series.add_to(*s);
-    s->callback([a] {
-      if (!a->series.active()) return run_chains(*a);
-      run_frame_series("chains", a->in.input, a->series, a->output,
-                       [a](long frame, const std::string& out) {
-                         ChainArgs b = *a;
-                         b.in.frame = frame;
-                         b.output = out;
-                         b.vtp.clear();
-                         run_chains(b);
-                       });
-    });
+    add_frame_series(*s, a, "chains", &run_chains);
   }
   {
     auto a = std::make_shared<WallArgs>();
@@ -412,18 +379,7 @@ void register_analyze_contacts(CLI::App& app) {
     s->add_option("--particle-density", a->particle_density,
                   "kg/m^3 for particles of unknown mass (default 2650)");
     s->add_option("--csv", a->csv, "also write the distributions as CSV");
-    a->series.add_to(*s);
-    s->callback([a] {
-      if (!a->series.active()) return run_walls(*a);
-      run_frame_series("walls", a->in.input, a->series, a->output,
-                       [a](long frame, const std::string& out) {
-                         WallArgs b = *a;
-                         b.in.frame = frame;
-                         b.output = out;
-                         b.csv.clear();
-                         run_walls(b);
-                       });
-    });
+    add_frame_series(*s, a, "walls", &run_walls);
   }
 }
 

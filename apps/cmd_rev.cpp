@@ -320,19 +320,7 @@ void register_analyze_rev(CLI::App& app) {
     s->add_option("--csv", a->csv, "also write a CSV: all cells, or the --profile");
     s->add_option("--profile", a->profile, "line x0 y0 z0 x1 y1 z1 for a CSV profile")->expected(6);
     s->add_option("--profile-points", a->profile_points, "points on the profile (default s/2)");
-    a->series.add_to(*s);
-    s->callback([a] {
-      if (!a->series.active()) return run_rev(*a);
-      run_frame_series("rev", a->in.input, a->series, a->output,
-                       [a](long frame, const std::string& out) {
-                         RevArgs b = *a;
-                         b.in.frame = frame;
-                         b.output = out;
-                         b.vti.clear();
-                         b.csv.clear();
-                         run_rev(b);
-                       });
-    });
+    add_frame_series(*s, a, "rev", &run_rev);
   }
   {
     auto a = std::make_shared<ShearArgs>();
@@ -348,18 +336,7 @@ void register_analyze_rev(CLI::App& app) {
                   "rotation (about the slab normal, default) or shear (needs --to)");
     a->grid.add_to(*s);
     s->add_option("--csv", a->csv, "also write the profile across the band as CSV");
-    a->series.add_to(*s);
-    s->callback([a] {
-      if (!a->series.active()) return run_shearzone(*a);
-      run_frame_series("shearzone", a->in.input, a->series, a->output,
-                       [a](long frame, const std::string& out) {
-                         ShearArgs b = *a;
-                         b.in.frame = frame;
-                         b.output = out;
-                         b.csv.clear();
-                         run_shearzone(b);
-                       });
-    });
+    add_frame_series(*s, a, "shearzone", &run_shearzone);
   }
   {
     auto a = std::make_shared<InvArgs>();
@@ -378,18 +355,7 @@ void register_analyze_rev(CLI::App& app) {
         ->expected(9);
     s->add_option("--gradient", a->gradient, "evaluate this F11 F12 ... F33 instead")->expected(9);
     s->add_option("--csv", a->csv, "also write one CSV row of all values");
-    a->series.add_to(*s);
-    s->callback([a] {
-      if (!a->series.active()) return run_invariants(*a);
-      run_frame_series("invariants", a->in.input, a->series, a->output,
-                       [a](long frame, const std::string& out) {
-                         InvArgs b = *a;
-                         b.in.frame = frame;
-                         b.output = out;
-                         b.csv.clear();
-                         run_invariants(b);
-                       });
-    });
+    add_frame_series(*s, a, "invariants", &run_invariants);
   }
 }
 

@@ -15,6 +15,7 @@
 #include "atomic_file.hpp"
 #include "commands.hpp"
 #include "errors.hpp"
+#include "frame_series.hpp"
 #include "scene_file.hpp"
 #include "scene_run.hpp"
 #ifdef GRANOSCOPE_MPI
@@ -160,13 +161,6 @@ void run_sweep(const Args& a, const solver::Scene& first) {
                          std::to_string(sw.values.size()) + " runs failed (see the output above)",
                      list);
   }
-}
-
-/// Processes in this launch (mpirun sets OMPI_COMM_WORLD_SIZE; other launchers PMI_SIZE).
-int launched_processes() {
-  for (const char* v : {"OMPI_COMM_WORLD_SIZE", "PMI_SIZE"})
-    if (const char* s = std::getenv(v)) return std::max(1, std::atoi(s));
-  return 1;
 }
 
 #ifdef GRANOSCOPE_MPI

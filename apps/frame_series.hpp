@@ -6,6 +6,7 @@
 
 #include <CLI/CLI.hpp>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -33,5 +34,27 @@ std::vector<long> frame_range(const std::string& input, const std::string& spec,
 void run_frame_series(const std::string& command, const std::string& input,
                       const FrameSeriesArgs& series, const std::string& output,
                       const std::function<void(long, const std::string&)>& one);
+
+/// Gives the analysis command `cmd` (arguments `a`: `in` a FrameArgs, `output`, `series`) its
+/// --frames and --jobs, and a callback that runs `run` on one frame, or on each frame of the
+/// series (A a copy of the arguments with the frame and the part's output set).
+template <class A>
+void add_frame_series(CLI::App& cmd, const std::shared_ptr<A>& a, const std::string& command,
+                      void (*run)(const A&)) {
+  a->series.add_to(cmd);
+  cmd.callback([a, command, run] {
+    if (!a->series.active()) return run(*a);
+    run_frame_series(command, a->in.input, a->series, a->output,
+                     [a, run](long frame, const std::string& out) {
+                       A b = *a;
+                       b.in.frame = frame;
+                       b.output = out;
+                       run(b);
+                     });
+  });
+}
+
+/// Processes in this launch (mpirun sets OMPI_COMM_WORLD_SIZE; other launchers PMI_SIZE).
+int launched_processes();
 
 }  // namespace gs::cli
