@@ -15,7 +15,6 @@
 #include "atomic_file.hpp"
 #include "commands.hpp"
 #include "errors.hpp"
-#include "frame_series.hpp"
 #include "scene_file.hpp"
 #include "scene_run.hpp"
 #ifdef GRANOSCOPE_MPI

@@ -29,12 +29,6 @@ namespace gs::cli {
 
 namespace fs = std::filesystem;
 
-int launched_processes() {
-  for (const char* v : {"OMPI_COMM_WORLD_SIZE", "PMI_SIZE"})
-    if (const char* s = std::getenv(v)) return std::max(1, std::atoi(s));
-  return 1;
-}
-
 void FrameSeriesArgs::add_to(CLI::App& cmd) {
   auto* o = cmd.add_option("--frames", frames,
                            "a range of frames A:B or A:B:S (a Python slice: B excluded, "

@@ -54,7 +54,4 @@ void add_frame_series(CLI::App& cmd, const std::shared_ptr<A>& a, const std::str
   });
 }
 
-/// Processes in this launch (mpirun sets OMPI_COMM_WORLD_SIZE; other launchers PMI_SIZE).
-int launched_processes();
-
 }  // namespace gs::cli

@@ -410,7 +410,6 @@ void Simulation::set_roles(std::vector<std::uint8_t> roles) {
   roles_ = std::move(roles);
   absent_.resize(roles_.size());
   for (std::size_t i = 0; i < roles_.size(); ++i) absent_[i] = roles_[i] == kAbsent;
-  nl_.absent = roles_.empty() ? nullptr : &absent_;
 }
 
 void Simulation::rebuild_local(const std::vector<ContactHistory>& received, bool keep_reference) {
