@@ -128,4 +128,12 @@ struct ContactHistory {
 
 inline constexpr std::uint32_t kWallBase = 0x80000000u;
 
+/// Makes room for n elements in a per-pair buffer, with 1/16 to spare, so that a list a little
+/// longer at the next neighbour-list build does not reallocate: a fresh block that large is
+/// mapped anew and costs a page fault per page every time.
+template <class Vec>
+void with_room(Vec& v, std::size_t n) {
+  if (v.capacity() < n) v.reserve(n + n / 16);
+}
+
 }  // namespace gs::solver

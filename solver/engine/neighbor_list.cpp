@@ -1,5 +1,7 @@
 #include "neighbor_list.hpp"
 
+#include <omp.h>
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -87,14 +89,16 @@ constexpr int kForward[13][3] = {{1, 0, 0},  {-1, 1, 0}, {0, 1, 0},  {1, 1, 0}, 
 /// cell and one of its forward neighbours, each pair once; a neighbour across a face of a
 /// direction that wraps is taken from the other side, `shift` the periods crossed (else such
 /// neighbours do not exist).
+/// Only the cells of layers z in [z0, z1) (z1 < 0: all) are taken as the first cell.
 template <class Test>
 void for_each_slot_pair(const Eigen::Array3i& dims, const bool (&wraps)[3],
-                        const std::vector<std::uint32_t>& start, Test&& test) {
+                        const std::vector<std::uint32_t>& start, Test&& test, int z0 = 0,
+                        int z1 = -1) {
   auto index_of = [&](int x, int y, int z) {
     return static_cast<std::uint32_t>((z * dims[1] + y) * dims[0] + x);
   };
   const Eigen::Vector3i none = Eigen::Vector3i::Zero();
-  for (int cz = 0; cz < dims[2]; ++cz)
+  for (int cz = z0; cz < (z1 < 0 ? dims[2] : z1); ++cz)
     for (int cy = 0; cy < dims[1]; ++cy)
       for (int cx = 0; cx < dims[0]; ++cx) {
         const std::uint32_t ci = index_of(cx, cy, cz);
@@ -246,16 +250,47 @@ void NeighborList::build(const ParticleState& p, const std::vector<WallState>& w
     return d2 < reach * reach * (1 + 1e-12);
   };
   // Sphere pairs, each found once: a cell with itself and with its forward neighbours.
+  // With threads, each takes layers of cells holding a share of the particles; the pairs are
+  // sorted below, so the order they are found in does not matter.
   found_.clear();
   const bool no_wrap[3] = {false, false, false};
-  for_each_slot_pair(
-      dims, no_wrap, cell_start_, [&](std::uint32_t s, std::uint32_t t, const Eigen::Vector3i&) {
-        const Slot &a = slots_[s], &b = slots_[t];
-        if (a.clump >= 0 && a.clump == b.clump) return;  // one clump
-        const double dx = b.x - a.x, dy = b.y - a.y, dz = b.z - a.z;
-        if (candidates(dx * dx + dy * dy + dz * dz, a.r, b.r))
-          found_.emplace_back(std::min(a.index, b.index), std::max(a.index, b.index));
-      });
+  auto sphere_pairs = [&](std::vector<std::pair<std::uint32_t, std::uint32_t>>& out, int z0,
+                          int z1) {
+    for_each_slot_pair(
+        dims, no_wrap, cell_start_,
+        [&](std::uint32_t s, std::uint32_t t, const Eigen::Vector3i&) {
+          const Slot &a = slots_[s], &b = slots_[t];
+          if (a.clump >= 0 && a.clump == b.clump) return;  // one clump
+          const double dx = b.x - a.x, dy = b.y - a.y, dz = b.z - a.z;
+          if (candidates(dx * dx + dy * dy + dz * dz, a.r, b.r))
+            out.emplace_back(std::min(a.index, b.index), std::max(a.index, b.index));
+        },
+        z0, z1);
+  };
+  const int nt = threads > 1 && active >= 20000 && dims[2] >= 2 * threads ? threads : 1;
+  if (nt == 1) {
+    sphere_pairs(found_, 0, dims[2]);
+  } else {
+    found_by_thread_.resize(static_cast<std::size_t>(nt));
+    const std::size_t layer = static_cast<std::size_t>(dims[0]) * dims[1];
+    const std::uint32_t slots = cell_start_[ncells];
+#pragma omp parallel num_threads(nt)
+    {
+      const int t = omp_get_thread_num(), n_t = omp_get_num_threads();
+      // The layers from the first whose particles reach this share's start.
+      auto first_layer = [&](int k) {
+        if (k == n_t) return dims[2];
+        const std::uint64_t target = static_cast<std::uint64_t>(slots) * k / n_t;
+        int z = 0;
+        while (z < dims[2] && cell_start_[static_cast<std::size_t>(z + 1) * layer] <= target) ++z;
+        return k == 0 ? 0 : z;
+      };
+      auto& out = found_by_thread_[static_cast<std::size_t>(t)];
+      out.clear();
+      sphere_pairs(out, first_layer(t), first_layer(t + 1));
+    }
+    for (const auto& part : found_by_thread_) found_.insert(found_.end(), part.begin(), part.end());
+  }
   // The large particles: with each other, and with the slots of the cells their reach covers.
   auto same_clump = [&](std::uint32_t a, std::uint32_t b) {
     return clumped && p.clump[a] >= 0 && p.clump[a] == p.clump[b];
@@ -372,8 +407,10 @@ void NeighborList::build(const ParticleState& p, const std::vector<WallState>& w
   for (const auto& pr : found_) ++first_start_[pr.first + 1];
   for (std::size_t i = 0; i < n; ++i) first_start_[i + 1] += first_start_[i];
   cell_fill_.assign(first_start_.begin(), first_start_.end() - 1);
+  with_room(pairs, found_.size());
   pairs.resize(found_.size());
   for (const auto& pr : found_) pairs[cell_fill_[pr.first]++] = pr;
+#pragma omp parallel for num_threads(nt) schedule(static)
   for (std::size_t i = 0; i < n; ++i) {
     auto* b = pairs.data() + first_start_[i];
     auto* e = pairs.data() + first_start_[i + 1];
@@ -480,6 +517,8 @@ void NeighborList::build_periodic(const ParticleState& p, const PeriodicCell& ce
       });
   std::sort(found_periodic_.begin(), found_periodic_.end(),
             [](const auto& x, const auto& y) { return x.a != y.a ? x.a < y.a : x.b < y.b; });
+  with_room(pairs, found_periodic_.size());
+  with_room(cell_dist, found_periodic_.size());
   pairs.resize(found_periodic_.size());
   cell_dist.resize(found_periodic_.size());
   for (std::size_t k = 0; k < found_periodic_.size(); ++k) {

@@ -45,6 +45,8 @@ struct NeighborList {
   /// Particles the build leaves out (1), as it does removed ones, and a cell's staleness test
   /// ignores: those of other processes (Simulation::set_roles). nullptr or empty: none.
   const std::vector<std::uint8_t>* absent = nullptr;
+  /// Threads the build may use (the pairs are the same for any number).
+  int threads = 1;
 
   /// True when some pair may have come within contact since the last build.
   /// With a cell, the gap of a pair also closes by the cell's deformation since the build:
@@ -80,6 +82,7 @@ struct NeighborList {
   std::vector<FacetEntry> facet_entries_, facet_sorted_;
   std::vector<std::uint32_t> plain_walls_;
   std::vector<std::pair<std::uint32_t, std::uint32_t>> found_;
+  std::vector<std::vector<std::pair<std::uint32_t, std::uint32_t>>> found_by_thread_;
   std::vector<std::uint32_t> first_start_;
   std::vector<std::uint32_t> big_;  // particles kept out of the grid (mixed sizes)
   std::vector<char> is_big_;

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <exception>
 #include <fstream>
 #include <iterator>
 #include <limits>
@@ -119,6 +120,7 @@ Simulation::Simulation(SimulationConfig config, const std::vector<Particle>& par
     walls_.push_back(w);
   }
   nl_.skin = cfg_.skin > 0 ? cfg_.skin : (n > 0 ? 0.5 * rmin : 1e-3);
+  nl_.threads = std::max(1, cfg_.threads);
 }
 
 void Simulation::set_clumps(std::vector<ClumpBody> clumps) {
@@ -291,6 +293,7 @@ void Simulation::set_periodic(const Eigen::Matrix3d& hsize, bool planar) {
   nl_.build(p_, walls_, cell_ptr(), planar_);  // (throws PeriodicTooSmall now, not at step 1)
   invalidate_neighbors();
   nl_.pairs.clear();  // (pairs and histories go together: the first step finds them)
+  ++pairs_version_;
   nl_.cell_dist.clear();
 }
 
@@ -511,6 +514,9 @@ void Simulation::attach_histories(const std::vector<ContactHistory>& old,
   // `old` is sorted by (a, b), as the pair list is. A contact whose pair left the list cannot be
   // touching (the skin guarantees it), so dropping it loses nothing.
   const std::size_t np = nl_.pairs.size();
+  ++pairs_version_;
+  with_room(hist_, np);
+  with_room(params_, np);
   hist_.assign(np, ContactHistory{});
   params_.resize(np);
   if (facet_forces_) pair_facet_.assign(np, 0);
@@ -529,8 +535,23 @@ void Simulation::attach_histories(const std::vector<ContactHistory>& old,
     reuse = params_walls_[w] == (static_cast<int>(walls_[w].spec.shape) << 1 |
                                  static_cast<int>(walls_[w].spec.plane_radii));
   const double tan_material = std::tan(mat.friction_deg * M_PI / 180.0);
-  std::size_t o = 0;
-  for (std::size_t k = 0; k < np; ++k) {
+  // Each pair on its own (threads take shares of the list, each starting its walk through the
+  // old list where its first pair would be).
+  const int threads = np >= 20000 ? std::max(1, cfg_.threads) : 1;
+  std::exception_ptr error;  // (the first thread's error, rethrown after the region)
+#pragma omp parallel num_threads(threads)
+  try {
+  const auto nt = static_cast<std::size_t>(omp_get_num_threads());
+  const auto t = static_cast<std::size_t>(omp_get_thread_num());
+  const std::size_t k0 = np * t / nt, k1 = np * (t + 1) / nt;
+  auto before = [](const ContactHistory& h, const std::pair<std::uint32_t, std::uint32_t>& pr) {
+    return std::make_pair(h.a, h.b) < pr;
+  };
+  std::size_t o = k0 < np ? static_cast<std::size_t>(
+                                std::lower_bound(old.begin(), old.end(), nl_.pairs[k0], before) -
+                                old.begin())
+                          : old.size();
+  for (std::size_t k = k0; k < k1; ++k) {
     const auto pr = nl_.pairs[k];
     while (o < old.size() && std::make_pair(old[o].a, old[o].b) < pr) ++o;
     const bool kept = o < old.size() && old[o].a == pr.first && old[o].b == pr.second;
@@ -580,6 +601,11 @@ void Simulation::attach_histories(const std::vector<ContactHistory>& old,
       if (wf >= 0) params_[k].tan_friction = std::tan(wf * M_PI / 180.0);
     }
   }
+  } catch (...) {
+#pragma omp critical(gs_attach_error)
+    if (!error) error = std::current_exception();
+  }
+  if (error) std::rethrow_exception(error);
   params_key_valid_ = true;
   params_radius_ = p_.radius;
   params_material_ = {
@@ -598,6 +624,7 @@ void Simulation::attach_histories(const std::vector<ContactHistory>& old,
   // distance. Until the positions have moved by more than it (NeighborList::moved), the pair
   // provably does not touch and the contact pass skips it: a wall of many small facets within
   // the skin of a sphere then costs what its contacts cost, not a geometry per facet and step.
+  with_room(facet_gap_, np);
   facet_gap_.assign(np, -HUGE_VAL);
   for (const std::uint32_t k : wall_pairs_) {
     const auto [a, b] = nl_.pairs[k];
@@ -663,6 +690,7 @@ void Simulation::attach_histories(const std::vector<ContactHistory>& old,
     if (b < kWallBase) ++pair_start_[b + 1];
   }
   for (std::size_t i = 0; i < n; ++i) pair_start_[i + 1] += pair_start_[i];
+  with_room(pair_of_, pair_start_[n]);
   pair_of_.resize(pair_start_[n]);
   std::vector<std::uint32_t> fill(pair_start_.begin(), pair_start_.end() - 1);
   for (std::size_t k = 0; k < np; ++k) {
@@ -1028,6 +1056,117 @@ void Simulation::run_law(ContactBatch& batch, int count, double dt) const {
     cohesive_frictional_batch(batch, count, dt, cfg_.twist_beta > 0, periodic_);
 }
 
+template <bool kIndexed>
+void Simulation::contact_pass(std::size_t begin, std::size_t end, double& max_overlap_out) {
+  double max_overlap_ratio = max_overlap_out;  // (a local: the loads' stores cannot alias it)
+  // The particles of this share start from their applied loads.
+  const auto t = static_cast<std::size_t>(omp_get_thread_num());
+  const std::size_t p0 = split_first_[t], p1 = split_first_[t + 1];
+  for (std::size_t i = p0; i < p1; ++i) {
+    p_.force[i] = p_.external_force[i];
+    p_.torque[i].setZero();
+    particle_dissipation_[2 * i] = particle_dissipation_[2 * i + 1] = 0;
+  }
+  const std::uint8_t* mixed = split_mixed_.data();
+  ContactBatch batch;
+  std::uint32_t lane_pair[ContactBatch::kLanes];
+  // The loads of body 1 stay in registers while its pairs follow each other (pairs are
+  // sorted by body 1, and a particle's pairs as body 2 all come before those as body 1):
+  // the same additions in the same order.
+  std::uint32_t cur = kWallBase;
+  V3 f_cur, t_cur;
+  double fr_cur = 0, ro_cur = 0;
+  auto flush = [&] {
+    if (cur == kWallBase) return;
+    f_cur.store(p_.force[cur]);
+    t_cur.store(p_.torque[cur]);
+    particle_dissipation_[2 * cur] = fr_cur;
+    particle_dissipation_[2 * cur + 1] = ro_cur;
+  };
+  auto keep_loads = [&](std::uint32_t k, const ContactLoads& L) {
+    loads_[k] = L;
+    dissipation_[2 * k] = L.friction_dissipation;
+    dissipation_[2 * k + 1] = L.rolling_dissipation;
+  };
+  const double dt = cfg_.dt;
+  for (std::size_t i = begin; i < end;) {
+    const int m = fill_batch<kIndexed>(i, end, batch, lane_pair);
+    run_law(batch, m, dt);
+    for (int j = 0; j < m; ++j) {
+      const std::uint32_t kk = lane_pair[j];
+      ContactLoads L;
+      if (!finish_pair(kk, batch, j, L, max_overlap_ratio)) continue;
+      const auto [a, b] = nl_.pairs[kk];
+      const bool a_mixed = mixed[a];
+      if (!a_mixed) {
+        if (a != cur) {
+          flush();
+          cur = a;
+          f_cur = V3(p_.force[a]);
+          t_cur = V3(p_.torque[a]);
+          fr_cur = particle_dissipation_[2 * a];
+          ro_cur = particle_dissipation_[2 * a + 1];
+        }
+        fr_cur += L.friction_dissipation;
+        ro_cur += L.rolling_dissipation;
+      }
+      if (b < kWallBase) {
+        const bool b_mixed = mixed[b];
+        if (!a_mixed) {
+          f_cur += L.force1;
+          t_cur += L.arm1;
+          t_cur += -L.moment;
+        }
+        if (!b_mixed) {
+          add_to(p_.force[b], -L.force1);
+          add_to(p_.torque[b], L.arm2);
+          add_to(p_.torque[b], L.moment);
+        }
+        if (a_mixed || b_mixed) keep_loads(kk, L);  // (for a mixed one's gather)
+      } else {
+        if (!a_mixed) {
+          f_cur += -L.force1;
+          t_cur += L.arm2;
+          t_cur += L.moment;
+        }
+        keep_loads(kk, L);  // (for the wall's resultant, and a mixed one's gather)
+      }
+    }
+  }
+  flush();
+  max_overlap_out = max_overlap_ratio;
+}
+
+void Simulation::split_pairs(std::size_t nt) {
+  const std::size_t n = p_.size(), np = nl_.pairs.size();
+  split_first_.assign(nt + 1, 0);
+  split_pair_.assign(nt + 1, 0);
+  for (std::size_t t = 1; t < nt; ++t) {
+    // The share starts at the body 1 of its first pair by count (all pairs of a particle as
+    // body 1 stay in one share).
+    const std::size_t k = np * t / nt;
+    const std::uint32_t first = k < np ? nl_.pairs[k].first : static_cast<std::uint32_t>(n);
+    split_first_[t] = std::max(first, split_first_[t - 1]);
+    split_pair_[t] = static_cast<std::size_t>(
+        std::lower_bound(nl_.pairs.begin(), nl_.pairs.end(),
+                         std::pair<std::uint32_t, std::uint32_t>{split_first_[t], 0}) -
+        nl_.pairs.begin());
+  }
+  split_first_[nt] = static_cast<std::uint32_t>(n);
+  split_pair_[nt] = np;
+  split_mixed_.assign(n, 0);
+  for (std::size_t t = 0; t < nt; ++t)
+    for (std::size_t k = split_pair_[t]; k < split_pair_[t + 1]; ++k) {
+      const std::uint32_t b = nl_.pairs[k].second;
+      if (b < kWallBase && b >= split_first_[t + 1]) split_mixed_[b] = 1;
+    }
+  split_mixed_list_.clear();
+  for (std::size_t i = 0; i < n; ++i)
+    if (split_mixed_[i]) split_mixed_list_.push_back(static_cast<std::uint32_t>(i));
+  split_version_ = pairs_version_;
+  split_threads_ = nt;
+}
+
 void Simulation::step() {
   if (periodic_) cell_.integrate(cfg_.dt);  // (YADE: Scene::moveToNextTimeStep, before engines)
   if (walls_dirty_) classify_walls();
@@ -1041,10 +1180,15 @@ void Simulation::step() {
   // The pairs the contact pass visits: all, or visit_ while some facet pairs are deferred.
   const bool indexed = !deferred_.empty();
   const std::size_t nv = indexed ? visit_.size() : np;
+  const int threads = std::max(1, cfg_.threads);
+  with_room(loads_, np);
+  with_room(active_, np);
   loads_.resize(np);
   active_.assign(np, 0);
-  dissipation_.resize(2 * np);
-  const int threads = std::max(1, cfg_.threads);
+  if (threads > 1) {  // (one thread keeps no dissipation per pair)
+    with_room(dissipation_, 2 * np);
+    dissipation_.resize(2 * np);
+  }
   const std::size_t n = p_.size();
   // Ledger terms summed per particle (a pair's dissipation goes to its body 1, in pair order),
   // then per chunk of kChunk particles, then over the chunks in order: the same sums for any
@@ -1058,7 +1202,8 @@ void Simulation::step() {
   // them, and waking it costs more than the loops on small systems).
 #pragma omp parallel num_threads(threads)
   {
-    if (threads == 1) {
+    const std::size_t nt = static_cast<std::size_t>(omp_get_num_threads());
+    if (nt == 1) {
       // One thread: the loads go straight onto the particles, in pair order, which is the
       // order the gather below sums them in, so the results are the same as with more threads.
       for (std::size_t i = 0; i < n; ++i) {
@@ -1117,34 +1262,38 @@ void Simulation::step() {
       }
       flush();
     } else {
-      // Each thread takes a contiguous share of the pairs, in batches.
+      // Each thread takes a share of the particles with their pairs as body 1 and sums their
+      // loads straight onto them, as one thread does; the few particles also loaded by another
+      // share's pairs (mixed) are gathered afterwards from loads_ in pair order. The sums are
+      // the serial pass's for any number of threads.
+#pragma omp single
+      if (split_version_ != pairs_version_ || split_threads_ != nt) split_pairs(nt);
       const std::size_t t = static_cast<std::size_t>(omp_get_thread_num());
-      const std::size_t nt = static_cast<std::size_t>(omp_get_num_threads());
-      const std::size_t k_end = nv * (t + 1) / nt;
-      double my_max_overlap = 0;
-      ContactBatch batch;
-      std::uint32_t lane_pair[ContactBatch::kLanes];
-      for (std::size_t i = nv * t / nt; i < k_end;) {
-        const int m = indexed ? fill_batch<true>(i, k_end, batch, lane_pair)
-                              : fill_batch<false>(i, k_end, batch, lane_pair);
-        run_law(batch, m, dt);
-        for (int j = 0; j < m; ++j) {
-          const std::uint32_t kk = lane_pair[j];
-          ContactLoads& L = loads_[kk];
-          if (!finish_pair(kk, batch, j, L, my_max_overlap)) continue;
-          dissipation_[2 * kk] = L.friction_dissipation;
-          dissipation_[2 * kk + 1] = L.rolling_dissipation;
-        }
+      std::size_t begin = split_pair_[t], end = split_pair_[t + 1];
+      if (indexed) {  // (the positions in visit_ of the share's pairs)
+        begin = static_cast<std::size_t>(
+            std::lower_bound(visit_.begin(), visit_.end(), static_cast<std::uint32_t>(begin)) -
+            visit_.begin());
+        end = static_cast<std::size_t>(
+            std::lower_bound(visit_.begin(), visit_.end(), static_cast<std::uint32_t>(end)) -
+            visit_.begin());
       }
+      double my_max_overlap = 0;
+      if (indexed)
+        contact_pass<true>(begin, end, my_max_overlap);
+      else
+        contact_pass<false>(begin, end, my_max_overlap);
 #pragma omp critical(gs_max_overlap)
       max_overlap_ratio = std::max(max_overlap_ratio, my_max_overlap);
 #pragma omp barrier
 
-      // Loads gathered per particle in pair order (the pairs of each particle are listed in
-      // that order), so the sums are the same for any number of threads.
+      // The mixed particles' loads gathered in pair order (the pairs of each particle are
+      // listed in that order).
+      const std::size_t nm = split_mixed_list_.size();
 #pragma omp for schedule(static)
-      for (std::size_t i = 0; i < n; ++i) {
-        V3 f(p_.external_force[i]), t;
+      for (std::size_t m = 0; m < nm; ++m) {
+        const std::uint32_t i = split_mixed_list_[m];
+        V3 f(p_.external_force[i]), tq;
         double fr = 0, ro = 0;  // dissipation of the pairs whose body 1 this particle is
         for (std::uint32_t e = pair_start_[i]; e < pair_start_[i + 1]; ++e) {
           const std::uint32_t k = pair_of_[e] >> 1;
@@ -1157,16 +1306,16 @@ void Simulation::step() {
           const bool first = (pair_of_[e] & 1u) == 0 && nl_.pairs[k].second < kWallBase;
           if (first) {  // body 1 of a sphere pair
             f += L.force1;
-            t += L.arm1;
-            t += -L.moment;
+            tq += L.arm1;
+            tq += -L.moment;
           } else {  // body 2: the second sphere, or the sphere of a wall pair
             f += -L.force1;
-            t += L.arm2;
-            t += L.moment;
+            tq += L.arm2;
+            tq += L.moment;
           }
         }
         f.store(p_.force[i]);
-        t.store(p_.torque[i]);
+        tq.store(p_.torque[i]);
         particle_dissipation_[2 * i] = fr;
         particle_dissipation_[2 * i + 1] = ro;
       }

@@ -296,6 +296,16 @@ class Simulation {
   /// blow-up limit.
   bool finish_pair(std::size_t k, const ContactBatch& batch, int j, ContactLoads& loads,
                    double& max_overlap_ratio);
+  /// One thread's share of the contact pass with several threads: positions [begin, end) of
+  /// the pairs (of visit_ with kIndexed), the law, and its loads summed straight onto the
+  /// share's particles in pair order, as one thread sums them; the pairs of a particle marked
+  /// in split_mixed_ keep their loads in loads_ for its gather instead.
+  template <bool kIndexed>
+  void contact_pass(std::size_t begin, std::size_t end, double& max_overlap_ratio);
+  /// Shares of the pairs for nt threads: particle ranges [split_first_[t], split_first_[t+1])
+  /// with all their pairs as body 1, balanced by pairs; a particle is mixed when a pair of
+  /// another share loads it (it is then gathered after the pass).
+  void split_pairs(std::size_t nt);
   void update_servos();
   const PeriodicCell* cell_ptr() const { return periodic_ ? &cell_ : nullptr; }
   /// Clump loads from their members, the clumps' integration, and the members moved rigidly;
@@ -398,6 +408,13 @@ class Simulation {
   // Pairs of each particle, in pair order (CSR), and the wall pairs: loads are gathered per
   // particle in parallel with the sums in the order of a serial pass over the pairs.
   std::vector<std::uint32_t> pair_start_, pair_of_, wall_pairs_;
+  // Threads' shares of the contact pass (split_pairs), for pairs_version_ and split_threads_.
+  std::uint64_t pairs_version_ = 0, split_version_ = ~std::uint64_t{0};
+  std::size_t split_threads_ = 0;
+  std::vector<std::uint32_t> split_first_;  // particle ranges, nt + 1 bounds
+  std::vector<std::size_t> split_pair_;     // their first pairs, nt + 1 bounds
+  std::vector<std::uint8_t> split_mixed_;   // per particle: loaded by another share's pairs
+  std::vector<std::uint32_t> split_mixed_list_;
   std::int64_t step_ = 0;
   double time_ = 0;
   std::int64_t wall_id_base_ = 0;
