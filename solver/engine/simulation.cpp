@@ -541,66 +541,68 @@ void Simulation::attach_histories(const std::vector<ContactHistory>& old,
   std::exception_ptr error;  // (the first thread's error, rethrown after the region)
 #pragma omp parallel num_threads(threads)
   try {
-  const auto nt = static_cast<std::size_t>(omp_get_num_threads());
-  const auto t = static_cast<std::size_t>(omp_get_thread_num());
-  const std::size_t k0 = np * t / nt, k1 = np * (t + 1) / nt;
-  auto before = [](const ContactHistory& h, const std::pair<std::uint32_t, std::uint32_t>& pr) {
-    return std::make_pair(h.a, h.b) < pr;
-  };
-  std::size_t o = k0 < np ? static_cast<std::size_t>(
-                                std::lower_bound(old.begin(), old.end(), nl_.pairs[k0], before) -
-                                old.begin())
-                          : old.size();
-  for (std::size_t k = k0; k < k1; ++k) {
-    const auto pr = nl_.pairs[k];
-    while (o < old.size() && std::make_pair(old[o].a, old[o].b) < pr) ++o;
-    const bool kept = o < old.size() && old[o].a == pr.first && old[o].b == pr.second;
-    if (kept) hist_[k] = old[o];
-    hist_[k].a = pr.first;
-    hist_[k].b = pr.second;
-    const WallSpec* ws = pr.second >= kWallBase ? &walls_[pr.second - kWallBase].spec : nullptr;
-    if (kept && reuse) {
-      params_[k] = (*old_params)[o];
-      if (cfg_.law == ContactLaw::HertzMindlin) continue;  // (set_friction_deg: linear law only)
-      params_[k].tan_friction =
-          ws && ws->friction_deg >= 0 ? std::tan(ws->friction_deg * M_PI / 180.0) : tan_material;
-      continue;
+    const auto nt = static_cast<std::size_t>(omp_get_num_threads());
+    const auto t = static_cast<std::size_t>(omp_get_thread_num());
+    const std::size_t k0 = np * t / nt, k1 = np * (t + 1) / nt;
+    auto before = [](const ContactHistory& h, const std::pair<std::uint32_t, std::uint32_t>& pr) {
+      return std::make_pair(h.a, h.b) < pr;
+    };
+    std::size_t o =
+        k0 < np ? static_cast<std::size_t>(
+                      std::lower_bound(old.begin(), old.end(), nl_.pairs[k0], before) - old.begin())
+                : old.size();
+    for (std::size_t k = k0; k < k1; ++k) {
+      const auto pr = nl_.pairs[k];
+      while (o < old.size() && std::make_pair(old[o].a, old[o].b) < pr) ++o;
+      const bool kept = o < old.size() && old[o].a == pr.first && old[o].b == pr.second;
+      if (kept) hist_[k] = old[o];
+      hist_[k].a = pr.first;
+      hist_[k].b = pr.second;
+      const WallSpec* ws = pr.second >= kWallBase ? &walls_[pr.second - kWallBase].spec : nullptr;
+      if (kept && reuse) {
+        params_[k] = (*old_params)[o];
+        if (cfg_.law == ContactLaw::HertzMindlin) continue;  // (set_friction_deg: linear law only)
+        params_[k].tan_friction =
+            ws && ws->friction_deg >= 0 ? std::tan(ws->friction_deg * M_PI / 180.0) : tan_material;
+        continue;
+      }
+      const double ra = p_.radius[pr.first];
+      const double rb = pr.second >= kWallBase ? ra : p_.radius[pr.second];
+      const bool facet2r = ws && ws->shape == WallShape::Facets && !ws->plane_radii;
+      if (cfg_.law == ContactLaw::HertzMindlin) {
+        // Walls flat (radius 1e5 m, YADE's hertzian facets) or YADE's default radii (a box R, a
+        // facet 2R); m* of the dynamic bodies; the pair's restitution and friction. (E*, G*, R*
+        // and m* are symmetric to the bit, so the order of the two bodies does not matter.)
+        const int ia = p_.material[pr.first], ib = ws ? ws->material : p_.material[pr.second];
+        const Material &A = material_at(ia), &B = material_at(ib);
+        const double r_wall = cfg_.hertz_flat_walls ? 1e5 : facet2r ? 2 * ra : ra;
+        const double ma = p_.fixed[pr.first] ? 0.0 : p_.mass[pr.first];
+        const double mb = ws || p_.fixed[pr.second] ? 0.0 : p_.mass[pr.second];
+        const std::size_t nm = 1 + cfg_.more_materials.size();
+        const std::size_t cell = static_cast<std::size_t>(ia) * nm + static_cast<std::size_t>(ib);
+        const double en =
+            cfg_.pair_restitution.empty() ? A.restitution : cfg_.pair_restitution[cell];
+        double phi = cfg_.pair_friction_deg.empty() ? -1 : cfg_.pair_friction_deg[cell];
+        if (phi < 0) phi = std::min(A.friction_deg, B.friction_deg);
+        params_[k] =
+            hertz_mindlin_params({A.young_ec, A.poisson}, {B.young_ec, B.poisson}, ra,
+                                 ws ? r_wall : rb, ma, mb, en, std::tan(phi * M_PI / 180.0));
+      } else if (facet2r) {  // YADE: the facet is 2R, first
+        params_[k] = contact_params(cfg_.material, 2 * ra, ra, cfg_.twist_beta, cfg_.twist_eta);
+      } else {
+        params_[k] = contact_params(cfg_.material, ra, rb, cfg_.twist_beta, cfg_.twist_eta);
+      }
+      if (disk_thickness_ > 0 && !ws &&
+          !(mat.normal_stiffness_N_m > 0)) {  // disks: a line contact of Ec per unit thickness
+        params_[k].kn = mat.young_ec * disk_thickness_;
+        params_[k].ks = mat.stiffness_ratio * params_[k].kn;
+        params_[k].kr = mat.rolling_beta * params_[k].ks * ra * rb;
+      }
+      if (pr.second >= kWallBase) {
+        const double wf = walls_[pr.second - kWallBase].spec.friction_deg;
+        if (wf >= 0) params_[k].tan_friction = std::tan(wf * M_PI / 180.0);
+      }
     }
-    const double ra = p_.radius[pr.first];
-    const double rb = pr.second >= kWallBase ? ra : p_.radius[pr.second];
-    const bool facet2r = ws && ws->shape == WallShape::Facets && !ws->plane_radii;
-    if (cfg_.law == ContactLaw::HertzMindlin) {
-      // Walls flat (radius 1e5 m, YADE's hertzian facets) or YADE's default radii (a box R, a
-      // facet 2R); m* of the dynamic bodies; the pair's restitution and friction. (E*, G*, R*
-      // and m* are symmetric to the bit, so the order of the two bodies does not matter.)
-      const int ia = p_.material[pr.first], ib = ws ? ws->material : p_.material[pr.second];
-      const Material &A = material_at(ia), &B = material_at(ib);
-      const double r_wall = cfg_.hertz_flat_walls ? 1e5 : facet2r ? 2 * ra : ra;
-      const double ma = p_.fixed[pr.first] ? 0.0 : p_.mass[pr.first];
-      const double mb = ws || p_.fixed[pr.second] ? 0.0 : p_.mass[pr.second];
-      const std::size_t nm = 1 + cfg_.more_materials.size();
-      const std::size_t cell = static_cast<std::size_t>(ia) * nm + static_cast<std::size_t>(ib);
-      const double en = cfg_.pair_restitution.empty() ? A.restitution : cfg_.pair_restitution[cell];
-      double phi = cfg_.pair_friction_deg.empty() ? -1 : cfg_.pair_friction_deg[cell];
-      if (phi < 0) phi = std::min(A.friction_deg, B.friction_deg);
-      params_[k] = hertz_mindlin_params({A.young_ec, A.poisson}, {B.young_ec, B.poisson}, ra,
-                                        ws ? r_wall : rb, ma, mb, en, std::tan(phi * M_PI / 180.0));
-    } else if (facet2r) {  // YADE: the facet is 2R, first
-      params_[k] = contact_params(cfg_.material, 2 * ra, ra, cfg_.twist_beta, cfg_.twist_eta);
-    } else {
-      params_[k] = contact_params(cfg_.material, ra, rb, cfg_.twist_beta, cfg_.twist_eta);
-    }
-    if (disk_thickness_ > 0 && !ws &&
-        !(mat.normal_stiffness_N_m > 0)) {  // disks: a line contact of Ec per unit thickness
-      params_[k].kn = mat.young_ec * disk_thickness_;
-      params_[k].ks = mat.stiffness_ratio * params_[k].kn;
-      params_[k].kr = mat.rolling_beta * params_[k].ks * ra * rb;
-    }
-    if (pr.second >= kWallBase) {
-      const double wf = walls_[pr.second - kWallBase].spec.friction_deg;
-      if (wf >= 0) params_[k].tan_friction = std::tan(wf * M_PI / 180.0);
-    }
-  }
   } catch (...) {
 #pragma omp critical(gs_attach_error)
     if (!error) error = std::current_exception();
