@@ -517,7 +517,7 @@ void Simulation::attach_histories(const std::vector<ContactHistory>& old,
   ++pairs_version_;
   with_room(hist_, np);
   with_room(params_, np);
-  hist_.assign(np, ContactHistory{});
+  hist_.resize(np);  // (every entry is set in the loop below, on the threads)
   params_.resize(np);
   if (facet_forces_) pair_facet_.assign(np, 0);
   // A pair that stays in the list keeps its stiffnesses and limits (contact_params of the same
@@ -555,7 +555,7 @@ void Simulation::attach_histories(const std::vector<ContactHistory>& old,
       const auto pr = nl_.pairs[k];
       while (o < old.size() && std::make_pair(old[o].a, old[o].b) < pr) ++o;
       const bool kept = o < old.size() && old[o].a == pr.first && old[o].b == pr.second;
-      if (kept) hist_[k] = old[o];
+      hist_[k] = kept ? old[o] : ContactHistory{};
       hist_[k].a = pr.first;
       hist_[k].b = pr.second;
       const WallSpec* ws = pr.second >= kWallBase ? &walls_[pr.second - kWallBase].spec : nullptr;
