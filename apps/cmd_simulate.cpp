@@ -45,7 +45,7 @@ using Results = solver::RunResults;
 /// line when a phase starts and at each 10 % of it.
 Results run(const Args& a, int sweep_point = -1,
             std::optional<solver::RunOptions::Parallel> parallel = {}) {
-  const solver::Scene scene = solver::load_scene(a.scene, sweep_point);
+  solver::Scene scene = solver::load_scene(a.scene, sweep_point);
   solver::RunOptions o;
   o.parallel = std::move(parallel);
   o.out = a.out;
@@ -87,7 +87,7 @@ Results run(const Args& a, int sweep_point = -1,
       return true;
     };
   }
-  const solver::RunOutcome r = solver::run_scene(scene, o);
+  const solver::RunOutcome r = solver::run_scene(std::move(scene), o);  // (its particles go)
   if (printed) std::fprintf(stderr, "\n");
   return r.results;
 }

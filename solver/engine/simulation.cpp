@@ -828,9 +828,7 @@ void Simulation::accumulate_walls() {
   }
   loaded_walls_.clear();
   // (the deferred pairs are not active: only the visited ones are looked at)
-  for (const std::uint32_t k : deferred_.empty() ? wall_pairs_ : visit_wall_) {
-    if (!active_[k]) continue;
-    const ContactLoads& L = loads_[k];
+  auto add = [&](std::uint32_t k, const ContactLoads& L) {
     WallState& w = walls_[nl_.pairs[k].second - kWallBase];
     if (w.contacts == 0) loaded_walls_.push_back(nl_.pairs[k].second - kWallBase);
     add_to(w.force, L.force1);
@@ -839,7 +837,14 @@ void Simulation::accumulate_walls() {
     ++w.contacts;
     add_to(w.torque, L.arm1);
     add_to(w.torque, -L.moment);
+  };
+  if (!wall_loads_.empty() || std::max(1, cfg_.threads) == 1) {
+    // One thread: the touching wall pairs' loads, kept in pair order by the pass.
+    for (const auto& [k, L] : wall_loads_) add(k, L);
+    return;
   }
+  for (const std::uint32_t k : deferred_.empty() ? wall_pairs_ : visit_wall_)
+    if (active_[k]) add(k, loads_[k]);
 }
 
 [[gnu::always_inline]] inline bool Simulation::prepare_pair(std::size_t k, ContactBatch& B, int j) {
@@ -1183,11 +1188,12 @@ void Simulation::step() {
   const bool indexed = !deferred_.empty();
   const std::size_t nv = indexed ? visit_.size() : np;
   const int threads = std::max(1, cfg_.threads);
-  with_room(loads_, np);
   with_room(active_, np);
-  loads_.resize(np);
   active_.assign(np, 0);
-  if (threads > 1) {  // (one thread keeps no dissipation per pair)
+  wall_loads_.clear();
+  if (threads > 1) {  // (one thread keeps no loads or dissipation per pair, only its walls')
+    with_room(loads_, np);
+    loads_.resize(np);
     with_room(dissipation_, 2 * np);
     dissipation_.resize(2 * np);
   }
@@ -1260,7 +1266,7 @@ void Simulation::step() {
             f_cur += -L.force1;
             t_cur += L.arm2;
             t_cur += L.moment;
-            loads_[kk] = L;  // for the wall's resultant
+            wall_loads_.push_back({kk, L});  // for the wall's resultant (in pair order)
           }
         }
       }

@@ -399,7 +399,8 @@ class Simulation {
   std::array<double, 7> params_material_{};
   RollingRadius params_rolling_radius_ = RollingRadius::Min;
   std::vector<int> params_walls_;
-  std::vector<ContactLoads> loads_;
+  std::vector<ContactLoads> loads_;                                 // per pair, with threads
+  std::vector<std::pair<std::uint32_t, ContactLoads>> wall_loads_;  // one thread: its walls'
   std::vector<std::uint8_t> active_;
   static constexpr std::size_t kChunk = 256, kSums = 5;
   std::vector<double> chunk_sums_;  // per chunk: friction, rolling, gravity, external, damping

@@ -347,6 +347,7 @@ RunOutcome run_scene(Scene scene, const RunOptions& a) {
          " s (YADE's PWaveTimeStep); the run may be unstable");
 
   Simulation sim(scene.config, scene.particles, scene.walls);
+  std::vector<Particle>().swap(scene.particles);  // (the engine holds them now: not twice)
   if (!scene.clumps.empty()) sim.set_clumps(scene.clumps);
   if (scene.outlet) sim.set_outlet(scene.outlet->first, scene.outlet->second);
   if (scene.cell) {
