@@ -537,21 +537,18 @@ struct TrajectoryWriter::Impl {
   /// frames convert in linear time), the commit marker /frames/end last.
   void append(const Frame* fr, std::size_t nf) {
     if (nf == 0) return;
+    write_particles_and_contacts(fr, nf);
+    write_rest(fr, nf);
+  }
+
+  /// The particle and contact rows of `nf` frames.
+  void write_particles_and_contacts(const Frame* fr, std::size_t nf) {
     const std::string n = name();
     const auto P = [](const Frame& f) -> const auto& {
       return f.particles;
     };
     const auto C = [](const Frame& f) -> const auto& {
       return f.contacts;
-    };
-    const auto W = [](const Frame& f) -> const auto& {
-      return f.walls;
-    };
-    const auto K = [](const Frame& f) -> const auto& {
-      return f.clumps;
-    };
-    const auto L = [](const Frame& f) -> const auto& {
-      return f.facet_loads;
     };
     auto wr = [&](int col, const auto& vec, std::size_t width) {
       ds[col].append(vec.data(), vec.size() / width, n);
@@ -602,7 +599,24 @@ struct TrajectoryWriter::Impl {
        3);
     wr(C_OVERLAP, gather_rows<double>(fr, nf, 1, C, [](const auto& r, auto* o) { *o = r.overlap; }),
        1);
+  }
 
+  /// The wall, clump and facet-load rows of `nf` frames, then their entries in the frame table
+  /// (whose row ends are the datasets' totals, so the particles and contacts go first).
+  void write_rest(const Frame* fr, std::size_t nf) {
+    const std::string n = name();
+    const auto W = [](const Frame& f) -> const auto& {
+      return f.walls;
+    };
+    const auto K = [](const Frame& f) -> const auto& {
+      return f.clumps;
+    };
+    const auto L = [](const Frame& f) -> const auto& {
+      return f.facet_loads;
+    };
+    auto wr = [&](int col, const auto& vec, std::size_t width) {
+      ds[col].append(vec.data(), vec.size() / width, n);
+    };
     wr(W_ID, gather_rows<std::int64_t>(fr, nf, 1, W, [](const auto& r, auto* o) { *o = r.id; }), 1);
     wr(W_KIND,
        gather_rows<std::int32_t>(
@@ -813,13 +827,17 @@ TrajectoryWriter::~TrajectoryWriter() {
 
 namespace {
 // What append() refuses before any row is written.
-void check_appendable(const Frame& frame, const std::string& name) {
-  validate_frame(frame, name);
+void check_template_names(const Frame& frame, const std::string& name) {
   for (const auto& k : frame.clumps)
     if (k.template_name.size() > kClumpTemplateBytes)
       throw InputError(
           name, "clump template name longer than " + std::to_string(kClumpTemplateBytes) + " bytes",
           k.template_name);
+}
+
+void check_appendable(const Frame& frame, const std::string& name) {
+  validate_frame(frame, name);
+  check_template_names(frame, name);
 }
 }  // namespace
 
@@ -833,6 +851,33 @@ void TrajectoryWriter::append(const std::vector<Frame>& frames) {
   constexpr std::size_t kBatch = 4096;  // frames per write: bounded memory, one flush per batch
   for (std::size_t b = 0; b < frames.size(); b += kBatch)
     impl_->append(frames.data() + b, std::min(kBatch, frames.size() - b));
+}
+
+void TrajectoryWriter::append(const Frame& head, const FramePieces& pieces) {
+  // Every piece is checked before any is written (a frame that fails leaves the file as it
+  // was), so each piece is asked for twice.
+  const std::string file = impl_->final_path.string();
+  if (!head.particles.empty() || !head.contacts.empty())
+    throw std::invalid_argument("append in pieces: the head carries no particles or contacts");
+  FrameCheck check(head, file);
+  check_template_names(head, file);
+  Frame piece;
+  for (std::size_t i = 0;; ++i) {
+    piece.particles.clear();
+    piece.contacts.clear();
+    const bool more = pieces(i, piece);
+    check.add(piece);
+    if (!more) break;
+  }
+  check.finish(head);
+  for (std::size_t i = 0;; ++i) {
+    piece.particles.clear();
+    piece.contacts.clear();
+    const bool more = pieces(i, piece);
+    impl_->write_particles_and_contacts(&piece, 1);
+    if (!more) break;
+  }
+  impl_->write_rest(&head, 1);
 }
 
 std::size_t TrajectoryWriter::frames_written() const {

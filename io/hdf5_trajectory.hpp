@@ -7,6 +7,7 @@
 
 #include <cstddef>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <string>
 
@@ -48,6 +49,14 @@ class TrajectoryWriter {
   /// Appends frames in batches (each dataset written once per batch, one flush per batch): the
   /// way to write a whole trajectory in time linear in its length.
   void append(const std::vector<Frame>& frames);
+  /// Fills `piece` (its particles and contacts, empty on entry) with piece `i` of a frame;
+  /// false when `i` is the last piece.
+  using FramePieces = std::function<bool(std::size_t i, Frame& piece)>;
+  /// Appends one frame given in pieces, so that a large one is never held whole: `head` has
+  /// all but the particles and contacts (it has none), `pieces` gives them in order. Each
+  /// piece is asked for twice and must come out the same: all are checked before any is
+  /// written.
+  void append(const Frame& head, const FramePieces& pieces);
   std::size_t frames_written() const;
   /// Closes the file and renames `<path>.partial` to `<path>`.
   void finish();

@@ -6,6 +6,7 @@
 #include <Eigen/Geometry>
 #include <cstdint>
 #include <string>
+#include <unordered_map>
 #include <utility>
 #include <vector>
 
@@ -128,6 +129,22 @@ std::pair<Eigen::Vector3d, Eigen::Vector3d> particle_bounds(const Frame& frame);
 /// bodies a non-unit orientation, mass <= 0, negative principal inertia, duplicate ids, a member
 /// naming a missing clump, or a clump without members.
 void validate_frame(const Frame& frame, const std::string& source);
+
+/// validate_frame for a frame given in pieces, never held whole: the head (all but its
+/// particles and contacts) when constructed, each piece's particles and contacts with add(),
+/// then finish(head) (particle ids unique over the pieces, every clump body with a member).
+/// The same checks and messages; a duplicate id is reported as the smallest one.
+class FrameCheck {
+ public:
+  FrameCheck(const Frame& head, std::string source);
+  void add(const Frame& piece);
+  void finish(const Frame& head);
+
+ private:
+  std::string source_;
+  std::vector<std::int64_t> ids_;
+  std::unordered_map<std::int64_t, std::size_t> members_;
+};
 
 /// The project version string, e.g. "granoscope 0.1.0".
 std::string code_version();

@@ -384,11 +384,8 @@ Eigen::Vector3d Simulation::cell_stiffness() const {
 
 void Simulation::rebuild_neighbors() {
   if (domain_) return domain_->rebuild(*this);  // (it calls rebuild_local)
-  // The old histories and parameters are swapped out (their buffers are reused).
-  old_hist_.swap(hist_);
-  old_params_.swap(params_);
   nl_.build(p_, walls_, cell_ptr(), planar_);
-  attach_histories(old_hist_, &old_params_);
+  attach_histories();  // (the old histories and parameters move in place)
   classify_walls();
 }
 
@@ -416,8 +413,6 @@ void Simulation::set_roles(std::vector<std::uint8_t> roles) {
 }
 
 void Simulation::rebuild_local(const std::vector<ContactHistory>& received, bool keep_reference) {
-  old_hist_.swap(hist_);
-  old_params_.swap(params_);
   const bool keep = keep_reference && nl_.ref_pos.size() == p_.size();
   if (keep) {
     kept_ref_pos_.swap(nl_.ref_pos);
@@ -447,7 +442,7 @@ void Simulation::rebuild_local(const std::vector<ContactHistory>& received, bool
     nl_.pairs.resize(kept);
     if (periods) nl_.cell_dist.resize(kept);
   }
-  attach_histories(old_hist_, &old_params_);
+  attach_histories();
   for (const ContactHistory& h : received) {
     const auto key = std::make_pair(h.a, h.b);
     const auto at = std::lower_bound(nl_.pairs.begin(), nl_.pairs.end(), key);
@@ -509,24 +504,22 @@ void Simulation::set_wall_velocity(std::size_t w, const Eigen::Vector3d& velocit
   if (at == moving_walls_.end() || *at != i) moving_walls_.insert(at, i);
 }
 
-void Simulation::attach_histories(const std::vector<ContactHistory>& old,
-                                  const std::vector<ContactParams>* old_params) {
-  // `old` is sorted by (a, b), as the pair list is. A contact whose pair left the list cannot be
-  // touching (the skin guarantees it), so dropping it loses nothing.
+void Simulation::attach_histories(const std::vector<ContactHistory>* from) {
+  // The old histories (hist_, or `from`) are sorted by (a, b), as the pair list is. A contact
+  // whose pair left the list cannot be touching (the skin guarantees it), so dropping it loses
+  // nothing.
   const std::size_t np = nl_.pairs.size();
+  const std::vector<ContactHistory>& old = from ? *from : hist_;
+  const std::size_t m = old.size();
   ++pairs_version_;
-  with_room(hist_, np);
-  with_room(params_, np);
-  hist_.resize(np);  // (every entry is set in the loop below, on the threads)
-  params_.resize(np);
   if (facet_forces_) pair_facet_.assign(np, 0);
   // A pair that stays in the list keeps its stiffnesses and limits (contact_params of the same
   // radii and material, so the same values) when nothing they are computed from has changed;
   // the friction is set afresh (set_friction_deg changes it for sphere pairs only).
   const auto& mat = cfg_.material;
-  bool reuse = old_params && old_params->size() == old.size() && params_key_valid_ &&
-               params_radius_ == p_.radius && params_walls_.size() == walls_.size() &&
-               params_material_[0] == mat.young_ec && params_material_[1] == mat.stiffness_ratio &&
+  bool reuse = !from && params_.size() == m && params_key_valid_ && params_radius_ == p_.radius &&
+               params_walls_.size() == walls_.size() && params_material_[0] == mat.young_ec &&
+               params_material_[1] == mat.stiffness_ratio &&
                params_material_[2] == mat.rolling_beta && params_material_[3] == mat.rolling_eta &&
                params_material_[4] == cfg_.twist_beta && params_material_[5] == cfg_.twist_eta &&
                params_material_[6] == mat.normal_stiffness_N_m &&
@@ -535,12 +528,20 @@ void Simulation::attach_histories(const std::vector<ContactHistory>& old,
     reuse = params_walls_[w] == (static_cast<int>(walls_[w].spec.shape) << 1 |
                                  static_cast<int>(walls_[w].spec.plane_radii));
   const double tan_material = std::tan(mat.friction_deg * M_PI / 180.0);
-  // Each pair on its own (threads take shares of the list, each starting its walk through the
-  // old list where its first pair would be).
+  // Threads take shares of the new list past 20 000 pairs.
   const int threads = np >= 20000 ? std::max(1, cfg_.threads) : 1;
-  std::exception_ptr error;  // (the first thread's error, rethrown after the region)
+  constexpr std::uint32_t kNew = std::numeric_limits<std::uint32_t>::max();
+  std::exception_ptr error;  // (the first thread's error, rethrown after each region)
+  auto keep_error = [&error] {
+#pragma omp critical(gs_attach_error)
+    if (!error) error = std::current_exception();
+  };
+  // 1. Each new pair's old index (kNew: a new pair), each share walking the old list from a
+  //    binary search for its first pair. The map is increasing.
+  with_room(attach_from_, np);
+  attach_from_.resize(np);
 #pragma omp parallel num_threads(threads)
-  try {
+  {
     const auto nt = static_cast<std::size_t>(omp_get_num_threads());
     const auto t = static_cast<std::size_t>(omp_get_thread_num());
     const std::size_t k0 = np * t / nt, k1 = np * (t + 1) / nt;
@@ -550,17 +551,95 @@ void Simulation::attach_histories(const std::vector<ContactHistory>& old,
     std::size_t o =
         k0 < np ? static_cast<std::size_t>(
                       std::lower_bound(old.begin(), old.end(), nl_.pairs[k0], before) - old.begin())
-                : old.size();
+                : m;
     for (std::size_t k = k0; k < k1; ++k) {
       const auto pr = nl_.pairs[k];
-      while (o < old.size() && std::make_pair(old[o].a, old[o].b) < pr) ++o;
-      const bool kept = o < old.size() && old[o].a == pr.first && old[o].b == pr.second;
-      hist_[k] = kept ? old[o] : ContactHistory{};
+      while (o < m && std::make_pair(old[o].a, old[o].b) < pr) ++o;
+      attach_from_[k] =
+          o < m && old[o].a == pr.first && old[o].b == pr.second ? static_cast<std::uint32_t>(o)
+                                                                 : kNew;
+    }
+  }
+  // 2. In place, the kept histories (and parameters) move to their new indices; no second copy
+  //    of them is held. Each share [k0, k1) of the new list first saves the entries it takes
+  //    from outside itself (another share's, or past the new end); after a barrier it moves
+  //    those it takes from inside itself: to higher indices from the top down, then to lower
+  //    ones from the bottom up, so that (the map being increasing) no entry is overwritten
+  //    before it has moved; then it writes the saved ones.
+  if (from) {
+    with_room(hist_, np);
+    hist_.resize(np);  // (every entry is set below, on the threads)
+    with_room(params_, np);
+    params_.resize(np);
+  } else {
+    const std::size_t span = std::max(m, np);
+    with_room(hist_, span);
+    hist_.resize(span);
+    with_room(params_, span);
+    params_.resize(span);
+#pragma omp parallel num_threads(threads)
+    {
+      const auto nt = static_cast<std::size_t>(omp_get_num_threads());
+      const auto t = static_cast<std::size_t>(omp_get_thread_num());
+      const std::size_t k0 = np * t / nt, k1 = np * (t + 1) / nt;
+      const auto inside = [k0, k1](std::size_t o) { return o >= k0 && o < k1; };
+      struct Saved {
+        std::uint32_t k;
+        ContactHistory h;
+        ContactParams q;
+      };
+      std::vector<Saved> saved;
+      try {
+        for (std::size_t k = k0; k < k1; ++k) {
+          const std::uint32_t o = attach_from_[k];
+          if (o != kNew && !inside(o))
+            saved.push_back({static_cast<std::uint32_t>(k), hist_[o], params_[o]});
+        }
+      } catch (...) {
+        keep_error();
+      }
+#pragma omp barrier
+      if (!error) {  // (every thread reaches the barrier, and none moves after an error)
+        for (std::size_t k = k1; k-- > k0;) {
+          const std::uint32_t o = attach_from_[k];
+          if (o == kNew || o >= k || !inside(o)) continue;
+          hist_[k] = hist_[o];
+          params_[k] = params_[o];
+        }
+        for (std::size_t k = k0; k < k1; ++k) {
+          const std::uint32_t o = attach_from_[k];
+          if (o == kNew || o <= k || !inside(o)) continue;
+          hist_[k] = hist_[o];
+          params_[k] = params_[o];
+        }
+        for (const Saved& e : saved) {
+          hist_[e.k] = e.h;
+          params_[e.k] = e.q;
+        }
+      }
+    }
+    if (error) std::rethrow_exception(error);
+    hist_.resize(np);
+    params_.resize(np);
+  }
+  // 3. Each pair's history and parameters.
+#pragma omp parallel num_threads(threads)
+  try {
+    const auto nt = static_cast<std::size_t>(omp_get_num_threads());
+    const auto t = static_cast<std::size_t>(omp_get_thread_num());
+    const std::size_t k0 = np * t / nt, k1 = np * (t + 1) / nt;
+    for (std::size_t k = k0; k < k1; ++k) {
+      const auto pr = nl_.pairs[k];
+      const std::uint32_t o = attach_from_[k];
+      const bool kept = o != kNew;
+      if (!kept)
+        hist_[k] = ContactHistory{};
+      else if (from)
+        hist_[k] = (*from)[o];
       hist_[k].a = pr.first;
       hist_[k].b = pr.second;
       const WallSpec* ws = pr.second >= kWallBase ? &walls_[pr.second - kWallBase].spec : nullptr;
       if (kept && reuse) {
-        params_[k] = (*old_params)[o];
         if (cfg_.law == ContactLaw::HertzMindlin) continue;  // (set_friction_deg: linear law only)
         params_[k].tan_friction =
             ws && ws->friction_deg >= 0 ? std::tan(ws->friction_deg * M_PI / 180.0) : tan_material;
@@ -604,8 +683,7 @@ void Simulation::attach_histories(const std::vector<ContactHistory>& old,
       }
     }
   } catch (...) {
-#pragma omp critical(gs_attach_error)
-    if (!error) error = std::current_exception();
+    keep_error();
   }
   if (error) std::rethrow_exception(error);
   params_key_valid_ = true;
@@ -1698,31 +1776,44 @@ void Simulation::check_energy() {
 }
 
 Frame Simulation::frame() const {
-  Frame f;
-  f.time = time_;
-  f.step = step_;
-  f.dt = cfg_.dt;
-  const std::size_t n = p_.size();
-  f.particles.reserve(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    if (p_.removed[i]) continue;  // (left through the outlet)
-    auto& q = f.particles.emplace_back();
-    q.id = p_.id[i];
-    q.position = periodic_ ? cell_.wrap(p_.pos[i]) : p_.pos[i];
-    q.radius = p_.radius[i];
+  Frame f = frame_head();
+  Frame piece;
+  // (one piece: every particle and every pair)
+  frame_piece(0, std::max<std::size_t>({p_.size(), hist_.size(), 1}), piece);
+  f.particles = std::move(piece.particles);
+  f.contacts = std::move(piece.contacts);
+  return f;
+}
+
+bool Simulation::frame_piece(std::size_t i, std::size_t rows, Frame& piece) const {
+  if (rows == 0) throw std::invalid_argument("frame_piece: rows must be positive");
+  const std::size_t n = p_.size(), np = hist_.size();
+  const std::size_t i0 = std::min(n, i * rows), i1 = std::min(n, i0 + rows);
+  piece.particles.reserve(piece.particles.size() + (i1 - i0));
+  for (std::size_t j = i0; j < i1; ++j) {
+    if (p_.removed[j]) continue;  // (left through the outlet)
+    auto& q = piece.particles.emplace_back();
+    q.id = p_.id[j];
+    q.position = periodic_ ? cell_.wrap(p_.pos[j]) : p_.pos[j];
+    q.radius = p_.radius[j];
     // In a cell the velocity carries the mean flow L·x at the unwrapped position; the image in
     // the cell moves with v − L·(x − x_wrapped) (YADE's image shift velocity), so that the
     // frame's velocities are a field over its wrapped positions.
-    q.velocity = periodic_ ? Eigen::Vector3d(p_.vel[i] - cell_.vel_grad * (p_.pos[i] - q.position))
-                           : p_.vel[i];
-    q.angular_velocity = p_.angvel[i];
-    q.orientation = p_.ori[i];
-    q.rotation = p_.rot[i];
-    q.mass = p_.mass[i];
-    q.material_id = p_.material[i];
-    q.clump_id = p_.clump[i] >= 0 ? clumps_[static_cast<std::size_t>(p_.clump[i])].id : -1;
+    q.velocity = periodic_ ? Eigen::Vector3d(p_.vel[j] - cell_.vel_grad * (p_.pos[j] - q.position))
+                           : p_.vel[j];
+    q.angular_velocity = p_.angvel[j];
+    q.orientation = p_.ori[j];
+    q.rotation = p_.rot[j];
+    q.mass = p_.mass[j];
+    q.material_id = p_.material[j];
+    q.clump_id = p_.clump[j] >= 0 ? clumps_[static_cast<std::size_t>(p_.clump[j])].id : -1;
   }
-  for (const auto& h : hist_) {
+  const std::size_t k0 = std::min(np, i * rows), k1 = std::min(np, k0 + rows);
+  std::size_t real = 0;
+  for (std::size_t k = k0; k < k1; ++k) real += hist_[k].real;
+  piece.contacts.reserve(piece.contacts.size() + real);
+  for (std::size_t k = k0; k < k1; ++k) {
+    const auto& h = hist_[k];
     if (!h.real) continue;
     Contact c;
     if (h.b >= kWallBase) {
@@ -1739,8 +1830,16 @@ Frame Simulation::frame() const {
     c.bending_moment = h.bending;
     c.twisting_moment = h.twist;
     c.overlap = h.overlap;
-    f.contacts.push_back(c);
+    piece.contacts.push_back(c);
   }
+  return i1 < n || k1 < np;
+}
+
+Frame Simulation::frame_head() const {
+  Frame f;
+  f.time = time_;
+  f.step = step_;
+  f.dt = cfg_.dt;
   for (std::size_t w = 0; w < walls_.size(); ++w) {
     const auto& ws = walls_[w];
     Wall wall;
@@ -1789,7 +1888,17 @@ Frame Simulation::frame() const {
     f.two_d = planar_;
     return f;
   }
-  const auto [lo, hi] = particle_bounds(f);
+  // The spheres' bounds (particle_bounds of the whole frame, without building it).
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+  Eigen::Vector3d hi = -lo;
+  bool any = false;
+  for (std::size_t i = 0; i < p_.size(); ++i) {
+    if (p_.removed[i]) continue;
+    any = true;
+    lo = lo.cwiseMin((p_.pos[i].array() - p_.radius[i]).matrix());
+    hi = hi.cwiseMax((p_.pos[i].array() + p_.radius[i]).matrix());
+  }
+  if (!any) lo = hi = Eigen::Vector3d::Zero();
   f.domain.lo = lo;
   f.domain.hi = hi;
   return f;
@@ -2060,7 +2169,7 @@ std::string Simulation::load_checkpoint(const std::filesystem::path& path) {
   if (!in) throw InputError(file, "truncated checkpoint");
   // Rebuild the neighbour list from the restored state and put the histories back.
   nl_.build(p_, walls_, cell_ptr(), planar_);
-  attach_histories(real);
+  attach_histories(&real);
   walls_dirty_ = true;
   return extra;
 }

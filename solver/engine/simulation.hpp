@@ -124,6 +124,11 @@ class Simulation {
 
   /// Snapshot of the current state: particles, real contacts, walls with their loads.
   Frame frame() const;
+  /// frame() in pieces, to write a large one without holding it whole: the head (all but the
+  /// particles and contacts), and piece i of them (the particles of [i·rows, (i+1)·rows) and
+  /// the contacts of those candidate pairs), appended to `piece`; false for the last piece.
+  Frame frame_head() const;
+  bool frame_piece(std::size_t i, std::size_t rows, Frame& piece) const;
   std::size_t contact_count() const;
   /// Real sphere–sphere contacts (wall contacts not counted).
   std::size_t sphere_contact_count() const;
@@ -264,10 +269,10 @@ class Simulation {
 
  private:
   void rebuild_neighbors();
-  /// Re-attaches contact histories (sorted by pair) to the current pair list.
-  /// With `old_params` (parallel to `old`), pairs kept keep their parameters.
-  void attach_histories(const std::vector<ContactHistory>& old,
-                        const std::vector<ContactParams>* old_params = nullptr);
+  /// Re-attaches contact histories (sorted by pair) to the current pair list: those of the
+  /// previous list, held in hist_ and params_ (moved in place; pairs kept keep their
+  /// parameters), or with `from`, those given (a checkpoint's).
+  void attach_histories(const std::vector<ContactHistory>* from = nullptr);
   /// Geometry and body motions of candidate pair k; false when the centres coincide.
   bool pair_geometry(std::size_t k, ContactGeometry& g, BodyMotion& m1, BodyMotion& m2,
                      std::uint32_t* facet = nullptr) const;
@@ -390,10 +395,9 @@ class Simulation {
   bool facet_forces_ = false;
   std::vector<std::uint32_t> pair_facet_;  // closest facet of each wall pair (facet forces on)
   std::vector<ContactParams> params_;
-  // Scratch of rebuild_neighbors (the previous list's histories and parameters), and what
-  // params_ were computed from (attach_histories reuses them only while these are unchanged).
-  std::vector<ContactHistory> old_hist_;
-  std::vector<ContactParams> old_params_;
+  // Scratch of attach_histories (each new pair's old index), and what params_ were computed
+  // from (attach_histories reuses them only while these are unchanged).
+  std::vector<std::uint32_t> attach_from_;
   bool params_key_valid_ = false;
   std::vector<double> params_radius_;
   std::array<double, 7> params_material_{};

@@ -424,9 +424,13 @@ RunOutcome run_scene(Scene scene, const RunOptions& a) {
   };
   auto write_frame_now = [&] {
     if (!writer) writer.emplace(traj, meta, TrajectoryWriter::Options{.discard_unfinished = false});
-    Frame f = sim.frame();
-    if (!scene.output.contacts) f.contacts.clear();
-    writer->append(f);
+    // In pieces of 65 536 particles and candidate pairs: a frame of a million spheres and
+    // their contacts (about 500 MB as Particle and Contact rows) is never held whole.
+    writer->append(sim.frame_head(), [&](std::size_t i, Frame& piece) {
+      const bool more = sim.frame_piece(i, 65536, piece);
+      if (!scene.output.contacts) piece.contacts.clear();
+      return more;
+    });
     last_frame_step = sim.step_count();
   };
   auto write_frame = [&] { whole(write_frame_now); };

@@ -322,6 +322,69 @@ TEST(Hdf5Trajectory, WriterRejectsInvalidFrames) {
   EXPECT_EQ(w.frames_written(), 0u);
 }
 
+// A frame given in pieces (the solver's way to write a large frame without holding it whole)
+// is the frame written whole, row for row; a bad piece is refused with the message the whole
+// frame gets, and nothing of it is written.
+TEST(Hdf5Trajectory, FrameInPiecesIsTheFrameWrittenWhole) {
+  ScratchDir dir("h5pieces");
+  const Frame whole = with_clump_bodies(random_frame(61, 40, 3, 1.0), 3);
+  Frame head = whole;
+  head.particles.clear();
+  head.contacts.clear();
+  // Pieces of 7 particles and 3 contacts (the particles run out first), and one empty piece.
+  auto pieces_of = [](const Frame& f) {
+    return [&f](std::size_t i, Frame& piece) {
+      const std::size_t n = f.particles.size(), c = f.contacts.size();
+      if (i == 2) return true;  // (an empty piece)
+      const std::size_t j = i > 2 ? i - 1 : i;
+      for (std::size_t k = 7 * j; k < std::min(n, 7 * j + 7); ++k)
+        piece.particles.push_back(f.particles[k]);
+      for (std::size_t k = 3 * j; k < std::min(c, 3 * j + 3); ++k)
+        piece.contacts.push_back(f.contacts[k]);
+      return 7 * j + 7 < n || 3 * j + 3 < c;
+    };
+  };
+  {
+    TrajectoryWriter w(dir / "p.h5", meta());
+    w.append(random_frame(5, 2, 1));
+    w.append(head, pieces_of(whole));
+    w.append(random_frame(6, 0, 2));
+    w.finish();
+  }
+  const Trajectory r = read_hdf5_trajectory(dir / "p.h5");
+  ASSERT_EQ(r.frames.size(), 3u);
+  gs::test::expect_same_frame(whole, r.frames[1]);
+  gs::test::expect_same_frame(random_frame(6, 0, 2), r.frames[2]);
+
+  TrajectoryWriter w(dir / "q.h5", meta());
+  Frame bad = whole;
+  bad.particles[50].radius = 0;  // (in a later piece)
+  std::string message = error_of([&] { TrajectoryWriter(dir / "r.h5", meta()).append(bad); });
+  message.replace(message.find("r.h5"), 4, "q.h5");
+  EXPECT_EQ(error_of([&] { w.append(head, pieces_of(bad)); }), message);
+  EXPECT_NE(message.find("radius is not positive"), std::string::npos) << message;
+  bad = whole;
+  bad.particles[60].id = bad.particles[1].id;  // a duplicate across pieces
+  EXPECT_EQ(error_of([&] { w.append(head, pieces_of(bad)); }),
+            (dir / "q.h5").string() + ": duplicate particle id (" +
+                std::to_string(bad.particles[1].id) + ")");
+  bad = whole;
+  bad.contacts[39].normal *= 2;
+  EXPECT_NE(error_of([&] { w.append(head, pieces_of(bad)); }), "no error");
+  Frame orphan = head;  // a body none of the pieces' particles belongs to
+  orphan.clumps.push_back(orphan.clumps[0]);
+  orphan.clumps.back().id = 1000;
+  EXPECT_EQ(error_of([&] { w.append(orphan, pieces_of(whole)); }),
+            (dir / "q.h5").string() + ": clump has no member particle (1000)");
+  EXPECT_THROW(w.append(whole, pieces_of(whole)), std::invalid_argument);  // (rows in the head)
+  EXPECT_EQ(w.frames_written(), 0u);
+  w.append(head, pieces_of(whole));
+  w.finish();
+  const Trajectory q = read_hdf5_trajectory(dir / "q.h5");
+  ASSERT_EQ(q.frames.size(), 1u);
+  gs::test::expect_same_frame(whole, q.frames[0]);
+}
+
 // Debian's python3-h5py reads our files as plain arrays.
 TEST(Hdf5Trajectory, ReadableByH5py) {
   ScratchDir dir("h5py");
