@@ -55,15 +55,15 @@ void check_header(const Frame& f, const std::string& source) {
 /// One particle's fields (not its id's uniqueness). The names of the fields are only built
 /// for a particle that fails.
 void check_particle(const Particle& p, const std::string& source) {
-  if (p.position.allFinite() && std::isfinite(p.radius) && p.radius > 0 &&
-      p.velocity.allFinite() && p.angular_velocity.allFinite() &&
-      p.orientation.coeffs().allFinite() && p.rotation.allFinite() && std::isfinite(p.mass) &&
-      p.mass >= 0)
+  if (p.position.allFinite() && std::isfinite(p.radius) && p.radius > 0 && p.velocity.allFinite() &&
+      p.angular_velocity.allFinite() && p.orientation.coeffs().allFinite() &&
+      p.rotation.allFinite() && std::isfinite(p.mass) && p.mass >= 0)
     return;
   const std::string pid = "particle " + std::to_string(p.id) + " ";
   check_finite(source, pid + "position", p.position);
   check_finite(source, pid + "radius", p.radius);
-  if (!(p.radius > 0)) throw InputError(source, pid + "radius is not positive", value_str(p.radius));
+  if (!(p.radius > 0))
+    throw InputError(source, pid + "radius is not positive", value_str(p.radius));
   check_finite(source, pid + "velocity", p.velocity);
   check_finite(source, pid + "angular velocity", p.angular_velocity);
   check_finite(source, pid + "orientation", p.orientation.coeffs());
@@ -74,9 +74,8 @@ void check_particle(const Particle& p, const std::string& source) {
 
 void check_contact(const Contact& c, const std::string& source) {
   if (c.point.allFinite() && c.normal.allFinite() && c.normal_force.allFinite() &&
-      c.shear_force.allFinite() && c.bending_moment.allFinite() &&
-      c.twisting_moment.allFinite() && std::isfinite(c.overlap) &&
-      std::abs(c.normal.norm() - 1.0) <= 1e-6)
+      c.shear_force.allFinite() && c.bending_moment.allFinite() && c.twisting_moment.allFinite() &&
+      std::isfinite(c.overlap) && std::abs(c.normal.norm() - 1.0) <= 1e-6)
     return;
   const std::string cid = "contact " + std::to_string(c.id1) + "-" + std::to_string(c.id2) + " ";
   check_finite(source, cid + "point", c.point);

@@ -538,8 +538,7 @@ void Simulation::attach_histories(const std::vector<ContactHistory>* from) {
   };
   // 1. Each new pair's old index (kNew: a new pair), each share walking the old list from a
   //    binary search for its first pair. The map is increasing.
-  with_room(attach_from_, np);
-  attach_from_.resize(np);
+  std::vector<std::uint32_t> attach_from(np);  // (4 B a pair, while attaching only)
 #pragma omp parallel num_threads(threads)
   {
     const auto nt = static_cast<std::size_t>(omp_get_num_threads());
@@ -555,9 +554,9 @@ void Simulation::attach_histories(const std::vector<ContactHistory>* from) {
     for (std::size_t k = k0; k < k1; ++k) {
       const auto pr = nl_.pairs[k];
       while (o < m && std::make_pair(old[o].a, old[o].b) < pr) ++o;
-      attach_from_[k] =
-          o < m && old[o].a == pr.first && old[o].b == pr.second ? static_cast<std::uint32_t>(o)
-                                                                 : kNew;
+      attach_from[k] = o < m && old[o].a == pr.first && old[o].b == pr.second
+                           ? static_cast<std::uint32_t>(o)
+                           : kNew;
     }
   }
   // 2. In place, the kept histories (and parameters) move to their new indices; no second copy
@@ -591,7 +590,7 @@ void Simulation::attach_histories(const std::vector<ContactHistory>* from) {
       std::vector<Saved> saved;
       try {
         for (std::size_t k = k0; k < k1; ++k) {
-          const std::uint32_t o = attach_from_[k];
+          const std::uint32_t o = attach_from[k];
           if (o != kNew && !inside(o))
             saved.push_back({static_cast<std::uint32_t>(k), hist_[o], params_[o]});
         }
@@ -601,13 +600,13 @@ void Simulation::attach_histories(const std::vector<ContactHistory>* from) {
 #pragma omp barrier
       if (!error) {  // (every thread reaches the barrier, and none moves after an error)
         for (std::size_t k = k1; k-- > k0;) {
-          const std::uint32_t o = attach_from_[k];
+          const std::uint32_t o = attach_from[k];
           if (o == kNew || o >= k || !inside(o)) continue;
           hist_[k] = hist_[o];
           params_[k] = params_[o];
         }
         for (std::size_t k = k0; k < k1; ++k) {
-          const std::uint32_t o = attach_from_[k];
+          const std::uint32_t o = attach_from[k];
           if (o == kNew || o <= k || !inside(o)) continue;
           hist_[k] = hist_[o];
           params_[k] = params_[o];
@@ -630,7 +629,7 @@ void Simulation::attach_histories(const std::vector<ContactHistory>* from) {
     const std::size_t k0 = np * t / nt, k1 = np * (t + 1) / nt;
     for (std::size_t k = k0; k < k1; ++k) {
       const auto pr = nl_.pairs[k];
-      const std::uint32_t o = attach_from_[k];
+      const std::uint32_t o = attach_from[k];
       const bool kept = o != kNew;
       if (!kept)
         hist_[k] = ContactHistory{};
@@ -704,9 +703,16 @@ void Simulation::attach_histories(const std::vector<ContactHistory>* from) {
   // distance. Until the positions have moved by more than it (NeighborList::moved), the pair
   // provably does not touch and the contact pass skips it: a wall of many small facets within
   // the skin of a sphere then costs what its contacts cost, not a geometry per facet and step.
-  with_room(facet_gap_, np);
-  facet_gap_.assign(np, -HUGE_VAL);
-  for (const std::uint32_t k : wall_pairs_) {
+  // (none without facet walls: 8 B a pair saved)
+  bool facets = false;
+  for (const auto& w : walls_) facets = facets || w.spec.shape == WallShape::Facets;
+  if (facets) {
+    with_room(facet_gap_, np);
+    facet_gap_.assign(np, -HUGE_VAL);
+  } else {
+    std::vector<double>().swap(facet_gap_);
+  }
+  for (const std::uint32_t k : facets ? wall_pairs_ : std::vector<std::uint32_t>{}) {
     const auto [a, b] = nl_.pairs[k];
     const WallState& w = walls_[b - kWallBase];
     if (w.spec.shape != WallShape::Facets) continue;
@@ -733,8 +739,9 @@ void Simulation::attach_histories(const std::vector<ContactHistory>* from) {
   admitted_prev_.clear();
   visit_valid_ = false;
   pass_pairs_.clear();
-  for (const std::uint32_t k : wall_pairs_)
-    if (facet_gap_[k] > 0) deferred_.push_back(k);
+  if (facets)
+    for (const std::uint32_t k : wall_pairs_)
+      if (facet_gap_[k] > 0) deferred_.push_back(k);
   if (!deferred_.empty()) {
     const auto by_gap = [&](std::uint32_t x, std::uint32_t y) {
       return facet_gap_[x] != facet_gap_[y] ? facet_gap_[x] < facet_gap_[y] : x < y;
@@ -1086,7 +1093,7 @@ int Simulation::fill_batch(std::size_t& i, std::size_t end, ContactBatch& batch,
         in_reach = !((p_.pos[b] - p_.pos[a]).squaredNorm() > reach * reach);
       }
     } else {
-      in_reach = !(facet_gap_[k] > nl_.moved) &&
+      in_reach = !(!facet_gap_.empty() && facet_gap_[k] > nl_.moved) &&
                  wall_may_touch(walls_[b - kWallBase], p_.pos[a], p_.radius[a]);
     }
     hist_[k].real = hist_[k].real & in_reach;

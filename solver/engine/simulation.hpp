@@ -395,9 +395,8 @@ class Simulation {
   bool facet_forces_ = false;
   std::vector<std::uint32_t> pair_facet_;  // closest facet of each wall pair (facet forces on)
   std::vector<ContactParams> params_;
-  // Scratch of attach_histories (each new pair's old index), and what params_ were computed
-  // from (attach_histories reuses them only while these are unchanged).
-  std::vector<std::uint32_t> attach_from_;
+  // What params_ were computed from (attach_histories reuses them only while these are
+  // unchanged).
   bool params_key_valid_ = false;
   std::vector<double> params_radius_;
   std::array<double, 7> params_material_{};

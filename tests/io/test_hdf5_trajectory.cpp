@@ -344,17 +344,18 @@ TEST(Hdf5Trajectory, FrameInPiecesIsTheFrameWrittenWhole) {
       return 7 * j + 7 < n || 3 * j + 3 < c;
     };
   };
+  const Frame after = random_frame(6, 0, 2);
   {
     TrajectoryWriter w(dir / "p.h5", meta());
     w.append(random_frame(5, 2, 1));
     w.append(head, pieces_of(whole));
-    w.append(random_frame(6, 0, 2));
+    w.append(after);
     w.finish();
   }
   const Trajectory r = read_hdf5_trajectory(dir / "p.h5");
   ASSERT_EQ(r.frames.size(), 3u);
   gs::test::expect_same_frame(whole, r.frames[1]);
-  gs::test::expect_same_frame(random_frame(6, 0, 2), r.frames[2]);
+  gs::test::expect_same_frame(after, r.frames[2]);
 
   TrajectoryWriter w(dir / "q.h5", meta());
   Frame bad = whole;

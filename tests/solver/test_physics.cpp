@@ -337,18 +337,23 @@ TEST(Physics, LargePackingGivesTheSameBitsOnAnyNumberOfThreads) {
 // bit, as a rebuild only adds or drops pairs that do not touch. On 1, 2 and 3 threads, where
 // the moves cross the threads' shares of the list.
 TEST(Physics, ExtraRebuildsCarryEveryHistoryInPlace) {
-  auto ps = random_packing(8000, 3);
+  // Fast spheres and a thin skin (20 µm, the spheres move 10–40 µm a leg): every rebuild finds
+  // pairs to add and drop, so the kept ones move both ways along the list.
+  auto ps = random_packing(12000, 3);
+  for (auto& p : ps) p.velocity *= 40;
   std::mt19937 rng(9);
-  std::shuffle(ps.begin() + 2000, ps.begin() + 5000, rng);
+  std::shuffle(ps.begin() + 3000, ps.begin() + 7000, rng);
   for (const int threads : {1, 2, 3}) {
-    Simulation plain(packing_config(threads), ps, box_walls());
-    plain.run(150);
-    Simulation rebuilt(packing_config(threads), ps, box_walls());
+    SimulationConfig config = packing_config(threads);
+    config.skin = 2e-5;
+    Simulation plain(config, ps, box_walls());
+    plain.run(300);
+    Simulation rebuilt(config, ps, box_walls());
     for (int leg = 0; leg < 5; ++leg) {
-      rebuilt.run(30);
+      rebuilt.run(60);
       rebuilt.invalidate_neighbors();
     }
-    ASSERT_GT(plain.contact_count(), 8000u);
+    ASSERT_GT(plain.contact_count(), 12000u);
     for (std::size_t i = 0; i < ps.size(); ++i) {
       ASSERT_EQ(plain.particles().pos[i], rebuilt.particles().pos[i]) << threads << " " << i;
       ASSERT_EQ(plain.particles().angvel[i], rebuilt.particles().angvel[i]) << threads << " " << i;
