@@ -929,7 +929,7 @@ void Simulation::accumulate_walls() {
     return;
   }
   for (const std::uint32_t k : deferred_.empty() ? wall_pairs_ : visit_wall_)
-    if (active_[k]) add(k, loads_[k]);
+    if (active_[k]) add(k, loads_[load_slot_[k]]);
 }
 
 [[gnu::always_inline]] inline bool Simulation::prepare_pair(std::size_t k, ContactBatch& B, int j) {
@@ -1176,9 +1176,10 @@ void Simulation::contact_pass(std::size_t begin, std::size_t end, double& max_ov
     particle_dissipation_[2 * cur + 1] = ro_cur;
   };
   auto keep_loads = [&](std::uint32_t k, const ContactLoads& L) {
-    loads_[k] = L;
-    dissipation_[2 * k] = L.friction_dissipation;
-    dissipation_[2 * k + 1] = L.rolling_dissipation;
+    const std::uint32_t r = load_slot_[k];
+    loads_[r] = L;
+    dissipation_[2 * r] = L.friction_dissipation;
+    dissipation_[2 * r + 1] = L.rolling_dissipation;
   };
   const double dt = cfg_.dt;
   for (std::size_t i = begin; i < end;) {
@@ -1255,6 +1256,20 @@ void Simulation::split_pairs(std::size_t nt) {
   split_mixed_list_.clear();
   for (std::size_t i = 0; i < n; ++i)
     if (split_mixed_[i]) split_mixed_list_.push_back(static_cast<std::uint32_t>(i));
+  // Rows for the loads kept per pair: those of a mixed particle's pairs (for its gather) and of
+  // the wall pairs (for the walls' resultants); 4 B a pair instead of 128.
+  with_room(load_slot_, np);
+  load_slot_.resize(np);
+  std::uint32_t rows = 0;
+  for (std::size_t k = 0; k < np; ++k) {
+    const auto [a, b] = nl_.pairs[k];
+    const bool kept = b >= kWallBase || split_mixed_[a] || split_mixed_[b];
+    load_slot_[k] = kept ? rows++ : std::numeric_limits<std::uint32_t>::max();
+  }
+  with_room(loads_, rows);
+  loads_.resize(rows);
+  with_room(dissipation_, 2 * std::size_t{rows});
+  dissipation_.resize(2 * std::size_t{rows});
   split_version_ = pairs_version_;
   split_threads_ = nt;
 }
@@ -1275,13 +1290,9 @@ void Simulation::step() {
   const int threads = std::max(1, cfg_.threads);
   with_room(active_, np);
   active_.assign(np, 0);
+  // (one thread keeps no loads per pair, only its walls'; threads keep the rows split_pairs
+  // gives)
   wall_loads_.clear();
-  if (threads > 1) {  // (one thread keeps no loads or dissipation per pair, only its walls')
-    with_room(loads_, np);
-    loads_.resize(np);
-    with_room(dissipation_, 2 * np);
-    dissipation_.resize(2 * np);
-  }
   const std::size_t n = p_.size();
   // Ledger terms summed per particle (a pair's dissipation goes to its body 1, in pair order),
   // then per chunk of kChunk particles, then over the chunks in order: the same sums for any
@@ -1393,10 +1404,11 @@ void Simulation::step() {
         for (std::uint32_t e = pair_start_[i]; e < pair_start_[i + 1]; ++e) {
           const std::uint32_t k = pair_of_[e] >> 1;
           if (!active_[k]) continue;
-          const ContactLoads& L = loads_[k];
+          const std::uint32_t r = load_slot_[k];
+          const ContactLoads& L = loads_[r];
           if ((pair_of_[e] & 1u) == 0) {
-            fr += dissipation_[2 * k];
-            ro += dissipation_[2 * k + 1];
+            fr += dissipation_[2 * r];
+            ro += dissipation_[2 * r + 1];
           }
           const bool first = (pair_of_[e] & 1u) == 0 && nl_.pairs[k].second < kWallBase;
           if (first) {  // body 1 of a sphere pair

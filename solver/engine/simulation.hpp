@@ -402,13 +402,16 @@ class Simulation {
   std::array<double, 7> params_material_{};
   RollingRadius params_rolling_radius_ = RollingRadius::Min;
   std::vector<int> params_walls_;
-  std::vector<ContactLoads> loads_;                                 // per pair, with threads
+  // With threads, the loads and dissipation of the pairs a mixed particle or a wall is in, at
+  // their row load_slot_[k] (split_pairs; the others' go straight onto their particles).
+  std::vector<ContactLoads> loads_;
+  std::vector<std::uint32_t> load_slot_;
   std::vector<std::pair<std::uint32_t, ContactLoads>> wall_loads_;  // one thread: its walls'
   std::vector<std::uint8_t> active_;
   static constexpr std::size_t kChunk = 256, kSums = 5;
   std::vector<double> chunk_sums_;  // per chunk: friction, rolling, gravity, external, damping
   std::vector<double> particle_dissipation_;  // friction and rolling of the step, per body 1
-  std::vector<double> dissipation_;  // friction and rolling dissipation of each pair this step
+  std::vector<double> dissipation_;           // friction and rolling dissipation, rows as loads_
   // Pairs of each particle, in pair order (CSR), and the wall pairs: loads are gathered per
   // particle in parallel with the sums in the order of a serial pass over the pairs.
   std::vector<std::uint32_t> pair_start_, pair_of_, wall_pairs_;
