@@ -19,14 +19,10 @@ std::string code_version() {
 }
 
 std::pair<Eigen::Vector3d, Eigen::Vector3d> particle_bounds(const Frame& frame) {
-  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
-  Eigen::Vector3d hi = -lo;
-  for (const auto& p : frame.particles) {
-    lo = lo.cwiseMin((p.position.array() - p.radius).matrix());
-    hi = hi.cwiseMax((p.position.array() + p.radius).matrix());
-  }
-  if (frame.particles.empty()) lo = hi = Eigen::Vector3d::Zero();
-  return {lo, hi};
+  const auto& ps = frame.particles;
+  return sphere_bounds(
+      ps.size(), [&](std::size_t i) -> const Eigen::Vector3d& { return ps[i].position; },
+      [&](std::size_t i) { return ps[i].radius; }, [](std::size_t) { return false; });
 }
 
 namespace {

@@ -4,7 +4,9 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <unordered_map>
 #include <utility>
@@ -123,6 +125,26 @@ struct Trajectory {
 
 /// Axis-aligned bounding box of the spheres (centres ± radius).
 std::pair<Eigen::Vector3d, Eigen::Vector3d> particle_bounds(const Frame& frame);
+
+/// The same box over spheres 0 … n−1 given by centre(i) and radius(i), leaving out those with
+/// skip(i) (zero when none is left): for spheres not held as a Frame (the solver's frame head).
+template <class Centre, class Radius, class Skip>
+std::pair<Eigen::Vector3d, Eigen::Vector3d> sphere_bounds(std::size_t n, Centre centre,
+                                                          Radius radius, Skip skip) {
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+  Eigen::Vector3d hi = -lo;
+  bool any = false;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (skip(i)) continue;
+    any = true;
+    const Eigen::Vector3d& x = centre(i);
+    const double r = radius(i);
+    lo = lo.cwiseMin((x.array() - r).matrix());
+    hi = hi.cwiseMax((x.array() + r).matrix());
+  }
+  if (!any) lo = hi = Eigen::Vector3d::Zero();
+  return {lo, hi};
+}
 
 /// Throws InputError naming `source` and the first invalid field: non-finite numbers, radius
 /// <= 0, negative mass, non-unit contact and plane-wall normals, duplicate particle ids; for clump

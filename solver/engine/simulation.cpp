@@ -574,8 +574,8 @@ void Simulation::attach_histories(const std::vector<ContactHistory>* from) {
     const std::size_t span = std::max(m, np);
     with_room(hist_, span);
     hist_.resize(span);
-    with_room(params_, span);
-    params_.resize(span);
+    with_room(params_, reuse ? span : np);  // (parameters not reused are computed afresh)
+    params_.resize(reuse ? span : np);
 #pragma omp parallel num_threads(threads)
     {
       const auto nt = static_cast<std::size_t>(omp_get_num_threads());
@@ -592,7 +592,8 @@ void Simulation::attach_histories(const std::vector<ContactHistory>* from) {
         for (std::size_t k = k0; k < k1; ++k) {
           const std::uint32_t o = attach_from[k];
           if (o != kNew && !inside(o))
-            saved.push_back({static_cast<std::uint32_t>(k), hist_[o], params_[o]});
+            saved.push_back(
+                {static_cast<std::uint32_t>(k), hist_[o], reuse ? params_[o] : ContactParams{}});
         }
       } catch (...) {
         keep_error();
@@ -603,17 +604,17 @@ void Simulation::attach_histories(const std::vector<ContactHistory>* from) {
           const std::uint32_t o = attach_from[k];
           if (o == kNew || o >= k || !inside(o)) continue;
           hist_[k] = hist_[o];
-          params_[k] = params_[o];
+          if (reuse) params_[k] = params_[o];
         }
         for (std::size_t k = k0; k < k1; ++k) {
           const std::uint32_t o = attach_from[k];
           if (o == kNew || o <= k || !inside(o)) continue;
           hist_[k] = hist_[o];
-          params_[k] = params_[o];
+          if (reuse) params_[k] = params_[o];
         }
         for (const Saved& e : saved) {
           hist_[e.k] = e.h;
-          params_[e.k] = e.q;
+          if (reuse) params_[e.k] = e.q;
         }
       }
     }
@@ -1908,16 +1909,10 @@ Frame Simulation::frame_head() const {
     return f;
   }
   // The spheres' bounds (particle_bounds of the whole frame, without building it).
-  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
-  Eigen::Vector3d hi = -lo;
-  bool any = false;
-  for (std::size_t i = 0; i < p_.size(); ++i) {
-    if (p_.removed[i]) continue;
-    any = true;
-    lo = lo.cwiseMin((p_.pos[i].array() - p_.radius[i]).matrix());
-    hi = hi.cwiseMax((p_.pos[i].array() + p_.radius[i]).matrix());
-  }
-  if (!any) lo = hi = Eigen::Vector3d::Zero();
+  const auto [lo, hi] = sphere_bounds(
+      p_.size(), [&](std::size_t i) -> const Eigen::Vector3d& { return p_.pos[i]; },
+      [&](std::size_t i) { return p_.radius[i]; },
+      [&](std::size_t i) { return p_.removed[i] != 0; });
   f.domain.lo = lo;
   f.domain.hi = hi;
   return f;
