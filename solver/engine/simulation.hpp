@@ -301,6 +301,10 @@ class Simulation {
   /// blow-up limit.
   bool finish_pair(std::size_t k, const ContactBatch& batch, int j, ContactLoads& loads,
                    double& max_overlap_ratio);
+  /// The contact pass on one thread: positions [0, nv) of the pairs (of visit_ when indexed),
+  /// the law, and its loads summed straight onto the particles in pair order; the wall pairs'
+  /// loads kept in wall_loads_.
+  void serial_pass(std::size_t nv, bool indexed, double& max_overlap_ratio);
   /// One thread's share of the contact pass with several threads: positions [begin, end) of
   /// the pairs (of visit_ with kIndexed), the law, and its loads summed straight onto the
   /// share's particles in pair order, as one thread sums them; the pairs of a particle marked
