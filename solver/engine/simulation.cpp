@@ -1152,9 +1152,7 @@ void Simulation::run_law(ContactBatch& batch, int count, double dt) const {
 // (Both passes without GCC's SLP vectoriser: it packed some of a pair's loads in pairs of two
 // and left the others scalar, loaded the lane's loads twice and spilled them; without it the
 // threads' pass ran 363 M instructions instead of 427 M on the 53k specimen, 21 steps.)
-void Simulation::serial_pass(std::size_t nv,
-                                                                        bool indexed,
-                                                                        double& max_overlap_out) {
+void Simulation::serial_pass(std::size_t nv, bool indexed, double& max_overlap_out) {
   double max_overlap_ratio = max_overlap_out;  // (a local: the loads' stores cannot alias it)
   const std::size_t n = p_.size();
   const double dt = cfg_.dt;
@@ -1304,14 +1302,52 @@ template <bool kIndexed>
   max_overlap_out = max_overlap_ratio;
 }
 
+bool Simulation::shares_unbalanced() const {
+  if (share_steps_ < kShareCheckSteps || share_seconds_.empty()) return false;
+  const auto [lo, hi] = std::minmax_element(share_seconds_.begin(), share_seconds_.end());
+  return *hi > kShareImbalance * *lo;
+}
+
+std::vector<double> balanced_cuts(std::size_t nt, const std::vector<std::size_t>& bounds,
+                                  const std::vector<double>& seconds) {
+  // The cost per pair is taken as constant within each old share (its seconds over its
+  // fraction of the list), and the cuts fall where the cumulative cost reaches t/nt of the total.
+  std::vector<double> cut(nt + 1);
+  for (std::size_t t = 0; t <= nt; ++t) cut[t] = static_cast<double>(t) / static_cast<double>(nt);
+  const std::size_t old_np = bounds.empty() ? 0 : bounds.back();
+  if (seconds.size() != nt || bounds.size() != nt + 1 || old_np == 0) return cut;
+  double total = 0;
+  for (const double s : seconds) {
+    if (!(s > 0 && s < HUGE_VAL)) return cut;
+    total += s;
+  }
+  auto frac = [&](std::size_t t) {
+    return static_cast<double>(bounds[t]) / static_cast<double>(old_np);
+  };
+  std::size_t seg = 0;
+  double below = 0;  // the cost of the old shares before seg
+  for (std::size_t t = 1; t < nt; ++t) {
+    const double target = total * static_cast<double>(t) / static_cast<double>(nt);
+    while (seg + 1 < nt && below + seconds[seg] < target) below += seconds[seg++];
+    const double w = frac(seg + 1) - frac(seg);
+    cut[t] = std::clamp(frac(seg) + w * (target - below) / seconds[seg], cut[t - 1], 1.0);
+  }
+  return cut;
+}
+
 void Simulation::split_pairs(std::size_t nt) {
   const std::size_t n = p_.size(), np = nl_.pairs.size();
+  // (equal counts of pairs until the shares of the last split have been timed; the shares'
+  // sizes change no result: every split gives the same bits)
+  const std::vector<double> cut =
+      share_steps_ > 0 ? balanced_cuts(nt, split_pair_, share_seconds_) : balanced_cuts(nt, {}, {});
   split_first_.assign(nt + 1, 0);
   split_pair_.assign(nt + 1, 0);
   for (std::size_t t = 1; t < nt; ++t) {
-    // The share starts at the body 1 of its first pair by count (all pairs of a particle as
+    // The share starts at the body 1 of its first pair by the cut (all pairs of a particle as
     // body 1 stay in one share).
-    const std::size_t k = np * t / nt;
+    const std::size_t k =
+        std::min(np, static_cast<std::size_t>(std::llround(cut[t] * static_cast<double>(np))));
     const std::uint32_t first = k < np ? nl_.pairs[k].first : static_cast<std::uint32_t>(n);
     split_first_[t] = std::max(first, split_first_[t - 1]);
     split_pair_[t] = static_cast<std::size_t>(
@@ -1346,6 +1382,8 @@ void Simulation::split_pairs(std::size_t nt) {
   dissipation_.resize(2 * std::size_t{rows});
   split_version_ = pairs_version_;
   split_threads_ = nt;
+  share_seconds_.assign(nt, 0.0);
+  share_steps_ = 0;
 }
 
 void Simulation::step() {
@@ -1391,7 +1429,11 @@ void Simulation::step() {
       // share's pairs (mixed) are gathered afterwards from loads_ in pair order. The sums are
       // the serial pass's for any number of threads.
 #pragma omp single
-      if (split_version_ != pairs_version_ || split_threads_ != nt) split_pairs(nt);
+      {
+        if (split_version_ != pairs_version_ || split_threads_ != nt || shares_unbalanced())
+          split_pairs(nt);
+        ++share_steps_;
+      }
       const std::size_t t = static_cast<std::size_t>(omp_get_thread_num());
       std::size_t begin = split_pair_[t], end = split_pair_[t + 1];
       if (indexed) {  // (the positions in visit_ of the share's pairs)
@@ -1403,10 +1445,12 @@ void Simulation::step() {
             visit_.begin());
       }
       double my_max_overlap = 0;
+      const double start = omp_get_wtime();
       if (indexed)
         contact_pass<true>(begin, end, my_max_overlap);
       else
         contact_pass<false>(begin, end, my_max_overlap);
+      share_seconds_[t] += omp_get_wtime() - start;  // (for the next split's balance)
 #pragma omp critical(gs_max_overlap)
       max_overlap_ratio = std::max(max_overlap_ratio, my_max_overlap);
 #pragma omp barrier
@@ -1446,8 +1490,8 @@ void Simulation::step() {
       }
     }
 
-#pragma omp single
-    {
+    // The walls' loads and work, the servos, the clumps' loads and the cell's field: one thread.
+    auto walls_and_fields = [&] {
       if (domain_) {
         zero_all_walls_ = true;  // (a wall loaded elsewhere has loads here after the sum)
         accumulate_walls();
@@ -1476,11 +1520,21 @@ void Simulation::step() {
         if (ws.spec.shape == WallShape::Facets) v += om.cross(ws.pos - ws.rot_center);
         ledger_.wall_work += -(ws.force.dot(v) + ws.torque.dot(om)) * dt;
       }
-    }  // (implicit barrier: servo velocities and the work terms use this step's loads)
+    };
+    // Without clumps, a periodic cell or processes the integration reads none of what that
+    // thread writes, so the others go on to integrate (nowait; the integration's chunks are
+    // then taken as the threads come, which changes no sum: they are kept per chunk).
+    if (clumps_.empty() && !periodic_ && !domain_) {
+#pragma omp single nowait
+      walls_and_fields();
+    } else {
+#pragma omp single
+      walls_and_fields();  // (implicit barrier: the integration uses the clumps' and cell's)
+    }
 
     // Integration, with the work of gravity and of applied loads over this step (velocities of
     // the step, before the update) and the damping dissipation, summed per fixed chunk.
-#pragma omp for schedule(static) reduction(&& : finite)
+#pragma omp for schedule(dynamic) reduction(&& : finite)
     for (std::size_t c = 0; c < chunks; ++c) {
       double fr = 0, ro = 0;
       const std::size_t begin = c * kChunk, end = std::min(n, (c + 1) * kChunk);

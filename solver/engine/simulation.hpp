@@ -96,6 +96,13 @@ double pwave_timestep(const std::vector<double>& radii, double density, double y
 /// period of a sphere on one spring over 2π; seed 003's dt = 1.02 µs is 0.58 of it at r = 0.3 mm).
 double material_timestep(const std::vector<double>& radii, const Material& m);
 
+/// Cuts of a list of pairs into nt shares of equal cost, as fractions of the list (nt + 1 of
+/// them, 0 … 1): equal counts, unless `seconds` holds the time each share of the last split took
+/// (its pairs [bounds[t], bounds[t+1])); then the cost per pair is taken as constant within
+/// each of those shares. The threads' contact pass is split so (Simulation::split_pairs).
+std::vector<double> balanced_cuts(std::size_t nt, const std::vector<std::size_t>& bounds,
+                                  const std::vector<double>& seconds);
+
 class Simulation {
  public:
   Simulation(SimulationConfig config, const std::vector<Particle>& particles,
@@ -312,9 +319,13 @@ class Simulation {
   template <bool kIndexed>
   void contact_pass(std::size_t begin, std::size_t end, double& max_overlap_ratio);
   /// Shares of the pairs for nt threads: particle ranges [split_first_[t], split_first_[t+1])
-  /// with all their pairs as body 1, balanced by pairs; a particle is mixed when a pair of
-  /// another share loads it (it is then gathered after the pass).
+  /// with all their pairs as body 1, balanced by the time each share took (by pairs before it
+  /// was timed); a particle is mixed when a pair of another share loads it (it is then gathered
+  /// after the pass). Made at each new pair list, and when the shares timed since the last
+  /// split differ by more than kShareImbalance.
   void split_pairs(std::size_t nt);
+  /// Whether the shares timed over kShareCheckSteps steps or more are out of balance.
+  bool shares_unbalanced() const;
   void update_servos();
   const PeriodicCell* cell_ptr() const { return periodic_ ? &cell_ : nullptr; }
   /// Clump loads from their members, the clumps' integration, and the members moved rigidly;
@@ -424,7 +435,11 @@ class Simulation {
   std::size_t split_threads_ = 0;
   std::vector<std::uint32_t> split_first_;  // particle ranges, nt + 1 bounds
   std::vector<std::size_t> split_pair_;     // their first pairs, nt + 1 bounds
-  std::vector<std::uint8_t> split_mixed_;   // per particle: loaded by another share's pairs
+  std::vector<double> share_seconds_;       // each share's pass time since the split
+  std::size_t share_steps_ = 0;             // steps since the split
+  static constexpr std::size_t kShareCheckSteps = 50;
+  static constexpr double kShareImbalance = 1.05;
+  std::vector<std::uint8_t> split_mixed_;  // per particle: loaded by another share's pairs
   std::vector<std::uint32_t> split_mixed_list_;
   std::int64_t step_ = 0;
   double time_ = 0;

@@ -297,6 +297,32 @@ TEST(Physics, OneAndTwoThreadsGiveIdenticalResults) {
   EXPECT_EQ(a.walls()[0].force, b.walls()[0].force);
 }
 
+// The threads' shares of the contact pass are cut by the time each share took, the cost per pair
+// taken as constant within an old share (hand-computed cuts).
+TEST(Physics, SharesAreCutWhereTheTimedCostIsEven) {
+  using gs::solver::balanced_cuts;
+  // Untimed, or a share not timed: equal counts of pairs.
+  EXPECT_EQ(balanced_cuts(2, {}, {}), (std::vector<double>{0.0, 0.5, 1.0}));
+  EXPECT_EQ(balanced_cuts(2, {0, 50, 100}, {0.0, 1.0}), (std::vector<double>{0.0, 0.5, 1.0}));
+  EXPECT_EQ(balanced_cuts(2, {0, 50, 100}, {1.0, NAN}), (std::vector<double>{0.0, 0.5, 1.0}));
+  // Two shares of 50 pairs, the second three times as slow: the cost is 1 on [0, 0.5) and 3 on
+  // [0.5, 1); half of the total 4 is reached at 0.5 + 0.5 · (1/3).
+  auto c = balanced_cuts(2, {0, 50, 100}, {1.0, 3.0});
+  ASSERT_EQ(c.size(), 3u);
+  EXPECT_DOUBLE_EQ(c[1], 0.5 + 0.5 / 3);
+  EXPECT_EQ(c[2], 1.0);
+  // Three uneven shares (pairs 0-20, 20-80, 80-100 of 100, taking 1, 1 and 4 s): thirds of the
+  // total 6 at cost 2 (the end of the second share, 0.8) and 4 (half-way into the third, 0.9).
+  c = balanced_cuts(3, {0, 20, 80, 100}, {1.0, 1.0, 4.0});
+  EXPECT_DOUBLE_EQ(c[1], 0.8);
+  EXPECT_DOUBLE_EQ(c[2], 0.9);
+  // An empty old share (no pairs) with its time does not make the cuts go backwards.
+  c = balanced_cuts(3, {0, 0, 50, 100}, {1.0, 1.0, 1.0});
+  EXPECT_LE(c[1], c[2]);
+  EXPECT_GE(c[1], 0.0);
+  EXPECT_LE(c[2], 1.0);
+}
+
 // Past 20 000 particles the neighbour search and the attaching of histories run on threads too,
 // and the contact pass gives each thread a share of the particles (those loaded from another
 // share gathered after it). Particles in shuffled order make many of those; a rebuild halfway
