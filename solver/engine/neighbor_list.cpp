@@ -14,6 +14,19 @@ bool NeighborList::stale(const ParticleState& p, const std::vector<WallState>& w
                          const PeriodicCell* cell,
                          const std::vector<std::uint32_t>* walls_to_check) const {
   if (ref_pos.size() != p.size() || wall_ref.size() != walls.size()) return true;
+  // The largest of d2(i) over the particles; on the build's threads past 20 000 particles (a
+  // maximum: the same for any split).
+  auto max_over = [&](auto&& d2) {
+    const std::size_t n = p.size();
+    double m = 0;
+    if (threads > 1 && n >= 20000) {
+#pragma omp parallel for num_threads(threads) schedule(static) reduction(max : m)
+      for (std::size_t i = 0; i < n; ++i) m = std::max(m, d2(i));
+    } else {
+      for (std::size_t i = 0; i < n; ++i) m = std::max(m, d2(i));
+    }
+    return m;
+  };
   if (cell) {
     // Branch vectors change by the particles' non-affine displacements and by M·(branch at the
     // build), M = ΔH·H_ref⁻¹ (|M|₂ ≤ |M|_F): a pair farther than r_a + r_b + skin at the
@@ -22,22 +35,19 @@ bool NeighborList::stale(const ParticleState& p, const std::vector<WallState>& w
     // (a domain's absent particles are not moved here: their affine part is not theirs)
     const std::uint8_t* out = absent && absent->size() == p.size() ? absent->data() : nullptr;
     if (cell->hsize == h_ref) {
-      double d2 = 0;
-      for (std::size_t i = 0; i < p.size(); ++i)
-        if (!out || !out[i]) d2 = std::max(d2, (p.pos[i] - ref_pos[i]).squaredNorm());
+      const double d2 = max_over([&](std::size_t i) {
+        return out && out[i] ? 0.0 : (p.pos[i] - ref_pos[i]).squaredNorm();
+      });
       return 2 * std::sqrt(d2) > skin;
     }
     const Eigen::Matrix3d m = (cell->hsize - h_ref) * h_ref.inverse();
-    double d2 = 0;
-    for (std::size_t i = 0; i < p.size(); ++i)
-      if (!out || !out[i])
-        d2 = std::max(d2, (p.pos[i] - ref_pos[i] - m * ref_pos[i]).squaredNorm());
+    const double d2 = max_over([&](std::size_t i) {
+      return out && out[i] ? 0.0 : (p.pos[i] - ref_pos[i] - m * ref_pos[i]).squaredNorm();
+    });
     return 2 * std::sqrt(d2) + m.norm() * (2 * max_radius + skin) > skin;
   }
-  double dmax2 = 0;
-  for (std::size_t i = 0; i < p.size(); ++i)
-    dmax2 = std::max(dmax2, (p.pos[i] - ref_pos[i]).squaredNorm());
-  const double dmax = std::sqrt(dmax2);
+  const double dmax =
+      std::sqrt(max_over([&](std::size_t i) { return (p.pos[i] - ref_pos[i]).squaredNorm(); }));
   moved = walls_moved = HUGE_VAL;  // (until known: a rebuild follows every early return)
   if (2 * dmax > skin) return true;
   double wmax = 0;
