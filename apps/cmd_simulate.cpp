@@ -260,9 +260,10 @@ void run_mpi(const Args& a) {
   MPI_Reduce(sent, total, 2, MPI_DOUBLE, MPI_SUM, 0, MPI_COMM_WORLD);
   if (root) {
     std::printf(
-        "mpirun: %d processes, slabs along %s%c; neighbour-list rebuilds %lld; sent by all "
+        "mpirun: %d processes, bricks %d x %d x %d%s; neighbour-list rebuilds %lld; sent by all "
         "processes: %.4g MB in halo exchanges (each step), %.4g MB at rebuilds\n",
-        domain.size(), domain.periodic() ? "the cell's base vector " : "", "xyz"[domain.axis()],
+        domain.size(), domain.grid()[0], domain.grid()[1], domain.grid()[2],
+        domain.periodic() ? " (along the cell's base vectors)" : "",
         static_cast<long long>(domain.rebuilds()), total[0] / 1e6, total[1] / 1e6);
   }
   if (!scratch.empty()) {

@@ -238,55 +238,92 @@ MpiDomain::MpiDomain(MPI_Comm comm) : comm_(comm) {
   check(MPI_Comm_size(comm_, &size_), "comm_size");
 }
 
-int MpiDomain::slab_of(double x) const {
-  return static_cast<int>(std::upper_bound(cuts_.begin(), cuts_.end(), x) - cuts_.begin());
+int MpiDomain::brick_of(const Eigen::Vector3d& c) const {
+  // Down the nested cuts: the slab along x, then the piece of it along y, then along z.
+  std::size_t node = 0;
+  for (int k = 0; k < 3; ++k) {
+    const std::vector<double>& cuts = cuts_[static_cast<std::size_t>(k)][node];
+    const auto i =
+        static_cast<std::size_t>(std::upper_bound(cuts.begin(), cuts.end(), c[k]) - cuts.begin());
+    node = node * static_cast<std::size_t>(grid_[static_cast<std::size_t>(k)]) + i;
+  }
+  return static_cast<int>(node);
 }
 
-bool MpiDomain::near_slab(double x, int r) const {
-  if (periodic_) {  // slabs of [0, 1), the first next to the last: x and its two images
-    const double lo = r == 0 ? 0.0 : cuts_[static_cast<std::size_t>(r - 1)];
-    const double hi = r == size_ - 1 ? 1.0 : cuts_[static_cast<std::size_t>(r)];
-    for (const double y : {x, x - 1, x + 1})
-      if (y > lo - reach_ && y < hi + reach_) return true;
-    return false;
+bool MpiDomain::near_brick(const Eigen::Vector3d& c, int r) const {
+  const Brick& box = bricks_[static_cast<std::size_t>(r)];
+  for (int k = 0; k < 3; ++k) {
+    if (grid_[static_cast<std::size_t>(k)] == 1) continue;  // (not cut along k)
+    const double lo = box.lo[k] - reach_[k], hi = box.hi[k] + reach_[k];
+    bool near = c[k] > lo && c[k] < hi;
+    // (in a cell the bricks are of [0, 1) along k, the first next to the last: the images too;
+    // the images along each axis shift independently, so the test is one per axis)
+    if (periodic_)
+      near = near || (c[k] - 1 > lo && c[k] - 1 < hi) || (c[k] + 1 > lo && c[k] + 1 < hi);
+    if (!near) return false;
   }
-  const double lo = r == 0 ? -HUGE_VAL : cuts_[static_cast<std::size_t>(r - 1)];
-  const double hi = r == size_ - 1 ? HUGE_VAL : cuts_[static_cast<std::size_t>(r)];
-  return x > lo - reach_ && x < hi + reach_;
+  return true;
 }
 
 std::vector<int> MpiDomain::owners_of(const Simulation& sim) const {
   const ParticleState& p = sim.particles();
   std::vector<int> owner(p.size());
-  for (std::size_t i = 0; i < p.size(); ++i) owner[i] = slab_of(coord(p.pos[i]));
+  for (std::size_t i = 0; i < p.size(); ++i) owner[i] = brick_of(coords(p.pos[i]));
   for (const ClumpBody& c : sim.clumps()) {
-    const int o = slab_of(coord(c.pos));
+    const int o = brick_of(coords(c.pos));
     for (const std::uint32_t m : c.members) owner[m] = o;
   }
   return owner;
 }
 
-double MpiDomain::coord(const Eigen::Vector3d& x) const {
-  if (!periodic_) return x[axis_];
-  const double s = inv_row_.dot(x.transpose());
-  return s - std::floor(s);
+Eigen::Vector3d MpiDomain::coords(const Eigen::Vector3d& x) const {
+  if (!periodic_) return x;
+  const Eigen::Vector3d s = inv_ * x;
+  return s - s.array().floor().matrix();
 }
 
 void MpiDomain::update_cell(const Simulation& sim) {
   if (!periodic_) {
-    reach_ = ghost_width_;
+    reach_ = Eigen::Vector3d::Constant(ghost_width_);
     return;
   }
   // The planes s_k = const are 1/|row k of H⁻¹| apart: a distance d is d·|row k| in s_k.
-  inv_row_ = sim.cell().hsize.inverse().row(axis_);
-  reach_ = ghost_width_ * inv_row_.norm();
+  inv_ = sim.cell().hsize.inverse();
+  for (int k = 0; k < 3; ++k) reach_[k] = ghost_width_ * inv_.row(k).norm();
+}
+
+std::array<int, 3> brick_grid(int processes, const Eigen::Vector3d& extent,
+                              const std::array<bool, 3>& cuttable) {
+  // The cut faces' area Σ_k (g_k − 1)·A_k, A_k the box's section across k, is what the ghost
+  // layers grow with; the smallest wins, ties to the larger counts on the earlier axes (so one
+  // slab cut goes along the longest side, the first of equal ones).
+  std::array<int, 3> best{1, 1, 1};
+  double best_area = HUGE_VAL;
+  const Eigen::Vector3d section(extent[1] * extent[2], extent[0] * extent[2],
+                                extent[0] * extent[1]);
+  for (int gx = processes; gx >= 1; --gx) {
+    if (processes % gx != 0 || (gx > 1 && !cuttable[0])) continue;
+    for (int gy = processes / gx; gy >= 1; --gy) {
+      if ((processes / gx) % gy != 0 || (gy > 1 && !cuttable[1])) continue;
+      const int gz = processes / gx / gy;
+      if (gz > 1 && !cuttable[2]) continue;
+      const double area = (gx - 1) * section[0] + (gy - 1) * section[1] + (gz - 1) * section[2];
+      if (area < best_area) {
+        best_area = area;
+        best = {gx, gy, gz};
+      }
+    }
+  }
+  return best;
 }
 
 void MpiDomain::attach(Simulation& sim) {
   const ParticleState& p = sim.particles();
   const std::size_t n = p.size();
-  // The slabs: along the longest side of the particles' box, cut at equal counts (midway
-  // between neighbouring centres). Every process computes the same from the same particles.
+  // The bricks: a grid of processes along the sides of the particles' box (in a cell: its base
+  // vectors that wrap, in the fractional coordinates), each side cut at equal counts (midway
+  // between neighbouring centres), nested: the slabs along x, each slab's particles along y,
+  // each piece's along z. Every process computes the same from the same particles.
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(HUGE_VAL), hi = -lo;
   double rmax = 0;
   for (std::size_t i = 0; i < n; ++i) {
@@ -294,31 +331,68 @@ void MpiDomain::attach(Simulation& sim) {
     hi = hi.cwiseMax(p.pos[i]);
     rmax = std::max(rmax, p.radius[i]);
   }
-  if (n > 0) (hi - lo).maxCoeff(&axis_);
   periodic_ = sim.periodic();
+  Eigen::Vector3d extent = n > 0 ? Eigen::Vector3d(hi - lo) : Eigen::Vector3d::Zero();
+  std::array<bool, 3> cuttable{true, true, true};
   if (periodic_) {
-    // A cell: along its widest base vector that wraps (the third of a planar cell does not).
-    const Eigen::Vector3d w = sim.cell().widths();
-    axis_ = w[1] > w[0] ? 1 : 0;
-    if (!sim.planar() && w[2] > w[axis_]) axis_ = 2;
+    extent = sim.cell().widths();
+    cuttable[2] = !sim.planar();  // (the third base vector of a planar cell does not wrap)
   }
   // A clump's members are owned with it (by the process of its centre of mass), so a member
-  // may lie up to the clump's extent outside its owner's slab: the ghost layer grows by it.
-  double extent = 0;
+  // may lie up to the clump's extent outside its owner's brick: the ghost layer grows by it.
+  double clump_extent = 0;
   for (const ClumpBody& c : sim.clumps())
-    for (const std::uint32_t m : c.members) extent = std::max(extent, (p.pos[m] - c.pos).norm());
-  ghost_width_ = (2 * rmax + sim.skin() + extent) * (1 + 1e-9);
+    for (const std::uint32_t m : c.members)
+      clump_extent = std::max(clump_extent, (p.pos[m] - c.pos).norm());
+  ghost_width_ = (2 * rmax + sim.skin() + clump_extent) * (1 + 1e-9);
+  // (the centres' box grown by a ghost layer: a flat packing still has sections to compare)
+  if (!periodic_) extent.array() += ghost_width_;
+  grid_ = brick_grid(size_, extent, cuttable);
   update_cell(sim);
-  std::vector<double> x(n);
-  for (std::size_t i = 0; i < n; ++i) x[i] = coord(p.pos[i]);
-  std::sort(x.begin(), x.end());
-  cuts_.clear();
-  for (int r = 1; r < size_; ++r) {
-    const std::size_t at = n * static_cast<std::size_t>(r) / static_cast<std::size_t>(size_);
-    cuts_.push_back(at == 0 ? -HUGE_VAL : at >= n ? HUGE_VAL : 0.5 * (x[at - 1] + x[at]));
+  std::vector<Eigen::Vector3d> c(n);
+  for (std::size_t i = 0; i < n; ++i) c[i] = coords(p.pos[i]);
+  std::vector<std::vector<std::uint32_t>> groups(1);
+  groups[0].resize(n);
+  for (std::size_t i = 0; i < n; ++i) groups[0][i] = static_cast<std::uint32_t>(i);
+  const double open_lo = periodic_ ? 0.0 : -HUGE_VAL, open_hi = periodic_ ? 1.0 : HUGE_VAL;
+  std::vector<Brick> boxes(
+      1, Brick{Eigen::Vector3d::Constant(open_lo), Eigen::Vector3d::Constant(open_hi)});
+  for (int k = 0; k < 3; ++k) {
+    const int g = grid_[static_cast<std::size_t>(k)];
+    auto& level = cuts_[static_cast<std::size_t>(k)];
+    level.assign(groups.size(), {});
+    std::vector<std::vector<std::uint32_t>> next;
+    std::vector<Brick> next_boxes;
+    for (std::size_t node = 0; node < groups.size(); ++node) {
+      std::vector<double> x;
+      x.reserve(groups[node].size());
+      for (const std::uint32_t i : groups[node]) x.push_back(c[i][k]);
+      std::sort(x.begin(), x.end());
+      const std::size_t m = x.size();
+      for (int r = 1; r < g; ++r) {
+        const std::size_t at = m * static_cast<std::size_t>(r) / static_cast<std::size_t>(g);
+        level[node].push_back(at == 0 ? -HUGE_VAL : at >= m ? HUGE_VAL : 0.5 * (x[at - 1] + x[at]));
+      }
+      const std::vector<double>& cuts = level[node];
+      for (int r = 0; r < g; ++r) {
+        Brick box = boxes[node];
+        if (r > 0) box.lo[k] = cuts[static_cast<std::size_t>(r - 1)];
+        if (r < g - 1) box.hi[k] = cuts[static_cast<std::size_t>(r)];
+        next_boxes.push_back(box);
+        next.emplace_back();
+      }
+      for (const std::uint32_t i : groups[node]) {
+        const auto r = static_cast<std::size_t>(
+            std::upper_bound(cuts.begin(), cuts.end(), c[i][k]) - cuts.begin());
+        next[next.size() - static_cast<std::size_t>(g) + r].push_back(i);
+      }
+    }
+    groups = std::move(next);
+    boxes = std::move(next_boxes);
   }
+  bricks_ = std::move(boxes);
   // A pair is a candidate when its centres are closer than r_a + r_b + skin: the ghosts of a
-  // slab are the particles within 2 r_max + skin of it (a hair more, for the candidates' own
+  // brick are the particles within 2 r_max + skin of it (a hair more, for the candidates' own
   // relative slack; ghost_width_ above).
   owner_ = owners_of(sim);
   // The ledger's particle terms: process 0 keeps the totals (those of a checkpoint too), the
@@ -394,17 +468,17 @@ void MpiDomain::reduce_walls(std::vector<WallState>& walls) {
   }
 }
 
-void MpiDomain::set_lists(const std::vector<double>& coords) {
+void MpiDomain::set_lists(const std::vector<Eigen::Vector3d>& c) {
   send_.assign(static_cast<std::size_t>(size_), {});
   recv_.assign(static_cast<std::size_t>(size_), {});
-  for (std::size_t i = 0; i < coords.size(); ++i) {
-    const double x = coords[i];
+  for (std::size_t i = 0; i < c.size(); ++i) {
+    const Eigen::Vector3d& x = c[i];
     const int o = owner_[i];
     if (o == rank_) {
       for (int r = 0; r < size_; ++r)
-        if (r != rank_ && near_slab(x, r))
+        if (r != rank_ && near_brick(x, r))
           send_[static_cast<std::size_t>(r)].push_back(static_cast<std::uint32_t>(i));
-    } else if (near_slab(x, rank_)) {
+    } else if (near_brick(x, rank_)) {
       recv_[static_cast<std::size_t>(o)].push_back(static_cast<std::uint32_t>(i));
     }
   }
@@ -432,11 +506,11 @@ void MpiDomain::rebuild(Simulation& sim) {
     rebuild_bytes_ += mine_c.size() * sizeof(double) * static_cast<std::size_t>(size_ - 1);
     unpack_clumps(sim.clump_states(), all_gather(comm_, size_, mine_c));
   }
-  // 2. The new owners, by the slab each particle (each clump's centre of mass) is in now (in a
+  // 2. The new owners, by the brick each particle (each clump's centre of mass) is in now (in a
   //    cell: as it is now).
   update_cell(sim);
-  std::vector<double> x(n);
-  for (std::size_t i = 0; i < n; ++i) x[i] = coord(p.pos[i]);
+  std::vector<Eigen::Vector3d> x(n);
+  for (std::size_t i = 0; i < n; ++i) x[i] = coords(p.pos[i]);
   std::vector<int> owner = owners_of(sim);
   // 3. Contact histories to the processes that compute their pairs from now on: each pair goes
   //    from the old owner of its first body (who computed it) to the new owners of its bodies.
@@ -456,7 +530,7 @@ void MpiDomain::rebuild(Simulation& sim) {
   owner_ = std::move(owner);
   std::vector<std::uint8_t> roles(n);
   for (std::size_t i = 0; i < n; ++i)
-    roles[i] = owner_[i] == rank_ ? kOwned : near_slab(x[i], rank_) ? kGhost : kAbsent;
+    roles[i] = owner_[i] == rank_ ? kOwned : near_brick(x[i], rank_) ? kGhost : kAbsent;
   sim.set_roles(std::move(roles));
   sim.rebuild_local(received);
   set_lists(x);

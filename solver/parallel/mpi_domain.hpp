@@ -1,13 +1,15 @@
-// Domain decomposition over MPI (issue 23; docs/scale.md): the particles are split into slabs
-// along the longest axis of the packing (in a periodic cell: along its widest base vector, in
-// the fractional coordinate, the last slab next to the first across the boundary), each process
-// owns the particles in its slab and holds those within 2 r_max + skin of it as ghosts. Every
-// process builds the same Simulation from the scene (the particle arrays are replicated, indexed as
-// in a one-process run), and steps only its part:
+// Domain decomposition over MPI (issue 23; docs/scale.md): the particles are split into bricks,
+// a grid of processes along the sides of the packing's box chosen for the least cut area (one
+// row of slabs along the longest side when the count is prime; in a periodic cell along its
+// base vectors that wrap, in the fractional coordinates, the last brick next to the first
+// across the boundary). The sides are cut at equal counts, nested (x, then y within each slab,
+// then z). Each process owns the particles in its brick and holds those within 2 r_max + skin
+// of it as ghosts. Every process builds the same Simulation from the scene (the particle arrays
+// are replicated, indexed as in a one-process run), and steps only its part:
 //  * each step, the owners send their ghosts' new states to the processes that hold them;
 //  * at each neighbour-list rebuild (when any process's list is stale), the owned states are
-//    gathered by all, particles migrate to the slab they are in, and the contact histories go to
-//    the processes that compute their pairs from then on;
+//    gathered by all, particles migrate to the brick they are in, and the contact histories go
+//    to the processes that compute their pairs from then on;
 //  * the walls' loads are summed over processes each step, so that servos see the whole.
 // A clump is owned by the process of its centre of mass, with its members (ghosted by their
 // own positions; the ghost layer is wider by the clumps' extent).
@@ -15,6 +17,8 @@
 // each particle's loads are summed in pair order as in one process: the trajectories are the
 // one-process run's bit for bit. Output (gather) puts the whole state on process 0.
 #pragma once
+
+#include <array>
 
 #include <mpi.h>
 
@@ -26,22 +30,26 @@
 
 namespace gs::solver {
 
+/// The bricks along x, y and z for `processes` processes (their product), for a box of sides
+/// `extent`: the grid with the least cut area Σ_k (g_k − 1)·A_k (A_k the box's section across
+/// k), only along the sides that may be cut; ties go to more bricks along the earlier sides.
+std::array<int, 3> brick_grid(int processes, const Eigen::Vector3d& extent,
+                              const std::array<bool, 3>& cuttable);
+
 class MpiDomain : public Domain {
  public:
   explicit MpiDomain(MPI_Comm comm = MPI_COMM_WORLD);
   int rank() const { return rank_; }
   int size() const { return size_; }
 
-  /// Splits `sim`'s particles (the same on every process) into slabs of equal counts along the
-  /// longest axis of their box, and makes `sim` step only this process's part. Collective.
+  /// Splits `sim`'s particles (the same on every process) into bricks of equal counts (the
+  /// grid brick_grid gives), and makes `sim` step only this process's part. Collective.
   /// Throws std::invalid_argument for what the decomposition does not handle (see
   /// Simulation::set_domain).
   void attach(Simulation& sim);
-  /// The slab boundaries along axis(): size() - 1 increasing values, in m; in a periodic cell
-  /// in the fractional coordinate s_k = (H⁻¹·x)_k of the cell's base vector k = axis(), wrapped
-  /// into [0, 1) (the slabs deform with the cell, and the first and last are neighbours).
-  const std::vector<double>& cuts() const { return cuts_; }
-  int axis() const { return axis_; }
+  /// Bricks along x, y and z (their product is size()). In a periodic cell the bricks are cut
+  /// in the fractional coordinates s = H⁻¹·x wrapped into [0, 1): they deform with the cell.
+  const std::array<int, 3>& grid() const { return grid_; }
   bool periodic() const { return periodic_; }
   double ghost_width() const { return ghost_width_; }
   /// Owning process of each particle (as of the last rebuild).
@@ -69,29 +77,38 @@ class MpiDomain : public Domain {
   void exchange(Simulation& sim) override;
 
  private:
-  int slab_of(double x) const;
-  /// Whether a particle at coordinate x is within the ghost width of process r's slab.
-  bool near_slab(double x, int r) const;
-  /// The coordinate the slabs cut: x_k, or in a cell the wrapped s_k (with the cell of the
-  /// last rebuild: update_cell()).
-  double coord(const Eigen::Vector3d& x) const;
-  /// Each particle's owner now: its slab's process, a clump member its clump's (the process of
-  /// the clump's centre of mass).
+  /// A brick's bounds in the coordinates the bricks cut (±∞, or 0 and 1 in a cell, where a
+  /// side is not cut).
+  struct Brick {
+    Eigen::Vector3d lo, hi;
+  };
+  /// The process whose brick holds coordinates c (coords()).
+  int brick_of(const Eigen::Vector3d& c) const;
+  /// Whether a particle at coordinates c is within the ghost width of process r's brick.
+  bool near_brick(const Eigen::Vector3d& c, int r) const;
+  /// The coordinates the bricks cut: x, or in a cell the wrapped s = H⁻¹·x (with the cell of
+  /// the last rebuild: update_cell()).
+  Eigen::Vector3d coords(const Eigen::Vector3d& x) const;
+  /// Each particle's owner now: its brick's process, a clump member its clump's (the process
+  /// of the clump's centre of mass).
   std::vector<int> owners_of(const Simulation& sim) const;
-  /// In a cell: H⁻¹ and the ghost width in s_k from the cell as it is now.
+  /// In a cell: H⁻¹ and the ghost width in each s_k from the cell as it is now.
   void update_cell(const Simulation& sim);
-  /// Whom this process sends its ghosts to and receives its ghosts from (coords: coord() of
-  /// each particle).
-  void set_lists(const std::vector<double>& coords);
+  /// Whom this process sends its ghosts to and receives its ghosts from (c: coords() of each
+  /// particle).
+  void set_lists(const std::vector<Eigen::Vector3d>& c);
 
   MPI_Comm comm_;
   int rank_ = 0, size_ = 1;
-  int axis_ = 0;
-  std::vector<double> cuts_;
+  std::array<int, 3> grid_{1, 1, 1};
+  // cuts_[k][node]: the cuts along k of the node-th piece of the levels before (x: one piece;
+  // y: each slab along x; z: each of those pieces), grid_[k] − 1 of them
+  std::array<std::vector<std::vector<double>>, 3> cuts_;
+  std::vector<Brick> bricks_;  // per process
   double ghost_width_ = 0;
   bool periodic_ = false;
-  Eigen::RowVector3d inv_row_ = Eigen::RowVector3d::Zero();  // row axis_ of H⁻¹ (a cell)
-  double reach_ = 0;  // the ghost width in the coordinate the slabs cut
+  Eigen::Matrix3d inv_ = Eigen::Matrix3d::Identity();  // H⁻¹ (a cell)
+  Eigen::Vector3d reach_ = Eigen::Vector3d::Zero();    // the ghost width in each coordinate
   std::vector<int> owner_;
   std::vector<std::uint8_t> my_roles_;                   // process 0's part, kept while gathered
   std::vector<std::vector<std::uint32_t>> send_, recv_;  // per process: particle indices

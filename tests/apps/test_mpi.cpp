@@ -17,6 +17,7 @@
 #include "../io/test_util.hpp"
 #include "cli_util.hpp"
 #include "hdf5_trajectory.hpp"
+#include "mpi_domain.hpp"
 
 namespace {
 
@@ -40,12 +41,17 @@ std::vector<std::string> words(const std::string& cmd) {
   return out;
 }
 
-/// Runs a command line (no shell quoting needed here); its exit code, stderr in `err`.
-int run(const std::string& cmd, std::string* err = nullptr) {
+/// Runs a command line (no shell quoting needed here); its exit code, stderr in `err`, stdout
+/// in `out`.
+int run(const std::string& cmd, std::string* err = nullptr, std::string* out = nullptr) {
   const auto e = fs::temp_directory_path() / ("gs_mpi_err_" + std::to_string(::getpid()));
-  const int status = std::system((cmd + " >/dev/null 2>" + e.string() + " </dev/null").c_str());
+  const auto o = fs::temp_directory_path() / ("gs_mpi_out_" + std::to_string(::getpid()));
+  const int status = std::system(
+      (cmd + " >" + (out ? o.string() : "/dev/null") + " 2>" + e.string() + " </dev/null").c_str());
   if (err) *err = slurp(e);
+  if (out) *out = slurp(o);
   fs::remove(e);
+  fs::remove(o);
   return WIFEXITED(status) ? WEXITSTATUS(status) : 128;
 }
 
@@ -102,14 +108,35 @@ bool mpirun_present() {
 
 }  // namespace
 
-/// `SCENE` (with `extra` options) on one process and on two: the same runs.
-void one_against_two(const std::string& scene, const std::string& extra, const std::string& h5) {
+/// `SCENE` (with `extra` options) on one process and on `processes`: the same runs. The
+/// summary line of the processes' run in `summary`.
+void one_against_two(const std::string& scene, const std::string& extra, const std::string& h5,
+                     const std::string& processes = "2", std::string* summary = nullptr) {
   gs::test::ScratchDir dir("mpi_one_two");
   const std::string args = " simulate " + scene + " -q --threads 1 " + extra + " -o ";
   ASSERT_EQ(run(kExe + args + (dir / "one").string()), 0);
   std::string err;
-  ASSERT_EQ(run(kMpirun + "2 " + kExe + args + (dir / "two").string(), &err), 0) << err;
+  ASSERT_EQ(run(kMpirun + processes + " " + kExe + args + (dir / "two").string(), &err, summary), 0)
+      << err;
   expect_same_run(dir / "one" / h5, dir / "two" / h5);
+}
+
+// The bricks' grid: the least cut area Σ (g_k − 1)·A_k, only along sides that may be cut, ties
+// to more bricks on the earlier sides (hand-counted areas).
+TEST(Mpi, BricksCutTheLeastArea) {
+  using gs::solver::brick_grid;
+  using G = std::array<int, 3>;
+  const Eigen::Vector3d cube(1, 1, 1), column(1, 1, 10), slab(10, 10, 1);
+  const std::array<bool, 3> all{true, true, true}, planar{true, true, false};
+  EXPECT_EQ(brick_grid(1, cube, all), (G{1, 1, 1}));
+  EXPECT_EQ(brick_grid(2, cube, all), (G{2, 1, 1}));     // a tie of three: x
+  EXPECT_EQ(brick_grid(3, column, all), (G{1, 1, 3}));   // a prime: slabs across the long side
+  EXPECT_EQ(brick_grid(4, cube, all), (G{2, 2, 1}));     // area 2 against 3 for slabs
+  EXPECT_EQ(brick_grid(8, cube, all), (G{2, 2, 2}));     // 3 against 4 (2 x 4 x 1)
+  EXPECT_EQ(brick_grid(4, column, all), (G{1, 1, 4}));   // 3 against 11 for 2 x 1 x 2
+  EXPECT_EQ(brick_grid(16, slab, all), (G{4, 4, 1}));    // never across the thin side here
+  EXPECT_EQ(brick_grid(8, cube, planar), (G{4, 2, 1}));  // z not cut: 4 x 2 (area 4), x first
+  EXPECT_EQ(brick_grid(6, Eigen::Vector3d(3, 2, 1), all), (G{3, 2, 1}));
 }
 
 // The shared YADE oedometer (883 spheres, five box walls, the top one moving): 2 000 steps on one
@@ -126,6 +153,16 @@ TEST(Mpi, TwoProcessesStepAFallingPackingAsOneBitForBit) {
   one_against_two((kData / "scenes" / "oedometer_fall.toml").string(), "", "oedometer_fall.h5");
 }
 
+// Four processes in bricks (two along x, two along z: particles and contacts change bricks
+// across two sides) step the falling packing as one.
+TEST(Mpi, FourProcessesInBricksStepAFallingPackingAsOneBitForBit) {
+  if (!mpirun_present()) GTEST_SKIP() << "mpirun not installed (apt-get install openmpi-bin)";
+  std::string summary;
+  one_against_two((kData / "scenes" / "oedometer_fall.toml").string(), "", "oedometer_fall.h5", "4",
+                  &summary);
+  EXPECT_NE(summary.find("mpirun: 4 processes, bricks 2 x 1 x 2;"), std::string::npos) << summary;
+}
+
 /// A plain scene in a periodic cell from the YADE reference packings in tests/data.
 std::string periodic_scene(const std::string& packing, const std::string& solver,
                            const std::string& cell) {
@@ -139,9 +176,9 @@ std::string periodic_scene(const std::string& packing, const std::string& solver
 }
 
 // YADE's periodic reference (1 000 spheres in a cube cell) sheared ten times faster than there
-// (L_xz = 20/s, 3 000 steps: γ = 0.15, several rebuilds): slabs along the cell's base vector x,
-// in the fractional coordinate, the first and the last slab neighbours across the boundary.
-// Two and three processes step it as one, bit for bit.
+// (L_xz = 20/s, 3 000 steps: γ = 0.15, several rebuilds): slabs along the cell's base vector x
+// (two and three processes) or 2 x 2 bricks (four), in the fractional coordinates, the first
+// and the last neighbours across the boundary. They step it as one, bit for bit.
 TEST(Mpi, ProcessesShearAPeriodicCellAsOneBitForBit) {
   if (!mpirun_present()) GTEST_SKIP() << "mpirun not installed (apt-get install openmpi-bin)";
   gs::test::ScratchDir dir("mpi_cell");
@@ -152,11 +189,13 @@ TEST(Mpi, ProcessesShearAPeriodicCellAsOneBitForBit) {
       "velocity_gradient_1_s = [[0, 0, 20.0], [0, 0, 0], [0, 0, 0]]\n");
   const std::string args = " simulate " + scene.string() + " -q --threads 1 -o ";
   ASSERT_EQ(run(kExe + args + (dir / "one").string()), 0);
-  std::string err;
-  for (const char* n : {"2", "3"}) {
-    ASSERT_EQ(run(kMpirun + n + " " + kExe + args + (dir / n).string(), &err), 0) << err;
+  std::string err, out;
+  for (const char* n : {"2", "3", "4"}) {
+    ASSERT_EQ(run(kMpirun + n + " " + kExe + args + (dir / n).string(), &err, &out), 0) << err;
     expect_same_run(dir / "one" / "cell.h5", dir / n / "cell.h5");
   }
+  // (four processes: bricks across x and y, each next to the others across two faces)
+  EXPECT_NE(out.find("bricks 2 x 2 x 1 (along the cell's base vectors)"), std::string::npos) << out;
 }
 
 // The planar cell (YADE's 2D emulation, the periodic2d reference: 600 spheres in one plane,
