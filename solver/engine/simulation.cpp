@@ -1187,7 +1187,6 @@ void Simulation::serial_pass(std::size_t nv, bool indexed, double& max_overlap_o
       const auto [a, b] = nl_.pairs[kk];
       if (a != cur) {
         flush();
-        max_overlap_out = max_overlap_ratio;
         cur = a;
         f_cur = V3(p_.force[a]);
         t_cur = V3(p_.torque[a]);
@@ -1212,6 +1211,7 @@ void Simulation::serial_pass(std::size_t nv, bool indexed, double& max_overlap_o
     }
   }
   flush();
+  max_overlap_out = max_overlap_ratio;
 }
 
 template <bool kIndexed>

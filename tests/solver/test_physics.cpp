@@ -464,6 +464,24 @@ TEST(Physics, BlowUpIsDetected) {
   EXPECT_THROW(sim.run(100), BlowUp);
 }
 
+// The overlap limit sees every pair of the pass, the last ones of the last particle included: a
+// sphere overlapping 0 by its radius, listed after a light contact of 0, stops the first step
+// (on one thread and on two).
+TEST(Physics, DeepOverlapOfTheLastPairStopsTheStep) {
+  for (const int threads : {1, 2}) {
+    SimulationConfig c;
+    c.material = material();
+    c.dt = 1e-9;
+    c.threads = threads;
+    c.max_overlap_ratio = 0.5;
+    const double r = 1e-3;
+    Simulation sim(
+        c, {sphere(0, {0, 0, 0}, r), sphere(1, {1.99e-3, 0, 0}, r), sphere(2, {0, 1.0e-3, 0}, r)},
+        {});
+    EXPECT_THROW(sim.step(), BlowUp) << threads << " thread(s)";
+  }
+}
+
 // A servo-controlled plane presses a sphere onto a fixed floor and settles at the target stress.
 TEST(Physics, ServoWallReachesTargetStress) {
   const double r = 1e-3;
