@@ -1338,10 +1338,9 @@ std::vector<double> balanced_cuts(std::size_t nt, const std::vector<std::size_t>
 
 void Simulation::split_pairs(std::size_t nt) {
   const std::size_t n = p_.size(), np = nl_.pairs.size();
-  // (equal counts of pairs until the shares of the last split have been timed; the shares'
-  // sizes change no result: every split gives the same bits)
-  const std::vector<double> cut =
-      share_steps_ > 0 ? balanced_cuts(nt, split_pair_, share_seconds_) : balanced_cuts(nt, {}, {});
+  // (equal counts of pairs until the shares of the last split have been timed: their seconds
+  // are zero until then; the shares' sizes change no result: every split gives the same bits)
+  const std::vector<double> cut = balanced_cuts(nt, split_pair_, share_seconds_);
   split_first_.assign(nt + 1, 0);
   split_pair_.assign(nt + 1, 0);
   for (std::size_t t = 1; t < nt; ++t) {

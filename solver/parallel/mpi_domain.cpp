@@ -265,10 +265,10 @@ bool MpiDomain::near_brick(const Eigen::Vector3d& c, int r) const {
   return true;
 }
 
-std::vector<int> MpiDomain::owners_of(const Simulation& sim) const {
-  const ParticleState& p = sim.particles();
-  std::vector<int> owner(p.size());
-  for (std::size_t i = 0; i < p.size(); ++i) owner[i] = brick_of(coords(p.pos[i]));
+std::vector<int> MpiDomain::owners_of(const Simulation& sim,
+                                      const std::vector<Eigen::Vector3d>& c) const {
+  std::vector<int> owner(c.size());
+  for (std::size_t i = 0; i < c.size(); ++i) owner[i] = brick_of(c[i]);
   for (const ClumpBody& c : sim.clumps()) {
     const int o = brick_of(coords(c.pos));
     for (const std::uint32_t m : c.members) owner[m] = o;
@@ -394,7 +394,7 @@ void MpiDomain::attach(Simulation& sim) {
   // A pair is a candidate when its centres are closer than r_a + r_b + skin: the ghosts of a
   // brick are the particles within 2 r_max + skin of it (a hair more, for the candidates' own
   // relative slack; ghost_width_ above).
-  owner_ = owners_of(sim);
+  owner_ = owners_of(sim, c);
   // The ledger's particle terms: process 0 keeps the totals (those of a checkpoint too), the
   // others count what they add from now on (summed on process 0 at each gather).
   if (rank_ != 0) zero_particle_terms(sim.ledger_terms());
@@ -511,7 +511,7 @@ void MpiDomain::rebuild(Simulation& sim) {
   update_cell(sim);
   std::vector<Eigen::Vector3d> x(n);
   for (std::size_t i = 0; i < n; ++i) x[i] = coords(p.pos[i]);
-  std::vector<int> owner = owners_of(sim);
+  std::vector<int> owner = owners_of(sim, x);
   // 3. Contact histories to the processes that compute their pairs from now on: each pair goes
   //    from the old owner of its first body (who computed it) to the new owners of its bodies.
   std::vector<std::vector<double>> to(static_cast<std::size_t>(size_));

@@ -89,9 +89,9 @@ class MpiDomain : public Domain {
   /// The coordinates the bricks cut: x, or in a cell the wrapped s = H⁻¹·x (with the cell of
   /// the last rebuild: update_cell()).
   Eigen::Vector3d coords(const Eigen::Vector3d& x) const;
-  /// Each particle's owner now: its brick's process, a clump member its clump's (the process
-  /// of the clump's centre of mass).
-  std::vector<int> owners_of(const Simulation& sim) const;
+  /// Each particle's owner now: its brick's process (c: coords() of each particle), a clump
+  /// member its clump's (the process of the clump's centre of mass).
+  std::vector<int> owners_of(const Simulation& sim, const std::vector<Eigen::Vector3d>& c) const;
   /// In a cell: H⁻¹ and the ghost width in each s_k from the cell as it is now.
   void update_cell(const Simulation& sim);
   /// Whom this process sends its ghosts to and receives its ghosts from (c: coords() of each
