@@ -217,15 +217,51 @@ void Simulation::set_outlet(const Eigen::Vector3d& keep_lo, const Eigen::Vector3
 }
 
 void Simulation::remove_outflow() {
+  // (under a domain: this process's own particles, whose states are its to change; the count
+  // waits for count_outflow, where every process holds every state)
+  const bool split = !roles_.empty();
+  if (split) uncounted_.resize(p_.size(), 0);
   bool any = false;
   for (std::size_t i = 0; i < p_.size(); ++i) {
-    if (p_.removed[i] || p_.clump[i] >= 0) continue;
-    const Eigen::Vector3d& x = p_.pos[i];
-    if ((x.array() >= keep_lo_.array()).all() && (x.array() <= keep_hi_.array()).all()) continue;
-    retire(i);
+    if (p_.removed[i] || p_.clump[i] >= 0 || kept(p_.pos[i])) continue;
+    if (split && roles_[i] != kOwned) continue;
+    if (split) {
+      ledger_.outflow += 0.5 * p_.mass[i] * p_.vel[i].squaredNorm() +
+                         0.5 * p_.inertia[i] * p_.angvel[i].squaredNorm();
+      uncounted_[i] = 1;
+      freeze(i);
+    } else {
+      retire(i);
+    }
     any = true;
   }
   if (any) invalidate_neighbors();  // (its pairs go with the rebuild before the next step)
+}
+
+void Simulation::restore_keeping_ledger(Simulation&& earlier) {
+  const EnergyLedger ledger = ledger_;
+  const bool started = ledger_started_;
+  *this = std::move(earlier);
+  ledger_ = ledger;
+  ledger_started_ = started;
+  nl_.absent = roles_.empty() ? nullptr : &absent_;  // (its own mask, not the earlier object's)
+}
+
+void Simulation::count_outflow() {
+  if (!outlet_) return;
+  const std::size_t n = p_.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    if (p_.clump[i] >= 0) continue;
+    if (p_.removed[i] == 0) {
+      if (kept(p_.pos[i])) continue;
+      freeze(i);  // (its owner's ledger has its energy)
+    } else if (i >= uncounted_.size() || !uncounted_[i]) {
+      continue;
+    }
+    if (i < uncounted_.size()) uncounted_[i] = 0;
+    removed_mass_ += p_.mass[i];
+    ++removed_count_;
+  }
 }
 
 void Simulation::retire(std::size_t i) {
@@ -234,12 +270,16 @@ void Simulation::retire(std::size_t i) {
                        0.5 * p_.inertia[i] * p_.angvel[i].squaredNorm();
     removed_mass_ += p_.mass[i];
   }
+  freeze(i);
+  ++removed_count_;
+}
+
+void Simulation::freeze(std::size_t i) {
   p_.removed[i] = 1;
   p_.fixed[i] = 1;
   p_.vel[i].setZero();
   p_.angvel[i].setZero();
   p_.external_force[i].setZero();
-  ++removed_count_;
 }
 
 void Simulation::set_pending(const std::vector<std::uint32_t>& indices) {
@@ -392,13 +432,11 @@ void Simulation::rebuild_neighbors() {
 void Simulation::set_domain(Domain* domain) {
   if (domain) {
     bool pending = false;
-    for (const auto r : p_.removed) pending = pending || r != 0;
-    const char* what = outlet_   ? "an outlet"
-                       : pending ? "removed or pending particles (filling)"
-                                 : nullptr;
-    if (what)
-      throw std::invalid_argument(std::string("the domain decomposition does not handle ") + what +
-                                  " yet (run on one process)");
+    for (const auto r : p_.removed) pending = pending || r == 2;
+    if (pending)
+      throw std::invalid_argument(
+          "the domain decomposition does not handle particles waiting to enter (filling) yet (run "
+          "on one process)");
   }
   domain_ = domain;
   invalidate_neighbors();

@@ -248,9 +248,21 @@ class Simulation {
 
   /// Domain decomposition (issue 23, docs/scale.md): `domain` gets the step's collective calls
   /// (nullptr: none). Spheres and clumps between planes, boxes and meshes, or spheres in a
-  /// periodic cell: throws std::invalid_argument with an outlet or filling, which it does not
-  /// handle yet. A domain gives each clump's members the owner of the clump.
+  /// periodic cell, with or without an outlet: throws std::invalid_argument with particles
+  /// waiting to enter (filling), which it does not handle yet. A domain gives each clump's
+  /// members the owner of the clump.
   void set_domain(Domain* domain);
+  /// This simulation becomes `earlier` (a copy taken before), all but its energy ledger, which
+  /// stays as it is now (a domain's process 0 steps on as it was before an output that gathered
+  /// the whole assembly into it, with the ledger's sums of that output).
+  void restore_keeping_ledger(Simulation&& earlier);
+  /// Under a domain, an outlet's removals are counted here, in index order as one process
+  /// counts them, where a process holds every particle's current state (a domain's rebuild, and
+  /// its gather on the process that writes). Each owner retires its own particles as they leave
+  /// (their kinetic energy to its ledger's outflow, the count left for this call); any other
+  /// particle found outside the kept box was retired by its owner on the same bits, and is
+  /// retired here too.
+  void count_outflow();
   /// The part of the scene this process steps: per particle a ParticleRole. Pairs are kept
   /// where at least one body is owned; only owned particles are integrated and counted in the
   /// ledger's particle terms. Empty: every particle owned. Takes effect at the next rebuild.
@@ -335,6 +347,12 @@ class Simulation {
   /// kinetic energy goes to the ledger's outflow and its mass to removed_mass (a member's are
   /// its clump's).
   void retire(std::size_t i);
+  /// Freezes particle i for good (removed, fixed, at rest), without counting it anywhere.
+  void freeze(std::size_t i);
+  /// Whether an outlet keeps a particle at x.
+  bool kept(const Eigen::Vector3d& x) const {
+    return (x.array() >= keep_lo_.array()).all() && (x.array() <= keep_hi_.array()).all();
+  }
   /// Drops the clumps marked gone (their members already removed), renumbering p_.clump.
   void drop_clumps(const std::vector<std::uint8_t>& gone);
   /// Elastic energy (normal, shear, rolling; J) stored in contact k.
@@ -363,6 +381,7 @@ class Simulation {
   ParticleState p_;
   Domain* domain_ = nullptr;
   std::vector<std::uint8_t> roles_;            // ParticleRole per particle; empty: all owned
+  std::vector<std::uint8_t> uncounted_;        // retired here by an outlet, not counted yet
   std::vector<std::uint8_t> absent_;           // roles_ == kAbsent (the neighbour list's mask)
   std::vector<Eigen::Vector3d> kept_ref_pos_;  // rebuild_local(…, keep_reference) scratch
   std::pair<std::vector<Eigen::Vector3d>, std::vector<Eigen::Vector3d>> kept_wall_ref_;

@@ -103,7 +103,7 @@ std::vector<ContactHistory> unpack_histories(const std::vector<double>& in) {
 /// process, from the summed wall loads).
 void zero_particle_terms(EnergyLedger& e) {
   e.friction_dissipation = e.rolling_dissipation = e.damping_dissipation = 0;
-  e.viscous_dissipation = e.gravity_work = e.external_work = 0;
+  e.viscous_dissipation = e.gravity_work = e.external_work = e.outflow = 0;
 }
 
 void check(int code, const char* what) {
@@ -506,6 +506,7 @@ void MpiDomain::rebuild(Simulation& sim) {
     rebuild_bytes_ += mine_c.size() * sizeof(double) * static_cast<std::size_t>(size_ - 1);
     unpack_clumps(sim.clump_states(), all_gather(comm_, size_, mine_c));
   }
+  sim.count_outflow();  // (an outlet's removals since the last rebuild, known here to all)
   // 2. The new owners, by the brick each particle (each clump's centre of mass) is in now (in a
   //    cell: as it is now).
   update_cell(sim);
@@ -577,6 +578,7 @@ void MpiDomain::exchange(Simulation& sim) {
 }
 
 void MpiDomain::gather(Simulation& sim) {
+  if (rank_ == 0) stepping_ = std::make_unique<Simulation>(sim);  // (release() puts it back)
   ParticleState& p = sim.particles();
   // The owned states with their loads, and the real contacts whose first body is owned here.
   const std::vector<double> states = pack_owned(p, owner_, rank_, true);
@@ -616,10 +618,15 @@ void MpiDomain::gather(Simulation& sim) {
   // The ledger's particle terms (each process counted its own particles and their contacts);
   // the walls' work is the same on every process, from the summed wall loads.
   EnergyLedger& e = sim.ledger_terms();
-  double terms[6] = {e.friction_dissipation, e.rolling_dissipation, e.damping_dissipation,
-                     e.viscous_dissipation,  e.gravity_work,        e.external_work};
-  double sums[6] = {};
-  check(MPI_Reduce(terms, sums, 6, MPI_DOUBLE, MPI_SUM, 0, comm_), "reduce");
+  double terms[7] = {e.friction_dissipation,
+                     e.rolling_dissipation,
+                     e.damping_dissipation,
+                     e.viscous_dissipation,
+                     e.gravity_work,
+                     e.external_work,
+                     e.outflow};
+  double sums[7] = {};
+  check(MPI_Reduce(terms, sums, 7, MPI_DOUBLE, MPI_SUM, 0, comm_), "reduce");
   if (rank_ != 0) return zero_particle_terms(e);  // (counted on process 0 from now on)
   e.friction_dissipation = sums[0];
   e.rolling_dissipation = sums[1];
@@ -627,19 +634,20 @@ void MpiDomain::gather(Simulation& sim) {
   e.viscous_dissipation = sums[3];
   e.gravity_work = sums[4];
   e.external_work = sums[5];
+  e.outflow = sums[6];
   for (const double* x = all_states.data(); x < all_states.data() + all_states.size();) {
     const auto i = static_cast<std::size_t>(*x++);
     unpack_state(p, i, x, true);
   }
-  my_roles_ = sim.roles();
+  sim.count_outflow();  // (the removals since the last rebuild: process 0 writes them)
   sim.set_roles({});
   sim.rebuild_local(unpack_histories(all_hist), true);
 }
 
 void MpiDomain::release(Simulation& sim) {
-  if (rank_ != 0) return;
-  sim.set_roles(my_roles_);
-  sim.rebuild_local({}, true);
+  if (rank_ != 0 || !stepping_) return;
+  sim.restore_keeping_ledger(std::move(*stepping_));
+  stepping_.reset();
 }
 
 }  // namespace gs::solver

@@ -23,6 +23,7 @@
 #include <mpi.h>
 
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "domain.hpp"
@@ -56,10 +57,16 @@ class MpiDomain : public Domain {
   const std::vector<int>& owners() const { return owner_; }
 
   /// Collective: process 0's simulation then holds the whole state (every particle's, every
-  /// contact's, the ledger's particle terms summed) as a one-process run would, for output and
-  /// checkpoints; the others keep theirs. release() undoes it.
+  /// contact's, the ledger's particle terms summed, an outlet's latest removals counted) as a
+  /// one-process run would, for output and checkpoints; the others keep theirs. release()
+  /// undoes it.
   void gather(Simulation& sim);
-  /// Process 0 back to its own part after gather().
+  /// Process 0 back to the very state it stepped with before gather() (its part, its
+  /// neighbour list and everything built from it), but for the ledger, which keeps the sums.
+  /// (Rebuilding its part's list instead would build it from the particles' present positions,
+  /// not from those of the last rebuild, as the other processes' are: other candidate pairs,
+  /// other deferred facet pairs, and once in a while another contact; an output cadence then
+  /// changed the run.)
   void release(Simulation& sim);
   /// Bytes this process sent in the halo exchanges since attach (per-step traffic), and at
   /// rebuilds (migration and histories).
@@ -110,7 +117,7 @@ class MpiDomain : public Domain {
   Eigen::Matrix3d inv_ = Eigen::Matrix3d::Identity();  // H⁻¹ (a cell)
   Eigen::Vector3d reach_ = Eigen::Vector3d::Zero();    // the ghost width in each coordinate
   std::vector<int> owner_;
-  std::vector<std::uint8_t> my_roles_;                   // process 0's part, kept while gathered
+  std::unique_ptr<Simulation> stepping_;  // process 0's own simulation, kept while gathered
   std::vector<std::vector<std::uint32_t>> send_, recv_;  // per process: particle indices
   std::vector<double> send_buf_, recv_buf_;
   std::uint64_t halo_bytes_ = 0, rebuild_bytes_ = 0;
