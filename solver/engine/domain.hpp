@@ -38,6 +38,9 @@ class Domain {
   /// After the integration: the owned particles' new states to the processes holding them as
   /// ghosts.
   virtual void exchange(Simulation& sim) = 0;
+  /// Values each process set for its own bodies, zero elsewhere, to every process: an
+  /// element-wise sum over processes, exact (every entry is non-zero on one process at most).
+  virtual void share(std::vector<double>& values) = 0;
 };
 
 }  // namespace gs::solver

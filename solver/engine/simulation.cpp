@@ -238,6 +238,32 @@ void Simulation::remove_outflow() {
   if (any) invalidate_neighbors();  // (its pairs go with the rebuild before the next step)
 }
 
+void Simulation::share_all_states() {
+  if (domain_) domain_->rebuild(*this);
+}
+
+double Simulation::owned_sum(const std::function<double(std::size_t)>& particle,
+                             const std::function<double(std::size_t)>& clump) const {
+  const std::size_t n = p_.size(), nc = clumps_.size();
+  double sum = 0;
+  if (!domain_) {
+    for (std::size_t i = 0; i < n; ++i) sum += particle(i);
+    for (std::size_t k = 0; k < nc; ++k) sum += clump(k);
+    return sum;
+  }
+  // (x + 0 = x: the shared values are the owners' to the bit, and the sum the same as above)
+  std::vector<double> v(n + nc, 0.0);
+  for (std::size_t i = 0; i < n; ++i)
+    if (roles_.empty() || roles_[i] == kOwned) v[i] = particle(i);
+  for (std::size_t k = 0; k < nc; ++k)
+    if (!clumps_[k].members.empty() && clump_owned(k)) v[n + k] = clump(k);
+  domain_->share(v);
+  for (std::size_t k = 0; k < nc; ++k)  // (a clump without members is every process's alike)
+    if (clumps_[k].members.empty()) v[n + k] = clump(k);
+  for (const double x : v) sum += x;
+  return sum;
+}
+
 void Simulation::restore_keeping_ledger(Simulation&& earlier) {
   const EnergyLedger ledger = ledger_;
   const bool started = ledger_started_;
@@ -430,14 +456,6 @@ void Simulation::rebuild_neighbors() {
 }
 
 void Simulation::set_domain(Domain* domain) {
-  if (domain) {
-    bool pending = false;
-    for (const auto r : p_.removed) pending = pending || r == 2;
-    if (pending)
-      throw std::invalid_argument(
-          "the domain decomposition does not handle particles waiting to enter (filling) yet (run "
-          "on one process)");
-  }
   domain_ = domain;
   invalidate_neighbors();
 }
@@ -479,6 +497,25 @@ void Simulation::rebuild_local(const std::vector<ContactHistory>& received, bool
     }
     nl_.pairs.resize(kept);
     if (periods) nl_.cell_dist.resize(kept);
+  }
+  if (keep_reference && !periodic_) {
+    // (for output: every contact received, also one whose pair this build leaves out; a wall
+    // switched off after the last step still holds its contacts of that step, as one process
+    // holds them until its next rebuild)
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> missing;
+    for (const ContactHistory& h : received) {
+      const auto key = std::make_pair(h.a, h.b);
+      if (h.real && !std::binary_search(nl_.pairs.begin(), nl_.pairs.end(), key))
+        missing.push_back(key);
+    }
+    if (!missing.empty()) {
+      std::sort(missing.begin(), missing.end());
+      std::vector<std::pair<std::uint32_t, std::uint32_t>> all;
+      all.reserve(nl_.pairs.size() + missing.size());
+      std::merge(nl_.pairs.begin(), nl_.pairs.end(), missing.begin(), missing.end(),
+                 std::back_inserter(all));
+      nl_.pairs.swap(all);
+    }
   }
   attach_histories();
   for (const ContactHistory& h : received) {

@@ -248,10 +248,19 @@ class Simulation {
 
   /// Domain decomposition (issue 23, docs/scale.md): `domain` gets the step's collective calls
   /// (nullptr: none). Spheres and clumps between planes, boxes and meshes, or spheres in a
-  /// periodic cell, with or without an outlet: throws std::invalid_argument with particles
-  /// waiting to enter (filling), which it does not handle yet. A domain gives each clump's
-  /// members the owner of the clump.
+  /// periodic cell, with or without an outlet and particles waiting to enter. A domain gives
+  /// each clump's members the owner of the clump.
   void set_domain(Domain* domain);
+  /// Under a domain decomposition (collective): a neighbour-list rebuild now, after which
+  /// every process holds every particle's present state, for a programme that reads the whole
+  /// assembly (a filling placing a layer). Nothing without a domain.
+  void share_all_states();
+  /// Σ particle(i) over the particles, then Σ clump(k) over the clumps, added in index order:
+  /// the sum one process computes, and the same bits on every process of a domain. Each
+  /// process calls the functions for its own bodies only (every body without a domain); the
+  /// values travel to every process (Domain::share) and are added there. Collective.
+  double owned_sum(const std::function<double(std::size_t)>& particle,
+                   const std::function<double(std::size_t)>& clump) const;
   /// This simulation becomes `earlier` (a copy taken before), all but its energy ledger, which
   /// stays as it is now (a domain's process 0 steps on as it was before an output that gathered
   /// the whole assembly into it, with the ledger's sums of that output).
@@ -270,8 +279,10 @@ class Simulation {
   const std::vector<std::uint8_t>& roles() const { return roles_; }
   /// Rebuilds the neighbour list now, for the roles set; the histories in `received` (pairs
   /// other processes computed until now; sorted or not) replace those of the same pairs.
-  /// `keep_reference`: the list's reference positions stay those of the last rebuild (the next
-  /// rebuild comes when the particles have moved half the skin since then, as on every process).
+  /// `keep_reference` (a list for output, not for stepping): the list's reference positions
+  /// stay those of the last rebuild, and every real contact received is in the list, also one
+  /// whose pair the build leaves out (of a wall switched off since the last step; not in a
+  /// periodic cell).
   void rebuild_local(const std::vector<ContactHistory>& received, bool keep_reference = false);
   /// The candidate pairs (sorted by (a, b)) and their histories, parallel.
   const std::vector<std::pair<std::uint32_t, std::uint32_t>>& pairs() const { return nl_.pairs; }

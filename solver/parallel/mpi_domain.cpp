@@ -324,15 +324,21 @@ void MpiDomain::attach(Simulation& sim) {
   // vectors that wrap, in the fractional coordinates), each side cut at equal counts (midway
   // between neighbouring centres), nested: the slabs along x, each slab's particles along y,
   // each piece's along z. Every process computes the same from the same particles.
+  // (the box and the counts of the particles in the scene: those waiting to enter sit at one
+  // point until they do, those removed where they left; the ghost layer fits every radius)
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(HUGE_VAL), hi = -lo;
   double rmax = 0;
+  std::vector<std::uint32_t> in_scene;
+  in_scene.reserve(n);
   for (std::size_t i = 0; i < n; ++i) {
+    rmax = std::max(rmax, p.radius[i]);
+    if (p.removed[i] != 0) continue;
     lo = lo.cwiseMin(p.pos[i]);
     hi = hi.cwiseMax(p.pos[i]);
-    rmax = std::max(rmax, p.radius[i]);
+    in_scene.push_back(static_cast<std::uint32_t>(i));
   }
   periodic_ = sim.periodic();
-  Eigen::Vector3d extent = n > 0 ? Eigen::Vector3d(hi - lo) : Eigen::Vector3d::Zero();
+  Eigen::Vector3d extent = !in_scene.empty() ? Eigen::Vector3d(hi - lo) : Eigen::Vector3d::Zero();
   std::array<bool, 3> cuttable{true, true, true};
   if (periodic_) {
     extent = sim.cell().widths();
@@ -351,9 +357,7 @@ void MpiDomain::attach(Simulation& sim) {
   update_cell(sim);
   std::vector<Eigen::Vector3d> c(n);
   for (std::size_t i = 0; i < n; ++i) c[i] = coords(p.pos[i]);
-  std::vector<std::vector<std::uint32_t>> groups(1);
-  groups[0].resize(n);
-  for (std::size_t i = 0; i < n; ++i) groups[0][i] = static_cast<std::uint32_t>(i);
+  std::vector<std::vector<std::uint32_t>> groups(1, std::move(in_scene));
   const double open_lo = periodic_ ? 0.0 : -HUGE_VAL, open_hi = periodic_ ? 1.0 : HUGE_VAL;
   std::vector<Brick> boxes(
       1, Brick{Eigen::Vector3d::Constant(open_lo), Eigen::Vector3d::Constant(open_hi)});
@@ -575,6 +579,12 @@ void MpiDomain::exchange(Simulation& sim) {
   const double* x = recv_buf_.data();
   for (std::size_t r = 0; r < n; ++r)
     for (const std::uint32_t i : recv_[r]) unpack_state(p, i, x, false);
+}
+
+void MpiDomain::share(std::vector<double>& values) {
+  check(MPI_Allreduce(MPI_IN_PLACE, values.data(), static_cast<int>(values.size()), MPI_DOUBLE,
+                      MPI_SUM, comm_),
+        "allreduce");
 }
 
 void MpiDomain::gather(Simulation& sim) {

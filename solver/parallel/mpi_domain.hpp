@@ -44,9 +44,8 @@ class MpiDomain : public Domain {
   int size() const { return size_; }
 
   /// Splits `sim`'s particles (the same on every process) into bricks of equal counts (the
-  /// grid brick_grid gives), and makes `sim` step only this process's part. Collective.
-  /// Throws std::invalid_argument for what the decomposition does not handle (see
-  /// Simulation::set_domain).
+  /// grid brick_grid gives; counted over the particles in the scene, not those removed or
+  /// waiting to enter), and makes `sim` step only this process's part. Collective.
   void attach(Simulation& sim);
   /// Bricks along x, y and z (their product is size()). In a periodic cell the bricks are cut
   /// in the fractional coordinates s = H⁻¹·x wrapped into [0, 1): they deform with the cell.
@@ -82,6 +81,7 @@ class MpiDomain : public Domain {
   void reduce_cell(Eigen::Matrix3d& stress, Eigen::Vector3d* stiffness) override;
   void agree(double& max_overlap_ratio, bool& finite) override;
   void exchange(Simulation& sim) override;
+  void share(std::vector<double>& values) override;
 
  private:
   /// A brick's bounds in the coordinates the bricks cut (±∞, or 0 and 1 in a cell, where a

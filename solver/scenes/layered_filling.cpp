@@ -188,25 +188,29 @@ LayeredFilling::LayeredFilling(FillSpec spec, std::uint32_t first_index,
       open_walls_(std::move(open_walls)),
       frame_every_(std::max<std::int64_t>(1, frame_every)) {}
 
+// (Both sums in index order over the bodies, each term from its owner under a domain: the same
+// bits on any number of processes, so every process inserts the next layer at the same step.)
 double LayeredFilling::settling_energy(const Simulation& sim) {
   const ParticleState& p = sim.particles();
-  double e = 0;
-  for (std::size_t i = 0; i < p.size(); ++i)
-    if (p.removed[i] == 0 && p.clump[i] < 0) e += 0.5 * p.mass[i] * p.vel[i].squaredNorm();
-  for (const auto& c : sim.clumps()) e += 0.5 * c.mass * c.vel.squaredNorm();
-  return e;
+  const auto& clumps = sim.clumps();
+  return sim.owned_sum(
+      [&](std::size_t i) {
+        return p.removed[i] == 0 && p.clump[i] < 0 ? 0.5 * p.mass[i] * p.vel[i].squaredNorm() : 0.0;
+      },
+      [&](std::size_t k) { return 0.5 * clumps[k].mass * clumps[k].vel.squaredNorm(); });
 }
 
 double LayeredFilling::threshold(const Simulation& sim) const {
   const ParticleState& p = sim.particles();
   const double g = sim.config().gravity.norm();
-  double work = 0;
-  for (std::size_t i = 0; i < p.size(); ++i)
-    if (p.removed[i] == 0) work += p.mass[i] * g * 2 * p.radius[i];
+  const double work = sim.owned_sum(
+      [&](std::size_t i) { return p.removed[i] == 0 ? p.mass[i] * g * 2 * p.radius[i] : 0.0; },
+      [](std::size_t) { return 0.0; });
   return spec_.kinetic_ratio * work;
 }
 
 void LayeredFilling::insert_layer(Simulation& sim) {
+  sim.share_all_states();  // (under a domain: every process places the layer among them all)
   const auto& layer = layers_[static_cast<std::size_t>(inserted_)];
   std::vector<double> radii;
   for (const auto k : layer) radii.push_back(sim.particles().radius[first_ + k]);

@@ -315,10 +315,10 @@ RunOutcome run_scene(Scene scene, const RunOptions& a) {
   const bool threads_by_size = scene.config.threads == 0;
   if (threads_by_size)  // "auto"; under mpirun one thread a process (the processes take the cores)
     scene.config.threads = par ? 1 : auto_threads(scene.particles.size());
-  if (par && (!scene.test.empty() || scene.fill))
+  if (par && !scene.test.empty())
     throw InputError(scene_file,
-                     "under mpirun only plain scenes run yet (no scene.test, no [fill])",
-                     scene.test.empty() ? "fill" : scene.test);
+                     "under mpirun only plain scenes and fillings run yet (no scene.test)",
+                     scene.test);
   // Where the run stops at the latest: `steps`, or a plain scene's own number of steps.
   std::optional<std::int64_t> stop_at = a.steps;
   if (scene.test.empty() && !scene.fill) {
@@ -528,9 +528,11 @@ RunOutcome run_scene(Scene scene, const RunOptions& a) {
       }
       copy.commit();
     }
-    if (par) par->attach(sim);
     history.create(history_header(sim, scene.output.track_ids));
+    // (the domain after the start: a filling's particles waiting to enter are then known, and
+    // its first layer is in place, so the bricks are cut where the particles are)
     programmes[0]->start(sim);
+    if (par) par->attach(sim);
     open_curve(0);
     history_append(false);
     curve_row();

@@ -548,6 +548,45 @@ TEST(Mpi, AnOutletRemovesOnEveryProcessAsOnOne) {
   EXPECT_EQ(removal_columns(resumed / "history.csv"), one);
 }
 
+// A filling and an outlet (tests/data/scenes/fill_drain.toml: three layers of 200 spheres
+// poured in quick succession into a box whose floor has a slot closed by a lid, the lid
+// switched off once the filling has settled, then an outlet under the slot). Every process
+// decides when the next layer goes in from the same sums (the kinetic energy and its
+// threshold, added in index order from the owners' terms), and places it among every
+// particle's present state (a rebuild just before). Checked: placed among the states of the
+// last rebuild instead, the runs part at step 10 500; with each process's sums over its own
+// particles only, the processes insert at different steps and the run hangs (the test then
+// fails at mpirun's time limit). Two and three processes equal one:
+// particles and contacts to the bit (the frame at the switch-off too, which lists the lid's
+// contacts of the last step), the removal columns of the history as written; a two-process run
+// stopped after a checkpoint in the middle of the filling resumes on one process to the
+// uninterrupted run.
+TEST(Mpi, AFillingAndAnOutletRunAsOnOneProcess) {
+  if (!mpirun_present()) GTEST_SKIP() << "mpirun not installed (apt-get install openmpi-bin)";
+  gs::test::ScratchDir dir("mpi_fill");
+  const std::string scene = (kData / "scenes" / "fill_drain.toml").string();
+  const std::string args = " simulate " + scene + " -q --threads 1 -o ";
+  ASSERT_EQ(run(kExe + args + (dir / "one").string()), 0);
+  const auto one = removal_columns(dir / "one" / "history.csv");
+  ASSERT_EQ(one.size(), 88u);  // (the header and 87 rows: 15 425 steps of filling, 6 000 more)
+  EXPECT_GT(std::stoi(one.back().substr(0, one.back().find(','))), 100);
+  std::string err;
+  for (const std::string np : {"2", "3"}) {
+    const fs::path out = dir / ("p" + np);
+    ASSERT_EQ(run(kMpirun + np + " " + kExe + args + out.string(), &err), 0) << err;
+    expect_same_run(dir / "one" / "fill_drain.h5", out / "fill_drain.h5");
+    EXPECT_EQ(removal_columns(out / "history.csv"), one) << np << " processes";
+  }
+  const fs::path resumed = dir / "two_then_one";
+  ASSERT_TRUE(gs::test::stop_at_checkpoint(words(kMpirun + "2 " + kExe + args + resumed.string()),
+                                           resumed, 8000, SIGTERM))
+      << "the run ended before it could be stopped";
+  wait_unlocked(resumed);
+  ASSERT_EQ(run(kExe + args + resumed.string() + " --resume", &err), 0) << err;
+  expect_same_run(dir / "one" / "fill_drain.h5", resumed / "fill_drain.h5");
+  EXPECT_EQ(removal_columns(resumed / "history.csv"), one);
+}
+
 // The shared YADE facet silo (tests/data/yade_facets: 1 000 spheres discharging from a 48-facet
 // silo with a saw-tooth wall, YADE's facets: a wall per triangle, facet pairs deferred while
 // provably apart) with a frame every 10 steps, 2 000 steps. Each frame gathers the whole
@@ -627,9 +666,10 @@ TEST(Mpi, UnsupportedScenesAndBadScenesGiveOneLineAndExit2) {
   const std::string tri = (kScenes / "triaxial.toml").string();
   EXPECT_EQ(
       run(kMpirun + "2 " + kExe + " simulate " + tri + " -q -o " + (dir / "t").string(), &err), 2);
-  EXPECT_EQ(err.substr(0, err.find('\n') + 1),
-            "error: " + tri +
-                ": under mpirun only plain scenes run yet (no scene.test, no [fill]) (triaxial)\n");
+  EXPECT_EQ(
+      err.substr(0, err.find('\n') + 1),
+      "error: " + tri +
+          ": under mpirun only plain scenes and fillings run yet (no scene.test) (triaxial)\n");
   const fs::path bad = dir / "bad.toml";
   {
     std::ofstream o(bad);
