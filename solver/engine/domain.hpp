@@ -41,6 +41,9 @@ class Domain {
   /// Values each process set for its own bodies, zero elsewhere, to every process: an
   /// element-wise sum over processes, exact (every entry is non-zero on one process at most).
   virtual void share(std::vector<double>& values) = 0;
+  /// Each process's `sums` replaced by their sums over processes, added in process order (the
+  /// same bits on every process).
+  virtual void add_over_processes(std::vector<double>& sums) = 0;
 };
 
 }  // namespace gs::solver

@@ -242,25 +242,64 @@ void Simulation::share_all_states() {
   if (domain_) domain_->rebuild(*this);
 }
 
-double Simulation::owned_sum(const std::function<double(std::size_t)>& particle,
-                             const std::function<double(std::size_t)>& clump) const {
-  const std::size_t n = p_.size(), nc = clumps_.size();
-  double sum = 0;
-  if (!domain_) {
-    for (std::size_t i = 0; i < n; ++i) sum += particle(i);
-    for (std::size_t k = 0; k < nc; ++k) sum += clump(k);
+std::vector<double> Simulation::owned_sums(
+    int count, const std::function<void(std::size_t, double*)>& particle,
+    const std::function<void(std::size_t, double*)>& clump, bool exact) const {
+  const std::size_t n = p_.size(), nc = clumps_.size(), m = static_cast<std::size_t>(count);
+  std::vector<double> sum(m, 0.0), t(m);
+  if (domain_ && !exact) {
+    for (std::size_t i = 0; i < n; ++i)
+      if (roles_.empty() || roles_[i] == kOwned) {
+        particle(i, t.data());
+        for (std::size_t j = 0; j < m; ++j) sum[j] += t[j];
+      }
+    std::vector<double> every(m, 0.0);  // (a clump without members: every process's alike)
+    for (std::size_t k = 0; k < nc; ++k) {
+      const bool none = clumps_[k].members.empty();
+      if (!none && !clump_owned(k)) continue;
+      clump(k, t.data());
+      for (std::size_t j = 0; j < m; ++j) (none ? every : sum)[j] += t[j];
+    }
+    domain_->add_over_processes(sum);
+    for (std::size_t j = 0; j < m; ++j) sum[j] += every[j];
     return sum;
   }
-  // (x + 0 = x: the shared values are the owners' to the bit, and the sum the same as above)
-  std::vector<double> v(n + nc, 0.0);
+  if (!domain_) {
+    for (std::size_t i = 0; i < n; ++i) {
+      particle(i, t.data());
+      for (std::size_t j = 0; j < m; ++j) sum[j] += t[j];
+    }
+    for (std::size_t k = 0; k < nc; ++k) {
+      clump(k, t.data());
+      for (std::size_t j = 0; j < m; ++j) sum[j] += t[j];
+    }
+    return sum;
+  }
+  // Term j of body b at v[j·(n + nc) + b], zero for the bodies of other processes (x + 0 = x:
+  // the shared terms are the owners' to the bit, and the sums the same as above).
+  const std::size_t nb = n + nc;
+  std::vector<double> v(m * nb, 0.0);
+  auto put = [&](std::size_t b) {
+    for (std::size_t j = 0; j < m; ++j) v[j * nb + b] = t[j];
+  };
   for (std::size_t i = 0; i < n; ++i)
-    if (roles_.empty() || roles_[i] == kOwned) v[i] = particle(i);
+    if (roles_.empty() || roles_[i] == kOwned) {
+      particle(i, t.data());
+      put(i);
+    }
   for (std::size_t k = 0; k < nc; ++k)
-    if (!clumps_[k].members.empty() && clump_owned(k)) v[n + k] = clump(k);
+    if (!clumps_[k].members.empty() && clump_owned(k)) {
+      clump(k, t.data());
+      put(n + k);
+    }
   domain_->share(v);
   for (std::size_t k = 0; k < nc; ++k)  // (a clump without members is every process's alike)
-    if (clumps_[k].members.empty()) v[n + k] = clump(k);
-  for (const double x : v) sum += x;
+    if (clumps_[k].members.empty()) {
+      clump(k, t.data());
+      put(n + k);
+    }
+  for (std::size_t j = 0; j < m; ++j)
+    for (std::size_t b = 0; b < nb; ++b) sum[j] += v[j * nb + b];
   return sum;
 }
 

@@ -255,12 +255,20 @@ class Simulation {
   /// every process holds every particle's present state, for a programme that reads the whole
   /// assembly (a filling placing a layer). Nothing without a domain.
   void share_all_states();
-  /// Σ particle(i) over the particles, then Σ clump(k) over the clumps, added in index order:
-  /// the sum one process computes, and the same bits on every process of a domain. Each
-  /// process calls the functions for its own bodies only (every body without a domain); the
-  /// values travel to every process (Domain::share) and are added there. Collective.
-  double owned_sum(const std::function<double(std::size_t)>& particle,
-                   const std::function<double(std::size_t)>& clump) const;
+  /// `count` sums, each Σ over the particles then over the clumps of the terms particle(i, t)
+  /// and clump(k, t) write (t[0 … count − 1]), added in index order: the sums one process
+  /// computes, and the same bits on every process of a domain. Each process calls the
+  /// functions for its own bodies only (every body without a domain); the terms travel to
+  /// every process (one Domain::share for all the sums) and are added there. Collective.
+  /// `exact` false: under a domain, each process adds its own bodies' terms and the sums are
+  /// added over processes (Domain::add_over_processes): within round-off of the exact sums, the
+  /// same bits on every process, for a few bytes instead of every body's terms.
+  std::vector<double> owned_sums(int count,
+                                 const std::function<void(std::size_t, double*)>& particle,
+                                 const std::function<void(std::size_t, double*)>& clump,
+                                 bool exact = true) const;
+  /// Whether a domain decomposition steps this simulation.
+  bool decomposed() const { return domain_ != nullptr; }
   /// This simulation becomes `earlier` (a copy taken before), all but its energy ledger, which
   /// stays as it is now (a domain's process 0 steps on as it was before an output that gathered
   /// the whole assembly into it, with the ledger's sums of that output).

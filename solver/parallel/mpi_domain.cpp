@@ -587,6 +587,17 @@ void MpiDomain::share(std::vector<double>& values) {
         "allreduce");
 }
 
+void MpiDomain::add_over_processes(std::vector<double>& sums) {
+  const std::size_t m = sums.size();
+  std::vector<double> all(m * static_cast<std::size_t>(size_));
+  check(MPI_Allgather(sums.data(), static_cast<int>(m), MPI_DOUBLE, all.data(), static_cast<int>(m),
+                      MPI_DOUBLE, comm_),
+        "allgather");
+  std::fill(sums.begin(), sums.end(), 0.0);
+  for (int r = 0; r < size_; ++r)
+    for (std::size_t j = 0; j < m; ++j) sums[j] += all[static_cast<std::size_t>(r) * m + j];
+}
+
 void MpiDomain::gather(Simulation& sim) {
   if (rank_ == 0) stepping_ = std::make_unique<Simulation>(sim);  // (release() puts it back)
   ParticleState& p = sim.particles();

@@ -82,6 +82,7 @@ class MpiDomain : public Domain {
   void agree(double& max_overlap_ratio, bool& finite) override;
   void exchange(Simulation& sim) override;
   void share(std::vector<double>& values) override;
+  void add_over_processes(std::vector<double>& sums) override;
 
  private:
   /// A brick's bounds in the coordinates the bricks cut (±∞, or 0 and 1 in a cell, where a

@@ -1,5 +1,7 @@
 #include "layered_filling.hpp"
 
+#include <tuple>
+
 #include <algorithm>
 #include <cmath>
 #include <random>
@@ -188,25 +190,43 @@ LayeredFilling::LayeredFilling(FillSpec spec, std::uint32_t first_index,
       open_walls_(std::move(open_walls)),
       frame_every_(std::max<std::int64_t>(1, frame_every)) {}
 
-// (Both sums in index order over the bodies, each term from its owner under a domain: the same
+// (The sums in index order over the bodies, each term from its owner under a domain: the same
 // bits on any number of processes, so every process inserts the next layer at the same step.)
+std::pair<double, double> LayeredFilling::energy_and_threshold(const Simulation& sim,
+                                                               bool exact) const {
+  const ParticleState& p = sim.particles();
+  const auto& clumps = sim.clumps();
+  const double g = sim.config().gravity.norm();
+  const std::vector<double> s = sim.owned_sums(
+      2,
+      [&](std::size_t i, double* t) {
+        const bool in = p.removed[i] == 0;
+        t[0] = in && p.clump[i] < 0 ? 0.5 * p.mass[i] * p.vel[i].squaredNorm() : 0.0;
+        t[1] = in ? p.mass[i] * g * 2 * p.radius[i] : 0.0;
+      },
+      [&](std::size_t k, double* t) {
+        t[0] = 0.5 * clumps[k].mass * clumps[k].vel.squaredNorm();
+        t[1] = 0.0;
+      },
+      exact);
+  return {s[0], spec_.kinetic_ratio * s[1]};
+}
+
 double LayeredFilling::settling_energy(const Simulation& sim) {
   const ParticleState& p = sim.particles();
   const auto& clumps = sim.clumps();
-  return sim.owned_sum(
-      [&](std::size_t i) {
-        return p.removed[i] == 0 && p.clump[i] < 0 ? 0.5 * p.mass[i] * p.vel[i].squaredNorm() : 0.0;
+  return sim.owned_sums(
+      1,
+      [&](std::size_t i, double* t) {
+        t[0] = p.removed[i] == 0 && p.clump[i] < 0 ? 0.5 * p.mass[i] * p.vel[i].squaredNorm() : 0.0;
       },
-      [&](std::size_t k) { return 0.5 * clumps[k].mass * clumps[k].vel.squaredNorm(); });
+      [&](std::size_t k, double* t) {
+        t[0] = 0.5 * clumps[k].mass * clumps[k].vel.squaredNorm();
+      })[0];
 }
 
 double LayeredFilling::threshold(const Simulation& sim) const {
-  const ParticleState& p = sim.particles();
-  const double g = sim.config().gravity.norm();
-  const double work = sim.owned_sum(
-      [&](std::size_t i) { return p.removed[i] == 0 ? p.mass[i] * g * 2 * p.radius[i] : 0.0; },
-      [](std::size_t) { return 0.0; });
-  return spec_.kinetic_ratio * work;
+  return energy_and_threshold(sim).second;
 }
 
 void LayeredFilling::insert_layer(Simulation& sim) {
@@ -247,7 +267,13 @@ void LayeredFilling::control(Simulation& sim) {
   if (done_) return;
   const std::int64_t since = sim.step_count() - last_insert_step_;
   if (since < spec_.min_steps) return;
-  const double ek = settling_energy(sim), threshold_J = threshold(sim);
+  // Under a domain the sums per process first (a few bytes; within round-off of the exact
+  // ones, the same on every process): only a layer near its threshold needs the exact sums,
+  // every term shared, for the decision one process makes. (Both are sums of the same positive
+  // terms: they differ by less than N·ε relative, far below the margin.)
+  auto [ek, threshold_J] = energy_and_threshold(sim, !sim.decomposed());
+  if (sim.decomposed() && !(ek > threshold_J * (1 + 1e-6)))
+    std::tie(ek, threshold_J) = energy_and_threshold(sim, true);
   // A layer placed at rest has next to no kinetic energy while it starts to fall: it has
   // settled only once it has moved (its energy went above the threshold) or has had the time
   // to fall through the region's height.

@@ -16,6 +16,7 @@
 #include <cstdint>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "loading_programme.hpp"
@@ -98,6 +99,9 @@ class LayeredFilling final : public LoadingProgramme {
   /// is compared with: Σ ½·m·v² over the free particles and the clumps in the scene.
   double threshold(const Simulation& sim) const;
   static double settling_energy(const Simulation& sim);
+  /// Both at once: {energy, threshold} (one exchange of terms under a domain; `exact` false:
+  /// see Simulation::owned_sums).
+  std::pair<double, double> energy_and_threshold(const Simulation& sim, bool exact = true) const;
 
  private:
   void insert_layer(Simulation& sim);
