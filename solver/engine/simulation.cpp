@@ -247,9 +247,12 @@ std::vector<double> Simulation::owned_sums(
     const std::function<void(std::size_t, double*)>& clump, bool exact) const {
   const std::size_t n = p_.size(), nc = clumps_.size(), m = static_cast<std::size_t>(count);
   std::vector<double> sum(m, 0.0), t(m);
-  if (domain_ && !exact) {
+  // (under a domain without roles, this process holds every state: before the first rebuild,
+  // and process 0 while it holds the whole for output; it adds them alone, as one process)
+  const bool split = domain_ && !roles_.empty();
+  if (split && !exact) {
     for (std::size_t i = 0; i < n; ++i)
-      if (roles_.empty() || roles_[i] == kOwned) {
+      if (roles_[i] == kOwned) {
         particle(i, t.data());
         for (std::size_t j = 0; j < m; ++j) sum[j] += t[j];
       }
@@ -264,7 +267,7 @@ std::vector<double> Simulation::owned_sums(
     for (std::size_t j = 0; j < m; ++j) sum[j] += every[j];
     return sum;
   }
-  if (!domain_) {
+  if (!split) {
     for (std::size_t i = 0; i < n; ++i) {
       particle(i, t.data());
       for (std::size_t j = 0; j < m; ++j) sum[j] += t[j];
@@ -283,7 +286,7 @@ std::vector<double> Simulation::owned_sums(
     for (std::size_t j = 0; j < m; ++j) v[j * nb + b] = t[j];
   };
   for (std::size_t i = 0; i < n; ++i)
-    if (roles_.empty() || roles_[i] == kOwned) {
+    if (roles_[i] == kOwned) {
       particle(i, t.data());
       put(i);
     }

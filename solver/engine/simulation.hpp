@@ -259,7 +259,8 @@ class Simulation {
   /// and clump(k, t) write (t[0 … count − 1]), added in index order: the sums one process
   /// computes, and the same bits on every process of a domain. Each process calls the
   /// functions for its own bodies only (every body without a domain); the terms travel to
-  /// every process (one Domain::share for all the sums) and are added there. Collective.
+  /// every process (one Domain::share for all the sums) and are added there. Collective once
+  /// the domain has set the processes' parts (a process holding every body adds them alone).
   /// `exact` false: under a domain, each process adds its own bodies' terms and the sums are
   /// added over processes (Domain::add_over_processes): within round-off of the exact sums, the
   /// same bits on every process, for a few bytes instead of every body's terms.
