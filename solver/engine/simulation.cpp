@@ -217,8 +217,8 @@ void Simulation::set_outlet(const Eigen::Vector3d& keep_lo, const Eigen::Vector3
 }
 
 void Simulation::remove_outflow() {
-  // (under a domain: this process's own particles, whose states are its to change; the count
-  // waits for count_outflow, where every process holds every state)
+  // (under a domain: this process's own particles, whose states are its to change; they are
+  // counted in count_outflow, where every process holds every state)
   const bool split = !roles_.empty();
   if (split) uncounted_.resize(p_.size(), 0);
   bool any = false;
@@ -235,7 +235,14 @@ void Simulation::remove_outflow() {
     }
     any = true;
   }
-  if (any) invalidate_neighbors();  // (its pairs go with the rebuild before the next step)
+  if (domain_) {
+    // (every process at once, when any process retired one: a rebuild now, where every process
+    // counts the step's removals as one process has just counted them, so that whatever reads
+    // the counts between steps reads the same on every process)
+    if (domain_->stale(any)) domain_->rebuild(*this);
+  } else if (any) {
+    invalidate_neighbors();  // (its pairs go with the rebuild before the next step)
+  }
 }
 
 void Simulation::share_all_states() {

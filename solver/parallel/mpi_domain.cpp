@@ -660,7 +660,6 @@ void MpiDomain::gather(Simulation& sim) {
     const auto i = static_cast<std::size_t>(*x++);
     unpack_state(p, i, x, true);
   }
-  sim.count_outflow();  // (the removals since the last rebuild: process 0 writes them)
   sim.set_roles({});
   sim.rebuild_local(unpack_histories(all_hist), true);
 }

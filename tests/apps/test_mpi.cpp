@@ -517,9 +517,10 @@ void wait_unlocked(const fs::path& dir) {
 
 // An outlet (tests/data/scenes/oedometer_drain.toml: the falling packing drained through a
 // slot in its floor, 67 spheres removed over 3 000 steps, several in one step). Each owner
-// retires its own particles as they leave; the count waits for the next rebuild (or the gather
-// before output), where every process holds every state and counts them in index order as one
-// process does. Two and four processes equal one: particles and contacts to the bit, and the
+// retires its own particles as they leave; the step then ends with a rebuild, where every
+// process holds every state and counts them in index order as one process does (without that
+// count, the test fails: checked). Two and four processes equal one: particles and contacts to
+// the bit, and the
 // removed count and mass of every history row as written. A two-process run stopped after a
 // checkpoint in the middle of the discharge resumes on one process to the uninterrupted run.
 TEST(Mpi, AnOutletRemovesOnEveryProcessAsOnOne) {
