@@ -246,7 +246,7 @@ void Simulation::remove_outflow() {
 }
 
 void Simulation::share_all_states() {
-  if (domain_) domain_->rebuild(*this);
+  if (domain_ && !gathered_) domain_->rebuild(*this);
 }
 
 std::vector<double> Simulation::owned_sums(
@@ -256,7 +256,7 @@ std::vector<double> Simulation::owned_sums(
   std::vector<double> sum(m, 0.0), t(m);
   // (under a domain without roles, this process holds every state: before the first rebuild,
   // and process 0 while it holds the whole for output; it adds them alone, as one process)
-  const bool split = domain_ && !roles_.empty();
+  const bool split = domain_ && !roles_.empty() && !gathered_;
   if (split && !exact) {
     for (std::size_t i = 0; i < n; ++i)
       if (roles_[i] == kOwned) {

@@ -270,6 +270,9 @@ class Simulation {
                                  bool exact = true) const;
   /// Whether a domain decomposition steps this simulation.
   bool decomposed() const { return domain_ != nullptr; }
+  /// While a domain has gathered the whole assembly for output (process 0 holds it), sums are
+  /// this process's own and no collective is made (the others' values are not used).
+  void set_gathered(bool gathered) { gathered_ = gathered; }
   /// This simulation becomes `earlier` (a copy taken before), all but its energy ledger, which
   /// stays as it is now (a domain's process 0 steps on as it was before an output that gathered
   /// the whole assembly into it, with the ledger's sums of that output).
@@ -402,6 +405,7 @@ class Simulation {
   Domain* domain_ = nullptr;
   std::vector<std::uint8_t> roles_;            // ParticleRole per particle; empty: all owned
   std::vector<std::uint8_t> uncounted_;        // retired here by an outlet, not counted yet
+  bool gathered_ = false;                      // set_gathered
   std::vector<std::uint8_t> absent_;           // roles_ == kAbsent (the neighbour list's mask)
   std::vector<Eigen::Vector3d> kept_ref_pos_;  // rebuild_local(…, keep_reference) scratch
   std::pair<std::vector<Eigen::Vector3d>, std::vector<Eigen::Vector3d>> kept_wall_ref_;

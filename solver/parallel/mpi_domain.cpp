@@ -600,6 +600,7 @@ void MpiDomain::add_over_processes(std::vector<double>& sums) {
 
 void MpiDomain::gather(Simulation& sim) {
   if (rank_ == 0) stepping_ = std::make_unique<Simulation>(sim);  // (release() puts it back)
+  sim.set_gathered(true);                                         // (no collective until release)
   ParticleState& p = sim.particles();
   // The owned states with their loads, and the real contacts whose first body is owned here.
   const std::vector<double> states = pack_owned(p, owner_, rank_, true);
@@ -665,8 +666,9 @@ void MpiDomain::gather(Simulation& sim) {
 }
 
 void MpiDomain::release(Simulation& sim) {
+  sim.set_gathered(false);
   if (rank_ != 0 || !stepping_) return;
-  sim.restore_keeping_ledger(std::move(*stepping_));
+  sim.restore_keeping_ledger(std::move(*stepping_));  // (a copy from before the gather)
   stepping_.reset();
 }
 

@@ -315,9 +315,10 @@ RunOutcome run_scene(Scene scene, const RunOptions& a) {
   const bool threads_by_size = scene.config.threads == 0;
   if (threads_by_size)  // "auto"; under mpirun one thread a process (the processes take the cores)
     scene.config.threads = par ? 1 : auto_threads(scene.particles.size());
-  if (par && !scene.test.empty())
+  if (par && !scene.test.empty() && scene.test != "silo")
     throw InputError(scene_file,
-                     "under mpirun only plain scenes and fillings run yet (no scene.test)",
+                     "under mpirun only plain scenes, fillings and the silo run yet (no other "
+                     "scene.test)",
                      scene.test);
   // Where the run stops at the latest: `steps`, or a plain scene's own number of steps.
   std::optional<std::int64_t> stop_at = a.steps;
@@ -377,6 +378,14 @@ RunOutcome run_scene(Scene scene, const RunOptions& a) {
   std::int64_t last_frame_step = -1;
   Index ck;
 
+  // Under a domain decomposition, what reads the whole state runs after a gather (process 0
+  // then holds it) and before the release.
+  auto whole = [&](auto&& fn) {
+    if (!par) return fn();
+    par->gather(sim);
+    fn();
+    par->release(sim);
+  };
   std::int64_t last_curve_step = -1;
   auto curve_for = [&](std::size_t i) -> CsvOutput& {
     return programmes[i]->name() == "preparation" ? prep_curve : curve;
@@ -389,18 +398,10 @@ RunOutcome run_scene(Scene scene, const RunOptions& a) {
   auto curve_row = [&] {
     CsvOutput& c = curve_for(k);
     if (c.open() && last_curve_step != sim.step_count()) {
-      c.append(programmes[k]->curve_row(sim));
+      whole([&] { c.append(programmes[k]->curve_row(sim)); });
       c.flush();  // a few rows per thousand steps: keep them readable while the run goes on
       last_curve_step = sim.step_count();
     }
-  };
-  // Under a domain decomposition, what reads the whole state runs after a gather (process 0
-  // then holds it) and before the release.
-  auto whole = [&](auto&& fn) {
-    if (!par) return fn();
-    par->gather(sim);
-    fn();
-    par->release(sim);
   };
   // The ledger's check on the whole (process 0), its verdict shared by every process.
   auto check_energy = [&] {
@@ -580,7 +581,8 @@ RunOutcome run_scene(Scene scene, const RunOptions& a) {
   try {
     while (!stop_requested) {
       if (programmes[k]->finished(sim)) {
-        const std::string sum = programmes[k]->summary(sim);
+        std::string sum;
+        whole([&] { sum = programmes[k]->summary(sim); });
         if (!sum.empty()) print(sum);
         curve_row();  // the state at the programme's end
         if (k + 1 == programmes.size()) {

@@ -176,6 +176,8 @@ SiloFlow::SiloFlow(SiloSpec spec, SiloWalls walls) : spec_(std::move(spec)), w_(
 }
 
 void SiloFlow::start(Simulation& sim) {
+  // (under a domain: every process reads every particle's state here, as one process does)
+  sim.share_all_states();
   sim.set_damping(spec_.flow_damping);
   reset_rotations(sim);
   t0_ = sim.time();
