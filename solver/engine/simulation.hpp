@@ -255,19 +255,18 @@ class Simulation {
   /// every process holds every particle's present state, for a programme that reads the whole
   /// assembly (a filling placing a layer). Nothing without a domain.
   void share_all_states();
-  /// `count` sums, each Σ over the particles then over the clumps of the terms particle(i, t)
-  /// and clump(k, t) write (t[0 … count − 1]), added in index order: the sums one process
-  /// computes, and the same bits on every process of a domain. Each process calls the
-  /// functions for its own bodies only (every body without a domain); the terms travel to
-  /// every process (one Domain::share for all the sums) and are added there. Collective once
-  /// the domain has set the processes' parts (a process holding every body adds them alone).
+  /// kCount sums, each Σ over the particles then over the clumps of the terms particle(i, t)
+  /// and clump(k, t) write (t[0 … kCount − 1]; callables, inlined: a template), added in index
+  /// order: the sums one process computes, and the same bits on every process of a domain. Each
+  /// process calls the functions for its own bodies only (every body without a domain); the terms
+  /// travel to every process (one Domain::share for all the sums) and are added there. Collective
+  /// once the domain has set the processes' parts (a process holding every body adds them alone).
   /// `exact` false: under a domain, each process adds its own bodies' terms and the sums are
   /// added over processes (Domain::add_over_processes): within round-off of the exact sums, the
   /// same bits on every process, for a few bytes instead of every body's terms.
-  std::vector<double> owned_sums(int count,
-                                 const std::function<void(std::size_t, double*)>& particle,
-                                 const std::function<void(std::size_t, double*)>& clump,
-                                 bool exact = true) const;
+  template <int kCount, class Particle, class Clump>
+  std::array<double, kCount> owned_sums(Particle&& particle, Clump&& clump,
+                                        bool exact = true) const;
   /// Whether a domain decomposition steps this simulation.
   bool decomposed() const { return domain_ != nullptr; }
   /// While a domain has gathered the whole assembly for output (process 0 holds it), sums are
@@ -404,8 +403,6 @@ class Simulation {
   ParticleState p_;
   Domain* domain_ = nullptr;
   std::vector<std::uint8_t> roles_;            // ParticleRole per particle; empty: all owned
-  std::vector<std::uint8_t> uncounted_;        // retired here by an outlet, not counted yet
-  bool gathered_ = false;                      // set_gathered
   std::vector<std::uint8_t> absent_;           // roles_ == kAbsent (the neighbour list's mask)
   std::vector<Eigen::Vector3d> kept_ref_pos_;  // rebuild_local(…, keep_reference) scratch
   std::pair<std::vector<Eigen::Vector3d>, std::vector<Eigen::Vector3d>> kept_wall_ref_;
@@ -489,6 +486,78 @@ class Simulation {
   std::int64_t wall_id_base_ = 0;
   EnergyLedger ledger_;
   bool ledger_started_ = false;
+  bool gathered_ = false;                // set_gathered
+  std::vector<std::uint8_t> uncounted_;  // retired here by an outlet, not counted yet
 };
+
+// (Simulation::owned_sums: a template, so that one process's sums stay plain loops.)
+template <int kCount, class Particle, class Clump>
+std::array<double, kCount> Simulation::owned_sums(Particle&& particle, Clump&& clump,
+                                                  bool exact) const {
+  constexpr auto m = static_cast<std::size_t>(kCount);
+  const std::size_t n = p_.size(), nc = clumps_.size();
+  std::array<double, kCount> sum{}, t{};
+  auto add = [&](std::array<double, kCount>& to) {
+    for (std::size_t j = 0; j < m; ++j) to[j] += t[j];
+  };
+  // (under a domain without roles, this process holds every state: before the first rebuild,
+  // and process 0 while it holds the whole for output; it adds them alone, as one process)
+  const bool split = domain_ && !roles_.empty() && !gathered_;
+  if (!split) {
+    for (std::size_t i = 0; i < n; ++i) {
+      particle(i, t.data());
+      add(sum);
+    }
+    for (std::size_t k = 0; k < nc; ++k) {
+      clump(k, t.data());
+      add(sum);
+    }
+    return sum;
+  }
+  if (!exact) {
+    for (std::size_t i = 0; i < n; ++i)
+      if (roles_[i] == kOwned) {
+        particle(i, t.data());
+        add(sum);
+      }
+    std::array<double, kCount> every{};  // (a clump without members: every process's alike)
+    for (std::size_t k = 0; k < nc; ++k) {
+      const bool none = clumps_[k].members.empty();
+      if (!none && !clump_owned(k)) continue;
+      clump(k, t.data());
+      add(none ? every : sum);
+    }
+    std::vector<double> over(sum.begin(), sum.end());
+    domain_->add_over_processes(over);
+    for (std::size_t j = 0; j < m; ++j) sum[j] = over[j] + every[j];
+    return sum;
+  }
+  // Term j of body b at v[j·(n + nc) + b], zero for the bodies of other processes (x + 0 = x:
+  // the shared terms are the owners' to the bit, and the sums the same as above).
+  const std::size_t nb = n + nc;
+  std::vector<double> v(m * nb, 0.0);
+  auto put = [&](std::size_t b) {
+    for (std::size_t j = 0; j < m; ++j) v[j * nb + b] = t[j];
+  };
+  for (std::size_t i = 0; i < n; ++i)
+    if (roles_[i] == kOwned) {
+      particle(i, t.data());
+      put(i);
+    }
+  for (std::size_t k = 0; k < nc; ++k)
+    if (!clumps_[k].members.empty() && clump_owned(k)) {
+      clump(k, t.data());
+      put(n + k);
+    }
+  domain_->share(v);
+  for (std::size_t k = 0; k < nc; ++k)  // (a clump without members is every process's alike)
+    if (clumps_[k].members.empty()) {
+      clump(k, t.data());
+      put(n + k);
+    }
+  for (std::size_t j = 0; j < m; ++j)
+    for (std::size_t b = 0; b < nb; ++b) sum[j] += v[j * nb + b];
+  return sum;
+}
 
 }  // namespace gs::solver

@@ -197,8 +197,7 @@ std::pair<double, double> LayeredFilling::energy_and_threshold(const Simulation&
   const ParticleState& p = sim.particles();
   const auto& clumps = sim.clumps();
   const double g = sim.config().gravity.norm();
-  const std::vector<double> s = sim.owned_sums(
-      2,
+  const auto s = sim.owned_sums<2>(
       [&](std::size_t i, double* t) {
         const bool in = p.removed[i] == 0;
         t[0] = in && p.clump[i] < 0 ? 0.5 * p.mass[i] * p.vel[i].squaredNorm() : 0.0;
@@ -215,8 +214,7 @@ std::pair<double, double> LayeredFilling::energy_and_threshold(const Simulation&
 double LayeredFilling::settling_energy(const Simulation& sim) {
   const ParticleState& p = sim.particles();
   const auto& clumps = sim.clumps();
-  return sim.owned_sums(
-      1,
+  return sim.owned_sums<1>(
       [&](std::size_t i, double* t) {
         t[0] = p.removed[i] == 0 && p.clump[i] < 0 ? 0.5 * p.mass[i] * p.vel[i].squaredNorm() : 0.0;
       },
