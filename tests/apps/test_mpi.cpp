@@ -515,6 +515,35 @@ void wait_unlocked(const fs::path& dir) {
   }
 }
 
+/// A scene with an outlet on one process, then on each of `processes`, then on two stopped
+/// at the checkpoint at or past `stop_step` and resumed on one: every run equals the first,
+/// particles and contacts to the bit and the history's removal columns as written. Returns
+/// the first run's removal columns (the header first).
+std::vector<std::string> removals_as_on_one(const gs::test::ScratchDir& dir,
+                                            const std::string& scene, const std::string& h5,
+                                            const std::vector<std::string>& processes,
+                                            long stop_step) {
+  const std::string args = " simulate " + scene + " -q --threads 1 -o ";
+  std::string err;
+  EXPECT_EQ(run(kExe + args + (dir / "one").string(), &err), 0) << err;
+  const auto one = removal_columns(dir / "one" / "history.csv");
+  for (const std::string& np : processes) {
+    const fs::path out = dir / ("p" + np);
+    EXPECT_EQ(run(kMpirun + np + " " + kExe + args + out.string(), &err), 0) << err;
+    expect_same_run(dir / "one" / h5, out / h5);
+    EXPECT_EQ(removal_columns(out / "history.csv"), one) << np << " processes";
+  }
+  const fs::path resumed = dir / "two_then_one";
+  EXPECT_TRUE(gs::test::stop_at_checkpoint(words(kMpirun + "2 " + kExe + args + resumed.string()),
+                                           resumed, stop_step, SIGTERM))
+      << "the run ended before it could be stopped";
+  wait_unlocked(resumed);
+  EXPECT_EQ(run(kExe + args + resumed.string() + " --resume", &err), 0) << err;
+  expect_same_run(dir / "one" / h5, resumed / h5);
+  EXPECT_EQ(removal_columns(resumed / "history.csv"), one);
+  return one;
+}
+
 // An outlet (tests/data/scenes/oedometer_drain.toml: the falling packing drained through a
 // slot in its floor, 67 spheres removed over 3 000 steps, several in one step). Each owner
 // retires its own particles as they leave; the step then ends with a rebuild, where every
@@ -526,27 +555,10 @@ void wait_unlocked(const fs::path& dir) {
 TEST(Mpi, AnOutletRemovesOnEveryProcessAsOnOne) {
   if (!mpirun_present()) GTEST_SKIP() << "mpirun not installed (apt-get install openmpi-bin)";
   gs::test::ScratchDir dir("mpi_outlet");
-  const std::string scene = (kData / "scenes" / "oedometer_drain.toml").string();
-  const std::string args = " simulate " + scene + " -q --threads 1 -o ";
-  ASSERT_EQ(run(kExe + args + (dir / "one").string()), 0);
-  const auto one = removal_columns(dir / "one" / "history.csv");
+  const auto one = removals_as_on_one(dir, (kData / "scenes" / "oedometer_drain.toml").string(),
+                                      "oedometer_drain.h5", {"2", "4"}, 4000);
   ASSERT_EQ(one.size(), 62u);  // (the header and 61 rows)
   EXPECT_EQ(one.back().substr(0, one.back().find(',')), "67");
-  std::string err;
-  for (const std::string np : {"2", "4"}) {
-    const fs::path out = dir / ("p" + np);
-    ASSERT_EQ(run(kMpirun + np + " " + kExe + args + out.string(), &err), 0) << err;
-    expect_same_run(dir / "one" / "oedometer_drain.h5", out / "oedometer_drain.h5");
-    EXPECT_EQ(removal_columns(out / "history.csv"), one) << np << " processes";
-  }
-  const fs::path resumed = dir / "two_then_one";
-  ASSERT_TRUE(gs::test::stop_at_checkpoint(words(kMpirun + "2 " + kExe + args + resumed.string()),
-                                           resumed, 4000, SIGTERM))
-      << "the run ended before it could be stopped";
-  wait_unlocked(resumed);
-  ASSERT_EQ(run(kExe + args + resumed.string() + " --resume", &err), 0) << err;
-  expect_same_run(dir / "one" / "oedometer_drain.h5", resumed / "oedometer_drain.h5");
-  EXPECT_EQ(removal_columns(resumed / "history.csv"), one);
 }
 
 // A filling and an outlet (tests/data/scenes/fill_drain.toml: three layers of 200 spheres
@@ -565,27 +577,10 @@ TEST(Mpi, AnOutletRemovesOnEveryProcessAsOnOne) {
 TEST(Mpi, AFillingAndAnOutletRunAsOnOneProcess) {
   if (!mpirun_present()) GTEST_SKIP() << "mpirun not installed (apt-get install openmpi-bin)";
   gs::test::ScratchDir dir("mpi_fill");
-  const std::string scene = (kData / "scenes" / "fill_drain.toml").string();
-  const std::string args = " simulate " + scene + " -q --threads 1 -o ";
-  ASSERT_EQ(run(kExe + args + (dir / "one").string()), 0);
-  const auto one = removal_columns(dir / "one" / "history.csv");
+  const auto one = removals_as_on_one(dir, (kData / "scenes" / "fill_drain.toml").string(),
+                                      "fill_drain.h5", {"2", "3"}, 8000);
   ASSERT_EQ(one.size(), 88u);  // (the header and 87 rows: 15 425 steps of filling, 6 000 more)
   EXPECT_GT(std::stoi(one.back().substr(0, one.back().find(','))), 100);
-  std::string err;
-  for (const std::string np : {"2", "3"}) {
-    const fs::path out = dir / ("p" + np);
-    ASSERT_EQ(run(kMpirun + np + " " + kExe + args + out.string(), &err), 0) << err;
-    expect_same_run(dir / "one" / "fill_drain.h5", out / "fill_drain.h5");
-    EXPECT_EQ(removal_columns(out / "history.csv"), one) << np << " processes";
-  }
-  const fs::path resumed = dir / "two_then_one";
-  ASSERT_TRUE(gs::test::stop_at_checkpoint(words(kMpirun + "2 " + kExe + args + resumed.string()),
-                                           resumed, 8000, SIGTERM))
-      << "the run ended before it could be stopped";
-  wait_unlocked(resumed);
-  ASSERT_EQ(run(kExe + args + resumed.string() + " --resume", &err), 0) << err;
-  expect_same_run(dir / "one" / "fill_drain.h5", resumed / "fill_drain.h5");
-  EXPECT_EQ(removal_columns(resumed / "history.csv"), one);
 }
 
 // Seed 004's silo programme (tests/data/scenes/silo_tiny.toml: two layers of 150 spheres
