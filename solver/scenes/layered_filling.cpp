@@ -192,6 +192,16 @@ LayeredFilling::LayeredFilling(FillSpec spec, std::uint32_t first_index,
 
 // (The sums in index order over the bodies, each term from its owner under a domain: the same
 // bits on any number of processes, so every process inserts the next layer at the same step.)
+namespace {
+// The settling sums' terms: a free body's translational kinetic energy (in the scene).
+double kinetic_term(const ParticleState& p, std::size_t i) {
+  return p.removed[i] == 0 && p.clump[i] < 0 ? 0.5 * p.mass[i] * p.vel[i].squaredNorm() : 0.0;
+}
+double kinetic_term(const ClumpBody& c) {
+  return 0.5 * c.mass * c.vel.squaredNorm();
+}
+}  // namespace
+
 std::pair<double, double> LayeredFilling::energy_and_threshold(const Simulation& sim,
                                                                bool exact) const {
   const ParticleState& p = sim.particles();
@@ -199,12 +209,11 @@ std::pair<double, double> LayeredFilling::energy_and_threshold(const Simulation&
   const double g = sim.config().gravity.norm();
   const auto s = sim.owned_sums<2>(
       [&](std::size_t i, double* t) {
-        const bool in = p.removed[i] == 0;
-        t[0] = in && p.clump[i] < 0 ? 0.5 * p.mass[i] * p.vel[i].squaredNorm() : 0.0;
-        t[1] = in ? p.mass[i] * g * 2 * p.radius[i] : 0.0;
+        t[0] = kinetic_term(p, i);
+        t[1] = p.removed[i] == 0 ? p.mass[i] * g * 2 * p.radius[i] : 0.0;
       },
       [&](std::size_t k, double* t) {
-        t[0] = 0.5 * clumps[k].mass * clumps[k].vel.squaredNorm();
+        t[0] = kinetic_term(clumps[k]);
         t[1] = 0.0;
       },
       exact);
@@ -214,13 +223,8 @@ std::pair<double, double> LayeredFilling::energy_and_threshold(const Simulation&
 double LayeredFilling::settling_energy(const Simulation& sim) {
   const ParticleState& p = sim.particles();
   const auto& clumps = sim.clumps();
-  return sim.owned_sums<1>(
-      [&](std::size_t i, double* t) {
-        t[0] = p.removed[i] == 0 && p.clump[i] < 0 ? 0.5 * p.mass[i] * p.vel[i].squaredNorm() : 0.0;
-      },
-      [&](std::size_t k, double* t) {
-        t[0] = 0.5 * clumps[k].mass * clumps[k].vel.squaredNorm();
-      })[0];
+  return sim.owned_sums<1>([&](std::size_t i, double* t) { t[0] = kinetic_term(p, i); },
+                           [&](std::size_t k, double* t) { t[0] = kinetic_term(clumps[k]); })[0];
 }
 
 double LayeredFilling::threshold(const Simulation& sim) const {
