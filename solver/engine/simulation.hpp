@@ -278,10 +278,10 @@ class Simulation {
   void restore_keeping_ledger(Simulation&& earlier);
   /// Under a domain, an outlet's removals are counted here, in index order as one process
   /// counts them, where a process holds every particle's current state (a domain's rebuild,
-  /// which ends every step that removed a particle anywhere, and its gather on the process that
-  /// writes). Each owner retires its own particles as they leave (their kinetic energy to its
-  /// ledger's outflow, the count left for this call); any other particle found outside the kept
-  /// box was retired by its owner on the same bits, and is retired here too.
+  /// which ends every step that removed a particle anywhere). Each owner retires its own particles
+  /// as they leave (their kinetic energy to its ledger's outflow, the count left for this call);
+  /// any other particle found outside the kept box was retired by its owner on the same bits, and
+  /// is retired here too.
   void count_outflow();
   /// The part of the scene this process steps: per particle a ParticleRole. Pairs are kept
   /// where at least one body is owned; only owned particles are integrated and counted in the
