@@ -218,7 +218,9 @@ void run_mpi(const Args& a) {
   Args mine = a;
   if (!root) {
     // The other processes run the same loop, writing to a scratch directory (resuming from a
-    // copy of process 0's).
+    // copy of process 0's). Their warnings on std::cerr (a programme's, from the curve rows they
+    // compute on their own part) are process 0's to give: not printed (errors go through fail).
+    std::cerr.rdbuf(nullptr);
     const fs::path out =
         a.out.empty() ? fs::path("out") / solver::load_scene(a.scene).name : fs::path(a.out);
     scratch = fs::temp_directory_path() /

@@ -9,6 +9,14 @@ namespace gs::solver {
 
 MembraneLoads membrane_loads(const ParticleState& p, double y_lo, double y_hi, double z_lo,
                              double z_hi, const MembraneSpec& spec) {
+  return membrane_loads(p.pos, p.radius, y_lo, y_hi, z_lo, z_hi, spec);
+}
+
+MembraneLoads membrane_loads(const std::vector<Eigen::Vector3d>& pos,
+                             const std::vector<double>& radius, double y_lo, double y_hi,
+                             double z_lo, double z_hi, const MembraneSpec& spec) {
+  if (pos.size() != radius.size())
+    throw std::invalid_argument("membrane: positions and radii differ in number");
   if (!(spec.bin_m > 0)) throw std::invalid_argument("membrane bin size must be positive");
   if (!(y_hi > y_lo) || !(z_hi > z_lo)) throw std::invalid_argument("membrane span is empty");
   MembraneLoads out;
@@ -23,9 +31,10 @@ MembraneLoads membrane_loads(const ParticleState& p, double y_lo, double y_hi, d
   out.x_plus.assign(nb, nan);
   std::vector<std::uint32_t> hit_minus(nb, none), hit_plus(nb, none);
   // First sphere along each ray from either side: per sphere, the rays through its disc.
-  for (std::size_t i = 0; i < p.size(); ++i) {
-    const Eigen::Vector3d& c = p.pos[i];
-    const double r = p.radius[i];
+  const std::size_t n = pos.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    const Eigen::Vector3d& c = pos[i];
+    const double r = radius[i];
     const int j0 = std::max(0, static_cast<int>(std::ceil((c.y() - r - y_lo) / dy - 0.5)));
     const int j1 =
         std::min(out.ny - 1, static_cast<int>(std::floor((c.y() + r - y_lo) / dy - 0.5)));
@@ -68,8 +77,8 @@ MembraneLoads membrane_loads(const ParticleState& p, double y_lo, double y_hi, d
     const double g = (xb - xa) / ((b - a) * (along_y ? dy : dz));
     return std::clamp(g, -1.0, 1.0);
   };
-  std::vector<Eigen::Vector3d> load(p.size(), Eigen::Vector3d::Zero());
-  std::vector<std::uint8_t> loaded(p.size(), 0);
+  std::vector<Eigen::Vector3d> load(n, Eigen::Vector3d::Zero());
+  std::vector<std::uint8_t> loaded(n, 0);
   const double f = spec.pressure_Pa * out.bin_area_m2;
   for (int k = 0; k < out.nz; ++k) {
     for (int j = 0; j < out.ny; ++j) {
@@ -92,7 +101,7 @@ MembraneLoads membrane_loads(const ParticleState& p, double y_lo, double y_hi, d
       out.volume_m3 += (out.x_plus[b] - out.x_minus[b]) * out.bin_area_m2;
     }
   }
-  for (std::size_t i = 0; i < p.size(); ++i) {
+  for (std::size_t i = 0; i < n; ++i) {
     if (!loaded[i]) continue;
     out.particle.push_back(static_cast<std::uint32_t>(i));
     out.force.push_back(load[i]);

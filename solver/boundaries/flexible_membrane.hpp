@@ -42,5 +42,9 @@ struct MembraneLoads {
 /// Loads of the two membranes normal to x over y ∈ [y_lo, y_hi], z ∈ [z_lo, z_hi].
 MembraneLoads membrane_loads(const ParticleState& p, double y_lo, double y_hi, double z_lo,
                              double z_hi, const MembraneSpec& spec);
+/// The same from the spheres' centres and radii.
+MembraneLoads membrane_loads(const std::vector<Eigen::Vector3d>& pos,
+                             const std::vector<double>& radius, double y_lo, double y_hi,
+                             double z_lo, double z_hi, const MembraneSpec& spec);
 
 }  // namespace gs::solver

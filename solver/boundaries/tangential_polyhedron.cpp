@@ -222,9 +222,11 @@ Eigen::Matrix3d stress_within(const Simulation& sim, std::size_t first,
   Eigen::Matrix3d m = sim.wall_contact_moment(first, P.faces.size());
   const auto& p = sim.particles();
   const Eigen::Vector3d g = sim.config().gravity;
-  if (g.squaredNorm() > 0.0)
-    for (std::size_t k = 0; k < p.pos.size(); ++k)
-      if (!p.removed[k]) m += p.pos[k] * (p.mass[k] * g).transpose();
+  if (g.squaredNorm() > 0.0) {
+    const std::vector<Eigen::Vector3d> x = sim.present_positions();  // (under a domain: shared)
+    for (std::size_t k = 0; k < x.size(); ++k)
+      if (!p.removed[k]) m += x[k] * (p.mass[k] * g).transpose();
+  }
   return -m / v;
 }
 

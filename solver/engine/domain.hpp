@@ -27,8 +27,11 @@ class Domain {
   /// The neighbour-list rebuild: particles migrate to their new owners, roles are set, the list
   /// is rebuilt (Simulation::rebuild_local) with the contact histories other processes held.
   virtual void rebuild(Simulation& sim) = 0;
-  /// The walls' loads summed over processes (each process summed its own particles' contacts).
-  virtual void reduce_walls(std::vector<WallState>& walls) = 0;
+  /// The walls' loads summed over processes (each process summed its own particles' contacts),
+  /// the same bits on every process: where Simulation::exact_wall_loads(), every process's wall
+  /// contacts merged in pair order and summed in it, the sums one process forms
+  /// (Simulation::wall_load_records); else each process's sums added in process order.
+  virtual void reduce_walls(Simulation& sim) = 0;
   /// A periodic cell's stress (and affine stiffness, if not null) summed over processes, each
   /// having summed its owned contacts (before the division by the volume).
   virtual void reduce_cell(Eigen::Matrix3d& stress, Eigen::Vector3d* stiffness) = 0;
@@ -44,6 +47,18 @@ class Domain {
   /// Each process's `sums` replaced by their sums over processes, added in process order (the
   /// same bits on every process).
   virtual void add_over_processes(std::vector<double>& sums) = 0;
+  /// Process 0's simulation then holds the whole assembly (every particle's state and loads,
+  /// every contact), as one process's would; the others keep theirs. release() undoes it.
+  virtual void gather(Simulation& sim) = 0;
+  /// Whether this is process 0, the one that holds the whole after gather().
+  virtual bool root() const = 0;
+  virtual void release(Simulation& sim) = 0;
+  /// Process 0's `values` (any length) to every process.
+  virtual void broadcast(std::vector<double>& values) = 0;
+  /// Every process's records (`size` doubles each, the first a particle index, in this
+  /// process's pair order) to every process, merged in pair order: sorted by the particle,
+  /// stably (a particle's records all come from one process, its owner).
+  virtual std::vector<double> merge_records(const std::vector<double>& mine, std::size_t size) = 0;
 };
 
 }  // namespace gs::solver

@@ -249,6 +249,31 @@ void Simulation::share_all_states() {
   if (domain_ && !gathered_) domain_->rebuild(*this);
 }
 
+std::vector<double> Simulation::on_whole(
+    const std::function<std::vector<double>(Simulation&)>& fn) {
+  if (!domain_ || gathered_) return fn(*this);
+  domain_->gather(*this);
+  std::vector<double> values;
+  if (domain_->root()) values = fn(*this);  // (process 0 holds the whole)
+  domain_->release(*this);
+  domain_->broadcast(values);
+  return values;
+}
+
+std::vector<Eigen::Vector3d> Simulation::present_positions() const {
+  const std::size_t n = p_.size();
+  if (!domain_ || gathered_ || roles_.empty()) return p_.pos;
+  std::vector<double> v(3 * n, 0.0);
+  for (std::size_t i = 0; i < n; ++i)
+    if (roles_[i] == kOwned && !p_.removed[i])
+      for (int k = 0; k < 3; ++k) v[3 * i + static_cast<std::size_t>(k)] = p_.pos[i][k];
+  domain_->share(v);
+  std::vector<Eigen::Vector3d> x(n);
+  for (std::size_t i = 0; i < n; ++i)  // (a removed particle lies where it left, on every process)
+    x[i] = p_.removed[i] ? p_.pos[i] : Eigen::Vector3d(v[3 * i], v[3 * i + 1], v[3 * i + 2]);
+  return x;
+}
+
 void Simulation::restore_keeping_ledger(Simulation&& earlier) {
   const EnergyLedger ledger = ledger_;
   const bool started = ledger_started_;
@@ -993,6 +1018,72 @@ void Simulation::accumulate_walls() {
     if (active_[k]) add(k, loads_[load_slot_[k]]);
 }
 
+std::vector<double> Simulation::wall_load_records() const {
+  std::vector<double> out;
+  auto put = [&](std::uint32_t k, const ContactLoads& L) {
+    const auto [a, b] = nl_.pairs[k];
+    const bool facet = facet_forces_ && !walls_[b - kWallBase].facet_force.empty();
+    const double r[kWallRecord] = {static_cast<double>(a),
+                                   static_cast<double>(b - kWallBase),
+                                   params_[k].kn,
+                                   L.force1.x,
+                                   L.force1.y,
+                                   L.force1.z,
+                                   L.arm1.x,
+                                   L.arm1.y,
+                                   L.arm1.z,
+                                   L.moment.x,
+                                   L.moment.y,
+                                   L.moment.z,
+                                   facet ? static_cast<double>(pair_facet_[k]) : -1.0};
+    out.insert(out.end(), r, r + kWallRecord);
+  };
+  // (the pairs accumulate_walls adds, in its order)
+  if (!wall_loads_.empty() || std::max(1, cfg_.threads) == 1) {
+    for (const auto& [k, L] : wall_loads_) put(k, L);
+    return out;
+  }
+  for (const std::uint32_t k : deferred_.empty() ? wall_pairs_ : visit_wall_)
+    if (active_[k]) put(k, loads_[load_slot_[k]]);
+  return out;
+}
+
+void Simulation::sum_wall_load_records(const std::vector<double>& records) {
+  for (WallState& w : walls_) {
+    w.force.setZero();
+    w.torque.setZero();
+    w.contact_stiffness = 0;
+    w.contacts = 0;
+    if (facet_forces_) w.facet_force.assign(w.facets.size(), Eigen::Vector3d::Zero());
+  }
+  // (the operations of accumulate_walls' add, on the same numbers)
+  for (std::size_t j = 0; j + kWallRecord <= records.size(); j += kWallRecord) {
+    const double* r = records.data() + j;
+    WallState& w = walls_.at(static_cast<std::size_t>(r[1]));
+    w.contact_stiffness += r[2];
+    ++w.contacts;
+    for (int c = 0; c < 3; ++c) {
+      w.force[c] += r[3 + c];
+      w.torque[c] += r[6 + c];
+      w.torque[c] += -r[9 + c];
+    }
+    if (r[12] >= 0)
+      for (int c = 0; c < 3; ++c) w.facet_force.at(static_cast<std::size_t>(r[12]))[c] += r[3 + c];
+  }
+}
+
+void Simulation::set_wall_loads(const std::vector<double>& sums) {
+  if (sums.size() != 8 * walls_.size()) throw std::invalid_argument("wall loads: 8 per wall");
+  const double* s = sums.data();
+  for (WallState& w : walls_) {
+    w.force = Eigen::Vector3d(s[0], s[1], s[2]);
+    w.torque = Eigen::Vector3d(s[3], s[4], s[5]);
+    w.contact_stiffness = s[6];
+    w.contacts = static_cast<std::size_t>(s[7]);
+    s += 8;
+  }
+}
+
 [[gnu::always_inline]] inline bool Simulation::prepare_pair(std::size_t k, ContactBatch& B, int j) {
   using F = ContactBatch::Field;
   const ContactHistory& h = hist_[k];
@@ -1555,7 +1646,7 @@ void Simulation::step() {
       if (domain_) {
         zero_all_walls_ = true;  // (a wall loaded elsewhere has loads here after the sum)
         accumulate_walls();
-        domain_->reduce_walls(walls_);
+        domain_->reduce_walls(*this);
       } else {
         accumulate_walls();
       }
@@ -1777,14 +1868,32 @@ double Simulation::inertial_number() const {
 }
 
 Eigen::Matrix3d Simulation::wall_contact_moment(std::size_t first, std::size_t count) const {
+  // Wall pairs: the sphere is the law's body 2 and receives Fn n + Fs (n from the wall to it).
+  auto term = [](const ContactHistory& h) -> Eigen::Matrix3d {
+    return h.point * (h.fn * h.normal + h.shear_force).transpose();
+  };
+  auto mine = [&](const ContactHistory& h) {
+    return h.real && h.b >= kWallBase && h.b - kWallBase >= first &&
+           h.b - kWallBase < first + count;
+  };
   Eigen::Matrix3d m = Eigen::Matrix3d::Zero();
-  for (const auto& h : hist_) {
-    if (!h.real || h.b < kWallBase) continue;
-    const std::size_t w = h.b - kWallBase;
-    if (w < first || w >= first + count) continue;
-    // Wall pairs: the sphere is the law's body 2 and receives Fn n + Fs (n from the wall to it).
-    m += h.point * (h.fn * h.normal + h.shear_force).transpose();
+  if (!domain_ || roles_.empty() || gathered_) {
+    for (const auto& h : hist_)
+      if (mine(h)) m += term(h);
+    return m;
   }
+  // Under a domain (collective): each sphere's wall contacts are its owner's; their terms,
+  // merged in pair order from every process, are added in it, as one process adds them.
+  std::vector<double> records;
+  for (const auto& h : hist_) {
+    if (!mine(h)) continue;
+    const Eigen::Matrix3d t = term(h);
+    records.push_back(static_cast<double>(h.a));
+    records.insert(records.end(), t.data(), t.data() + 9);
+  }
+  const std::vector<double> all = domain_->merge_records(records, 10);
+  for (std::size_t j = 0; j + 10 <= all.size(); j += 10)
+    m += Eigen::Map<const Eigen::Matrix3d>(&all[j + 1]);
   return m;
 }
 
@@ -1857,21 +1966,33 @@ void Simulation::remove_particles(const std::vector<std::size_t>& indices) {
     }
   }
   // The energy they take away: their kinetic energy (a clump's as a rigid body) and the elastic
-  // energy of their contacts, which end now.
+  // energy of their contacts, which end now. (Under a domain every process removes the same
+  // particles, and the energy is counted once: by the owner of a body, or of a contact's first
+  // body, as the ledger's particle terms are; the counts and masses on every process.)
+  const bool split = !roles_.empty();
   for (std::size_t k = 0; k < hist_.size(); ++k) {
     auto& h = hist_[k];
     if (!h.real || !(gone[h.a] || (h.b < kWallBase && gone[h.b]))) continue;
-    ledger_.outflow += contact_elastic_energy(k).sum();
+    if (!split || roles_[h.a] == kOwned) ledger_.outflow += contact_elastic_energy(k).sum();
     h.real = false;
   }
   for (std::size_t c = 0; c < clumps_.size(); ++c) {
     if (!clump_gone[c]) continue;
-    ledger_.outflow += 0.5 * clumps_[c].mass * clumps_[c].vel.squaredNorm() +
-                       0.5 * clumps_[c].angvel.dot(clumps_[c].angmom);
+    if (clump_owned(c))
+      ledger_.outflow += 0.5 * clumps_[c].mass * clumps_[c].vel.squaredNorm() +
+                         0.5 * clumps_[c].angvel.dot(clumps_[c].angmom);
     removed_mass_ += clumps_[c].mass;  // (the clump's, not its members' summed)
   }
-  for (std::size_t i = 0; i < n; ++i)
-    if (gone[i]) retire(i);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!gone[i]) continue;
+    if (!split || roles_[i] == kOwned) {
+      retire(i);
+      continue;
+    }
+    if (p_.clump[i] < 0) removed_mass_ += p_.mass[i];  // (retire's, but for the energy)
+    freeze(i);
+    ++removed_count_;
+  }
   drop_clumps(clump_gone);
   invalidate_neighbors();
 }

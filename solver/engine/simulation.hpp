@@ -233,7 +233,8 @@ class Simulation {
   Eigen::Matrix3d cell_stress() const;
   /// Σ x ⊗ f over the real contacts of the walls first .. first + count - 1: x the contact
   /// point, f the force the wall exerts on the sphere (N·m). The boundary term of seed 003's
-  /// Eq 14 (σ = -(1/v)(Σ x ⊗ F + Σ x ⊗ G), compression positive).
+  /// Eq 14 (σ = -(1/v)(Σ x ⊗ F + Σ x ⊗ G), compression positive). Under a domain
+  /// (collective): the one-process sum, from every process's wall contacts in pair order.
   Eigen::Matrix3d wall_contact_moment(std::size_t first, std::size_t count) const;
   /// The affine stiffness of the contacts along each axis (Pa): K_ii of CellServo.
   Eigen::Vector3d cell_stiffness() const;
@@ -255,6 +256,17 @@ class Simulation {
   /// every process holds every particle's present state, for a programme that reads the whole
   /// assembly (a filling placing a layer). Nothing without a domain.
   void share_all_states();
+  /// What `fn` computes from the whole assembly, on every process: fn(*this) without a domain
+  /// (or while this process holds the whole). Under a domain (collective): the domain gathers
+  /// the whole into process 0, fn runs there on the state one process would hold, and its values
+  /// go to every process. For a programme's decisions on whole-assembly measures (the unbalanced
+  /// force, the energies, a void ratio), taken every so many steps: a gather is the state of
+  /// every particle and contact. fn must not throw (the other processes wait for its values).
+  std::vector<double> on_whole(const std::function<std::vector<double>(Simulation&)>& fn);
+  /// Every particle's present position (as p.pos without a domain, or while this process holds
+  /// the whole). Under a domain (collective): each owner's positions, shared with every process
+  /// (3 doubles per particle), the process's own state left as it is.
+  std::vector<Eigen::Vector3d> present_positions() const;
   /// kCount sums, each Σ over the particles then over the clumps of the terms particle(i, t)
   /// and clump(k, t) write (t[0 … kCount − 1]; callables, inlined: a template), added in index
   /// order: the sums one process computes, and the same bits on every process of a domain. Each
@@ -300,6 +312,25 @@ class Simulation {
   const std::vector<ContactHistory>& histories() const { return hist_; }
   /// The ledger's cumulative terms, for a domain to sum them over processes.
   EnergyLedger& ledger_terms() { return ledger_; }
+  /// Under a domain: whether the walls' loads are summed each step over every process's wall
+  /// contacts in pair order (wall_load_records), the sums one process forms, or per process and
+  /// then over processes (within round-off of them, for fewer bytes and collectives). Exact
+  /// where the run reads them as it steps: a servo wall, or `on` (a programme's control).
+  void set_exact_wall_loads(bool on) { exact_wall_loads_ = on; }
+  bool exact_wall_loads() const { return exact_wall_loads_ || !servo_walls_.empty(); }
+  /// Doubles per wall contact in wall_load_records().
+  static constexpr std::size_t kWallRecord = 13;
+  /// This process's touching wall pairs of the last step, in pair order, each as the terms the
+  /// step adds to its wall's loads: particle, wall, normal stiffness, force (3), arm (3),
+  /// moment (3) and the triangle its force goes to (−1: none). For a domain: every process's
+  /// records merged in pair order are one process's.
+  std::vector<double> wall_load_records() const;
+  /// The walls' loads (force, torque, contact stiffness and count, per-triangle forces) summed
+  /// anew from `records`, in their order, as the step sums its own.
+  void sum_wall_load_records(const std::vector<double>& records);
+  /// The walls' loads set from `sums`, 8 per wall: force (3), torque (3), contact stiffness and
+  /// count (a domain's sums over processes).
+  void set_wall_loads(const std::vector<double>& sums);
   /// The Verlet skin (m).
   double skin() const { return nl_.skin; }
 
@@ -488,6 +519,7 @@ class Simulation {
   bool ledger_started_ = false;
   bool gathered_ = false;                // set_gathered
   std::vector<std::uint8_t> uncounted_;  // retired here by an outlet, not counted yet
+  bool exact_wall_loads_ = false;        // set_exact_wall_loads
 };
 
 // (Simulation::owned_sums: a template, so that one process's sums stay plain loops.)

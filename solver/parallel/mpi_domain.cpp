@@ -443,33 +443,50 @@ void MpiDomain::reduce_cell(Eigen::Matrix3d& stress, Eigen::Vector3d* stiffness)
   if (stiffness) *stiffness = Eigen::Vector3d(s[9], s[10], s[11]);
 }
 
-void MpiDomain::reduce_walls(std::vector<WallState>& walls) {
-  // Each process's sums to all, added in process order: the same bits on every process (the
-  // walls move by them, on every process alike).
-  constexpr int kW = 8;
-  std::vector<double> mine(walls.size() * kW);
-  double* o = mine.data();
-  for (const WallState& w : walls) {
-    put3(o, w.force);
-    put3(o, w.torque);
-    *o++ = w.contact_stiffness;
-    *o++ = static_cast<double>(w.contacts);
-  }
-  std::vector<double> all(mine.size() * static_cast<std::size_t>(size_));
-  check(MPI_Allgather(mine.data(), static_cast<int>(mine.size()), MPI_DOUBLE, all.data(),
-                      static_cast<int>(mine.size()), MPI_DOUBLE, comm_),
-        "allgather");
-  for (std::size_t w = 0; w < walls.size(); ++w) {
-    double s[kW] = {};
+void MpiDomain::reduce_walls(Simulation& sim) {
+  if (!sim.exact_wall_loads()) {
+    // Each process's sums to all, added in process order: the same bits on every process
+    // (within round-off of one process's sums; nothing reads them while the run steps).
+    constexpr int kW = 8;
+    const std::vector<WallState>& walls = sim.walls();
+    std::vector<double> mine(walls.size() * kW);
+    double* o = mine.data();
+    for (const WallState& w : walls) {
+      put3(o, w.force);
+      put3(o, w.torque);
+      *o++ = w.contact_stiffness;
+      *o++ = static_cast<double>(w.contacts);
+    }
+    std::vector<double> all(mine.size() * static_cast<std::size_t>(size_));
+    check(MPI_Allgather(mine.data(), static_cast<int>(mine.size()), MPI_DOUBLE, all.data(),
+                        static_cast<int>(mine.size()), MPI_DOUBLE, comm_),
+          "allgather");
+    std::vector<double> sums(mine.size(), 0.0);
     for (int r = 0; r < size_; ++r)
-      for (int j = 0; j < kW; ++j)
-        s[j] += all[static_cast<std::size_t>(r) * mine.size() + w * kW + j];
-    WallState& ws = walls[w];
-    ws.force = Eigen::Vector3d(s[0], s[1], s[2]);
-    ws.torque = Eigen::Vector3d(s[3], s[4], s[5]);
-    ws.contact_stiffness = s[6];
-    ws.contacts = static_cast<std::size_t>(s[7]);
+      for (std::size_t j = 0; j < mine.size(); ++j)
+        sums[j] += all[static_cast<std::size_t>(r) * mine.size() + j];
+    sim.set_wall_loads(sums);
+    return;
   }
+  // Every process's wall contacts to all, merged in pair order and summed in it: the bits one
+  // process sums, the same on every process (servos and programmes read them; the meshes'
+  // per-triangle forces are summed so too). Per step: the records of the touching wall
+  // contacts, 13 doubles each.
+  sim.sum_wall_load_records(merge_records(sim.wall_load_records(), Simulation::kWallRecord));
+}
+
+std::vector<double> MpiDomain::merge_records(const std::vector<double>& mine, std::size_t size) {
+  halo_bytes_ += mine.size() * sizeof(double) * static_cast<std::size_t>(size_ - 1);
+  const std::vector<double> all = all_gather(comm_, size_, mine);
+  const std::size_t m = all.size() / size;
+  std::vector<std::uint32_t> order(m);
+  for (std::size_t i = 0; i < m; ++i) order[i] = static_cast<std::uint32_t>(i);
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::uint32_t x, std::uint32_t y) { return all[x * size] < all[y * size]; });
+  std::vector<double> merged(all.size());
+  for (std::size_t i = 0; i < m; ++i)
+    std::copy_n(all.data() + order[i] * size, size, merged.data() + i * size);
+  return merged;
 }
 
 void MpiDomain::set_lists(const std::vector<Eigen::Vector3d>& c) {
@@ -598,6 +615,13 @@ void MpiDomain::add_over_processes(std::vector<double>& sums) {
     for (std::size_t j = 0; j < m; ++j) sums[j] += all[static_cast<std::size_t>(r) * m + j];
 }
 
+void MpiDomain::broadcast(std::vector<double>& values) {
+  auto n = static_cast<std::uint64_t>(values.size());
+  check(MPI_Bcast(&n, 1, MPI_UINT64_T, 0, comm_), "bcast");
+  values.resize(static_cast<std::size_t>(n));
+  check(MPI_Bcast(values.data(), static_cast<int>(n), MPI_DOUBLE, 0, comm_), "bcast");
+}
+
 void MpiDomain::gather(Simulation& sim) {
   if (rank_ == 0) stepping_ = std::make_unique<Simulation>(sim);  // (release() puts it back)
   sim.set_gathered(true);                                         // (no collective until release)
@@ -616,25 +640,27 @@ void MpiDomain::gather(Simulation& sim) {
         gather_at_root(comm_, size_, rank_, pack_owned_clumps(sim.clumps(), owner_, rank_));
     if (rank_ == 0) unpack_clumps(sim.clump_states(), all_clumps);
   }
-  // The meshes' per-triangle forces (for output), summed in process order; the step clears
-  // and sums them anew, so process 0's own part need not be kept.
-  std::vector<double> facets;
-  for (const WallState& w : sim.walls())
-    for (const Eigen::Vector3d& f : w.facet_force)
-      facets.insert(facets.end(), f.data(), f.data() + 3);
-  if (!facets.empty()) {
-    const std::vector<double> all = gather_at_root(comm_, size_, rank_, facets);
-    if (rank_ == 0) {
-      std::fill(facets.begin(), facets.end(), 0.0);
-      for (int r = 0; r < size_; ++r)
-        for (std::size_t j = 0; j < facets.size(); ++j)
-          facets[j] += all[static_cast<std::size_t>(r) * facets.size() + j];
-      std::size_t j = 0;
-      for (WallState& w : sim.mutable_walls())
-        for (Eigen::Vector3d& f : w.facet_force) {
-          f = Eigen::Vector3d(facets[j], facets[j + 1], facets[j + 2]);
-          j += 3;
-        }
+  if (!sim.exact_wall_loads()) {
+    // The meshes' per-triangle forces (for output), summed in process order; the step clears
+    // and sums them anew, so process 0's own part need not be kept.
+    std::vector<double> facets;
+    for (const WallState& w : sim.walls())
+      for (const Eigen::Vector3d& f : w.facet_force)
+        facets.insert(facets.end(), f.data(), f.data() + 3);
+    if (!facets.empty()) {
+      const std::vector<double> all = gather_at_root(comm_, size_, rank_, facets);
+      if (rank_ == 0) {
+        std::fill(facets.begin(), facets.end(), 0.0);
+        for (int r = 0; r < size_; ++r)
+          for (std::size_t j = 0; j < facets.size(); ++j)
+            facets[j] += all[static_cast<std::size_t>(r) * facets.size() + j];
+        std::size_t j = 0;
+        for (WallState& w : sim.mutable_walls())
+          for (Eigen::Vector3d& f : w.facet_force) {
+            f = Eigen::Vector3d(facets[j], facets[j + 1], facets[j + 2]);
+            j += 3;
+          }
+      }
     }
   }
   // The ledger's particle terms (each process counted its own particles and their contacts);

@@ -10,7 +10,9 @@
 //  * at each neighbour-list rebuild (when any process's list is stale), the owned states are
 //    gathered by all, particles migrate to the brick they are in, and the contact histories go
 //    to the processes that compute their pairs from then on;
-//  * the walls' loads are summed over processes each step, so that servos see the whole.
+//  * each step, the walls' loads are summed over processes; where the run reads them as it
+//    steps (servos, a laboratory programme), over every process's wall contacts in pair order,
+//    as one process sums them.
 // A clump is owned by the process of its centre of mass, with its members (ghosted by their
 // own positions; the ghost layer is wider by the clumps' extent).
 // A pair is computed by the owner of each of its bodies, from the same states and history, and
@@ -42,6 +44,7 @@ class MpiDomain : public Domain {
   explicit MpiDomain(MPI_Comm comm = MPI_COMM_WORLD);
   int rank() const { return rank_; }
   int size() const { return size_; }
+  bool root() const override { return rank_ == 0; }
 
   /// Splits `sim`'s particles (the same on every process) into bricks of equal counts (the
   /// grid brick_grid gives; counted over the particles in the scene, not those removed or
@@ -59,14 +62,14 @@ class MpiDomain : public Domain {
   /// contact's, the ledger's particle terms summed, an outlet's latest removals counted) as a
   /// one-process run would, for output and checkpoints; the others keep theirs. release()
   /// undoes it.
-  void gather(Simulation& sim);
+  void gather(Simulation& sim) override;
   /// Process 0 back to the very state it stepped with before gather() (its part, its
   /// neighbour list and everything built from it), but for the ledger, which keeps the sums.
   /// (Rebuilding its part's list instead would build it from the particles' present positions,
   /// not from those of the last rebuild, as the other processes' are: other candidate pairs,
   /// other deferred facet pairs, and once in a while another contact; an output cadence then
   /// changed the run.)
-  void release(Simulation& sim);
+  void release(Simulation& sim) override;
   /// Bytes this process sent in the halo exchanges since attach (per-step traffic), and at
   /// rebuilds (migration and histories).
   std::uint64_t halo_bytes() const { return halo_bytes_; }
@@ -77,12 +80,14 @@ class MpiDomain : public Domain {
   bool any(bool mine);
   bool stale(bool mine) override;
   void rebuild(Simulation& sim) override;
-  void reduce_walls(std::vector<WallState>& walls) override;
+  void reduce_walls(Simulation& sim) override;
   void reduce_cell(Eigen::Matrix3d& stress, Eigen::Vector3d* stiffness) override;
   void agree(double& max_overlap_ratio, bool& finite) override;
   void exchange(Simulation& sim) override;
   void share(std::vector<double>& values) override;
   void add_over_processes(std::vector<double>& sums) override;
+  void broadcast(std::vector<double>& values) override;
+  std::vector<double> merge_records(const std::vector<double>& mine, std::size_t size) override;
 
  private:
   /// A brick's bounds in the coordinates the bricks cut (±∞, or 0 and 1 in a cell, where a

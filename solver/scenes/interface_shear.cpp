@@ -187,6 +187,7 @@ double InterfaceShear::specimen_height(const Simulation& sim) const {
 }
 
 void InterfaceShear::start(Simulation& sim) {
+  sim.share_all_states();  // (under a domain: e0 from every particle's present state)
   reset_rotations(sim);
   for (const auto c : w_.closer) sim.set_wall_active(c, false);
   for (std::size_t k = 0; k < sim.walls().size(); ++k)

@@ -46,7 +46,10 @@ MembraneLoads PlaneStrainCompression::membrane(const Simulation& sim) const {
   m.pressure_Pa = spec_.confining_Pa;
   m.bin_m = spec_.membrane_bin_m > 0 ? spec_.membrane_bin_m : 0.5 * d50_;
   m.normal_stencil_m = spec_.membrane_stencil_m > 0 ? spec_.membrane_stencil_m : d50_;
-  return membrane_loads(sim.particles(), lo.y(), hi.y(), lo.z() + clamp_, hi.z() - clamp_, m);
+  // (under a domain decomposition every process finds the membranes from every particle's
+  // present position, as one process does)
+  return membrane_loads(sim.present_positions(), sim.particles().radius, lo.y(), hi.y(),
+                        lo.z() + clamp_, hi.z() - clamp_, m);
 }
 
 void PlaneStrainCompression::refresh(Simulation& sim) {

@@ -118,7 +118,7 @@ bool SpecimenPreparation::equilibrium(Simulation& sim, bool with_stress) const {
   return ek <= spec_.kinetic_ratio * el;
 }
 
-void SpecimenPreparation::next_stage(Simulation& sim) {
+void SpecimenPreparation::next_stage(Simulation& sim, double core_void_ratio) {
   stage_start_ = sim.step_count();
   if (stage_ == kDeposition) {  // gravity stays on until the preparation ends
     stage_ = spec_.pressure_Pa > 0 ? kCompaction : kSettling;
@@ -130,7 +130,7 @@ void SpecimenPreparation::next_stage(Simulation& sim) {
   }
   if (stage_ == kCompaction || stage_ == kLowering) {
     const bool dense_enough =
-        spec_.void_ratio_target < 0 || core_void_ratio(sim) <= spec_.void_ratio_target;
+        spec_.void_ratio_target < 0 || core_void_ratio <= spec_.void_ratio_target;
     if (!dense_enough && friction_ > 0) {
       stage_ = kLowering;
       friction_ *= spec_.friction_factor;
@@ -169,7 +169,14 @@ void SpecimenPreparation::control(Simulation& sim) {
     return;
   }
   if (s - stage_start_ < spec_.stage_steps || (s - stage_start_) % spec_.check_every != 0) return;
-  if (equilibrium(sim, servo)) next_stage(sim);
+  // (under a domain decomposition the whole assembly is gathered for the check; its verdict,
+  // and the core's void ratio where a compaction stage ends, go to every process)
+  const bool compacting = stage_ == kCompaction || stage_ == kLowering;
+  const std::vector<double> v = sim.on_whole([&](Simulation& whole) -> std::vector<double> {
+    if (!equilibrium(whole, servo)) return {0.0, 0.0};
+    return {1.0, compacting && spec_.void_ratio_target >= 0 ? core_void_ratio(whole) : 0.0};
+  });
+  if (v[0] != 0) next_stage(sim, v[1]);
 }
 
 double SpecimenPreparation::progress(const Simulation& sim) const {

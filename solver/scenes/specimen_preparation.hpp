@@ -92,7 +92,9 @@ class SpecimenPreparation final : public LoadingProgramme {
   /// The stresses the servo holds (compression positive, Pa): each servo wall's, or the cell's
   /// diagonal.
   Eigen::VectorXd servo_stresses(const Simulation& sim) const;
-  void next_stage(Simulation& sim);
+  /// To the next stage; `core_void_ratio`: the core's void ratio now (read where a compaction
+  /// stage ends).
+  void next_stage(Simulation& sim, double core_void_ratio);
 
   PreparationSpec spec_;
   SpecimenGauge gauge_;

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <numbers>
 #include <stdexcept>
 #include <string>
@@ -20,6 +21,17 @@ std::string num(double v) {
   char b[40];
   std::snprintf(b, sizeof b, "%.9g", v);
   return b;
+}
+
+// What `fn` says of the whole assembly (under a domain decomposition: on the whole gathered on
+// process 0, its verdict sent to every process).
+bool whole_says(Simulation& sim, const std::function<bool(const Simulation&)>& fn) {
+  return sim.on_whole([&](Simulation& w) { return std::vector<double>{fn(w) ? 1.0 : 0.0}; })[0] !=
+         0;
+}
+
+double whole_unbalanced_force(Simulation& sim) {
+  return sim.on_whole([](Simulation& w) { return std::vector<double>{w.unbalanced_force()}; })[0];
 }
 
 // p, q = sqrt(3 J2), b and the angle (degrees) of σ1 from z in the x-z plane, folded to within
@@ -100,6 +112,7 @@ bool StressRotation::equilibrium(const Simulation& sim, double tolerance) const 
 }
 
 void StressRotation::carve(Simulation& sim) {
+  sim.share_all_states();  // (under a domain: every process carves the same bed)
   const ParticleState& p = sim.particles();
   // The bed must cover the polyhedron (centred at the origin, end walls at z = ±R) with a
   // grain to spare, or its top would be the bed's loose surface.
@@ -181,13 +194,15 @@ void StressRotation::control(Simulation& sim) {
   if (stage_ == kDeposition) {
     if (s - stage_start_ >= spec_.max_stage_steps)
       throw ProgrammeError("stress rotation: the deposition did not settle (f_unb/f_av = " +
-                           num(sim.unbalanced_force()) + " after " +
+                           num(whole_unbalanced_force(sim)) + " after " +
                            std::to_string(s - stage_start_) + " steps, tolerance " +
                            num(spec_.deposition_tolerance) + ")");
     // Settled: f_unb/f_av within the tolerance, and a bed (at least as many contacts as bodies:
     // while the cloud falls, a few collisions make f_av large and the ratio small).
     if (s - stage_start_ >= spec_.min_stage_steps && s % spec_.check_every == 0 &&
-        sim.contact_count() >= body_count(sim) && equilibrium(sim, spec_.deposition_tolerance)) {
+        whole_says(sim, [&](const Simulation& w) {
+          return w.contact_count() >= body_count(w) && equilibrium(w, spec_.deposition_tolerance);
+        })) {
       carve(sim);
       enter(sim, kReequilibration);
       if (spec_.quasi_static_dt_s > 0) sim.set_dt(spec_.quasi_static_dt_s);
@@ -197,12 +212,14 @@ void StressRotation::control(Simulation& sim) {
   if (stage_ == kReequilibration) {  // the walls fixed (§2.4)
     if (s - stage_start_ >= spec_.max_stage_steps)
       throw ProgrammeError("stress rotation: the carved specimen did not settle (f_unb/f_av = " +
-                           num(sim.unbalanced_force()) + " after " +
+                           num(whole_unbalanced_force(sim)) + " after " +
                            std::to_string(s - stage_start_) + " steps)");
     // In equilibrium when f_unb/f_av is within the tolerance, or when nothing touches any more
     // (gravity off, the bed's contacts unloaded and parted: no force to balance).
     if (s - stage_start_ >= spec_.min_stage_steps && s % spec_.check_every == 0 &&
-        (equilibrium(sim, spec_.tolerance) || sim.contact_count() == 0))
+        whole_says(sim, [&](const Simulation& w) {
+          return equilibrium(w, spec_.tolerance) || w.contact_count() == 0;
+        }))
       enter(sim, kIsotropic);
     return;
   }
@@ -213,7 +230,8 @@ void StressRotation::control(Simulation& sim) {
   servo_step(sim, spec_.poly_first, P_, t, servo, sim.config().dt, &sigma_);
   if (s % spec_.check_every != 0) return;
   const double error = (sigma_ - t).norm() / spec_.p_Pa;
-  if (!(error <= spec_.stress_tolerance && equilibrium(sim, spec_.tolerance))) {
+  if (!(error <= spec_.stress_tolerance &&
+        whole_says(sim, [&](const Simulation& w) { return equilibrium(w, spec_.tolerance); }))) {
     const std::int64_t limit =
         stage_ == kIsotropic ? spec_.max_stage_steps : spec_.max_increment_steps;
     if (s - increment_start_ >= limit) {
@@ -227,7 +245,7 @@ void StressRotation::control(Simulation& sim) {
                            std::to_string(limit) + "); stopped at p = " + num(st.p) +
                            " Pa, eta = " + num(st.p > 0 ? st.q / st.p : 0.0) +
                            ", b = " + num(st.b) + ", |sigma - target|/p = " + num(error) +
-                           ", f_unb/f_av = " + num(sim.unbalanced_force()));
+                           ", f_unb/f_av = " + num(whole_unbalanced_force(sim)));
     }
     return;
   }
