@@ -94,7 +94,10 @@ Results run(const Args& a, int sweep_point = -1,
 
 /// A scene with [sweep]: one run per value, each in OUT/<key leaf>_<value>/ (resumed, or read
 /// back when complete, with --resume), and OUT/sweep.csv: the value and each run's results.
-void run_sweep(const Args& a, const solver::Scene& first) {
+/// Under mpirun (`parallel`) every run is decomposed over the processes, one after the other.
+void run_sweep(const Args& a, const solver::Scene& first,
+               const std::optional<solver::RunOptions::Parallel>& parallel = {}) {
+  const bool root = !parallel || parallel->root;  // (process 0 speaks for all)
   const solver::SweepInfo& sw = *first.sweep;
   const std::string leaf = sw.key.substr(sw.key.rfind('.') + 1);
   const fs::path out = a.out.empty() ? fs::path("out") / first.name : fs::path(a.out);
@@ -109,14 +112,17 @@ void run_sweep(const Args& a, const solver::Scene& first) {
     const bool started = fs::exists(fs::path(one.out) / "checkpoint.txt") ||
                          fs::exists(fs::path(one.out) / "results.csv");
     one.resume = a.resume && started;
-    std::printf("sweep %s = %s (%zu of %zu) -> %s\n", sw.key.c_str(), sw.values[i].c_str(), i + 1,
-                sw.values.size(), one.out.c_str());
+    if (root)
+      std::printf("sweep %s = %s (%zu of %zu) -> %s\n", sw.key.c_str(), sw.values[i].c_str(), i + 1,
+                  sw.values.size(), one.out.c_str());
     std::fflush(stdout);
     try {
-      rows.emplace_back(sw.values[i], run(one, static_cast<int>(i)));
+      rows.emplace_back(sw.values[i], run(one, static_cast<int>(i), parallel));
     } catch (const InputError& e) {
       // A point that fails (a blow-up, a jam) does not stop the others: its row stays empty.
-      std::printf("sweep %s = %s failed: %s\n", sw.key.c_str(), sw.values[i].c_str(), e.what());
+      // (under mpirun every process meets it at the same step)
+      if (root)
+        std::printf("sweep %s = %s failed: %s\n", sw.key.c_str(), sw.values[i].c_str(), e.what());
       std::fflush(stdout);
       rows.emplace_back(sw.values[i], Results{});
       failed.push_back(sw.values[i]);
@@ -151,7 +157,7 @@ void run_sweep(const Args& a, const solver::Scene& first) {
     }
     table.commit();
   }
-  std::printf("wrote %s\n", (out / "sweep.csv").string().c_str());
+  if (root) std::printf("wrote %s\n", (out / "sweep.csv").string().c_str());
   if (!failed.empty()) {
     std::string list;
     for (const auto& v : failed) list += (list.empty() ? "" : ", ") + v;
@@ -207,8 +213,6 @@ void run_mpi(const Args& a) {
     if (provided < MPI_THREAD_SERIALIZED)
       throw InputError(a.scene, "this MPI does not allow calls from OpenMP threads",
                        "MPI_THREAD_SERIALIZED");
-    if (solver::scene_has_sweep(a.scene))
-      throw InputError(a.scene, "a [sweep] runs on one process (not under mpirun)", "sweep");
     (void)solver::load_scene(a.scene);
   } catch (const std::exception& e) {
     error = e.what();
@@ -249,7 +253,10 @@ void run_mpi(const Args& a) {
   par.release = [&](solver::Simulation& sim) { domain.release(sim); };
   par.any = [&](bool mine_flag) { return domain.any(mine_flag); };
   try {
-    run(mine, -1, par);
+    if (solver::scene_has_sweep(a.scene))
+      run_sweep(mine, solver::load_scene(a.scene), par);
+    else
+      run(mine, -1, par);
   } catch (const InputError& e) {
     fail(e.what(), true);  // (the scene's, or a blow-up: every process stops at the same step)
   } catch (const std::exception& e) {

@@ -728,6 +728,27 @@ TEST(Mpi, LaboratoryTestsRunAsOnOneProcess) {
   }
 }
 
+// A sweep (the tiny triaxial test to 1 % axial strain at two confining pressures) under
+// mpirun: each point decomposed over the processes in turn; every point's outputs and the
+// sweep's table equal one process's.
+TEST(Mpi, ASweepRunsEachPointDecomposed) {
+  if (!mpirun_present()) GTEST_SKIP() << "mpirun not installed (apt-get install openmpi-bin)";
+  gs::test::ScratchDir dir("mpi_sweep");
+  std::string text = slurp(kData / "scenes" / "triaxial_tiny.toml");
+  const std::string from = "max_strain = 0.02";
+  ASSERT_NE(text.find(from), std::string::npos);
+  text.replace(text.find(from), from.size(), "max_strain = 0.01");
+  text += "\n[sweep]\nkey = \"triaxial.confining_Pa\"\nvalues = [1.0e5, 2.0e5]\n";
+  std::ofstream(dir / "sweep.toml") << text;
+  const std::string args = " simulate " + (dir / "sweep.toml").string() + " -q --threads 1 -o ";
+  std::string err;
+  ASSERT_EQ(run(kExe + args + (dir / "one").string(), &err), 0) << err;
+  ASSERT_EQ(run(kMpirun + "2 " + kExe + args + (dir / "two").string(), &err), 0) << err;
+  EXPECT_EQ(slurp(dir / "two" / "sweep.csv"), slurp(dir / "one" / "sweep.csv"));
+  for (const char* point : {"confining_Pa_1e+05", "confining_Pa_2e+05"})
+    expect_same_lab_run(dir / "one" / point, dir / "two" / point, "triaxial.h5");
+}
+
 // A triaxial test stopped on two processes in the middle of its preparation (the checkpoint at
 // step 3 000 or past it) resumes on one process, and one stopped on one process resumes on
 // three: both end as the uninterrupted run (its outputs, to the bit and as text).
@@ -883,18 +904,11 @@ TEST(Mpi, AnalysesOverFramesShareTheFramesBetweenProcesses) {
   EXPECT_EQ(read_dataset(dir / "mpi.h5", "/frame"), (std::vector<double>{1, 3, 5}));
 }
 
-// What the decomposition does not handle yet, and a scene error, are one line from process 0
-// and exit code 2.
-TEST(Mpi, UnsupportedScenesAndBadScenesGiveOneLineAndExit2) {
+// A scene error is one line from process 0 and exit code 2.
+TEST(Mpi, BadScenesGiveOneLineAndExit2) {
   if (!mpirun_present()) GTEST_SKIP() << "mpirun not installed (apt-get install openmpi-bin)";
   gs::test::ScratchDir dir("mpi_bad");
   std::string err;
-  const std::string sweep = (kScenes / "interface_shear.toml").string();  // (has a [sweep])
-  EXPECT_EQ(
-      run(kMpirun + "2 " + kExe + " simulate " + sweep + " -q -o " + (dir / "t").string(), &err),
-      2);
-  EXPECT_EQ(err.substr(0, err.find('\n') + 1),
-            "error: " + sweep + ": a [sweep] runs on one process (not under mpirun) (sweep)\n");
   const fs::path bad = dir / "bad.toml";
   {
     std::ofstream o(bad);
