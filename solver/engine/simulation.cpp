@@ -1923,6 +1923,60 @@ double Simulation::unbalanced_force() const {
   return (sum_f / static_cast<double>(nf)) / (sum_c / static_cast<double>(nc));
 }
 
+Simulation::Measures Simulation::approximate_measures(bool kinetic_in_contact) const {
+  const bool split = domain_ && !roles_.empty() && !gathered_;
+  auto mine = [&](std::size_t i) { return !split || roles_[i] == kOwned; };
+  // Σ|F| over the free bodies and their number, Σ|f| over the contacts and their number, the
+  // kinetic and the elastic energy.
+  std::vector<double> s(6, 0.0);
+  std::vector<std::uint8_t> touching(kinetic_in_contact ? p_.size() : 0, 0);
+  for (std::size_t k = 0; k < hist_.size(); ++k) {
+    const auto& h = hist_[k];
+    if (!h.real) continue;
+    if (kinetic_in_contact) {  // (an owned body's contacts are all here)
+      touching[h.a] = 1;
+      if (h.b < kWallBase) touching[h.b] = 1;
+    }
+    if (!mine(h.a)) continue;  // (a contact counts at the owner of its first body)
+    s[2] += (h.fn * h.normal + h.shear_force).norm();
+    s[3] += 1;
+    s[5] += contact_elastic_energy(k).sum();
+  }
+  for (std::size_t i = 0; i < p_.size(); ++i) {
+    if (!mine(i)) continue;
+    if (!p_.fixed[i]) {
+      s[0] += (p_.force[i] + p_.mass[i] * cfg_.gravity).norm();
+      s[1] += 1;
+    }
+    if (p_.clump[i] >= 0 || (kinetic_in_contact && !touching[i])) continue;
+    const Eigen::Vector3d v =
+        periodic_ ? Eigen::Vector3d(p_.vel[i] - cell_.vel_grad * p_.pos[i]) : p_.vel[i];
+    s[4] += 0.5 * p_.mass[i] * v.squaredNorm() + 0.5 * p_.inertia[i] * p_.angvel[i].squaredNorm();
+  }
+  for (std::size_t k = 0; k < clumps_.size(); ++k) {
+    const ClumpBody& c = clumps_[k];
+    if (split && (c.members.empty() ? !domain_->root() : !clump_owned(k))) continue;
+    Eigen::Vector3d f = c.mass * cfg_.gravity;
+    bool t = !kinetic_in_contact;
+    for (const std::uint32_t m : c.members) {
+      f += p_.force[m];
+      t = t || touching[m] != 0;
+    }
+    s[0] += f.norm();
+    s[1] += 1;
+    if (t) s[4] += clump_kinetic_energy(c);
+  }
+  if (split) domain_->add_over_processes(s);
+  Measures m;
+  m.unbalanced_force = s[1] == 0 || s[3] == 0 || s[2] == 0
+                           ? std::numeric_limits<double>::quiet_NaN()
+                           : (s[0] / s[1]) / (s[2] / s[3]);
+  m.kinetic_J = s[4];
+  m.elastic_J = s[5];
+  m.contacts = static_cast<std::size_t>(s[3]);
+  return m;
+}
+
 Eigen::Vector3d Simulation::contact_elastic_energy(std::size_t k) const {
   const auto& h = hist_[k];
   const auto& p = params_[k];

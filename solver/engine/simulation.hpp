@@ -146,6 +146,19 @@ class Simulation {
   /// rattlers, which in a periodic cell keep flying or spinning undamped (local damping acts on
   /// forces) and would hold any kinetic-energy criterion of equilibrium off forever.
   double kinetic_energy_in_contact() const;
+  /// Whole-assembly measures for a decision far from its threshold.
+  struct Measures {
+    double unbalanced_force = 0;  // as unbalanced_force()
+    double kinetic_J = 0;         // kinetic_energy(), or kinetic_energy_in_contact()
+    double elastic_J = 0;         // the elastic energy of the contacts (energy()'s)
+    std::size_t contacts = 0;     // contact_count(), exactly
+  };
+  /// Under a domain (collective): each process sums over its own bodies and over the contacts
+  /// of its own first bodies, and the sums are added over processes (a few doubles). Every term
+  /// is non-negative, so each measure is within N·ε (relative) of the one-process value: a
+  /// decision with a margin of 1e-6 is the one-process decision, without a gather. Without a
+  /// domain: the same sums over everything (within round-off of the functions above).
+  Measures approximate_measures(bool kinetic_in_contact) const;
   /// Global inertial number I = γ̇·d/sqrt(p/ρ): γ̇ = sqrt(2·D':D') from the least-squares
   /// affine fit of particle velocities to positions (D its symmetric part, ' deviatoric),
   /// d the mean diameter, p the mean stress of the contact (Love–Weber) stress over the bounding

@@ -118,6 +118,17 @@ bool SpecimenPreparation::equilibrium(Simulation& sim, bool with_stress) const {
   return ek <= spec_.kinetic_ratio * el;
 }
 
+bool SpecimenPreparation::surely_unsettled(const Simulation& sim, bool with_stress) const {
+  constexpr double kMargin = 1 + 1e-5;       // (the sums' round-off: N·ε relative)
+  if (with_stress && gauge_.cell_axes == 0)  // (the walls' loads: the whole's, exactly)
+    for (const double v : servo_stresses(sim))
+      if (!(std::abs(v - spec_.pressure_Pa) <= spec_.stress_tolerance * spec_.pressure_Pa))
+        return true;
+  const Simulation::Measures m = sim.approximate_measures(gauge_.cell_axes > 0);
+  if (!(m.unbalanced_force <= kMargin * spec_.unbalanced_force)) return true;  // (NaN too)
+  return m.kinetic_J > kMargin * spec_.kinetic_ratio * m.elastic_J;
+}
+
 void SpecimenPreparation::next_stage(Simulation& sim, double core_void_ratio) {
   stage_start_ = sim.step_count();
   if (stage_ == kDeposition) {  // gravity stays on until the preparation ends
@@ -169,8 +180,10 @@ void SpecimenPreparation::control(Simulation& sim) {
     return;
   }
   if (s - stage_start_ < spec_.stage_steps || (s - stage_start_) % spec_.check_every != 0) return;
-  // (under a domain decomposition the whole assembly is gathered for the check; its verdict,
-  // and the core's void ratio where a compaction stage ends, go to every process)
+  // (under a domain decomposition the whole assembly is gathered for the check, unless each
+  // process's sums already tell; its verdict, and the core's void ratio where a compaction
+  // stage ends, go to every process)
+  if (sim.decomposed() && surely_unsettled(sim, servo)) return;
   const bool compacting = stage_ == kCompaction || stage_ == kLowering;
   const std::vector<double> v = sim.on_whole([&](Simulation& whole) -> std::vector<double> {
     if (!equilibrium(whole, servo)) return {0.0, 0.0};

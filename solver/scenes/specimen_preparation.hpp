@@ -89,6 +89,10 @@ class SpecimenPreparation final : public LoadingProgramme {
 
  private:
   bool equilibrium(Simulation& sim, bool with_stress) const;
+  /// Under a domain decomposition: whether each process's sums (Simulation::
+  /// approximate_measures, within round-off of the whole's) show the specimen out of
+  /// equilibrium by more than round-off could change, so that the check needs no gather.
+  bool surely_unsettled(const Simulation& sim, bool with_stress) const;
   /// The stresses the servo holds (compression positive, Pa): each servo wall's, or the cell's
   /// diagonal.
   Eigen::VectorXd servo_stresses(const Simulation& sim) const;

@@ -24,10 +24,19 @@ std::string num(double v) {
 }
 
 // What `fn` says of the whole assembly (under a domain decomposition: on the whole gathered on
-// process 0, its verdict sent to every process).
-bool whole_says(Simulation& sim, const std::function<bool(const Simulation&)>& fn) {
+// process 0, its verdict sent to every process), unless `surely_not` says no from each
+// process's sums (Simulation::approximate_measures), which then needs no gather.
+bool whole_says(Simulation& sim, const std::function<bool(const Simulation::Measures&)>& surely_not,
+                const std::function<bool(const Simulation&)>& fn) {
+  if (sim.decomposed() && surely_not(sim.approximate_measures(false))) return false;
   return sim.on_whole([&](Simulation& w) { return std::vector<double>{fn(w) ? 1.0 : 0.0}; })[0] !=
          0;
+}
+
+// Whether f_unb/f_av from each process's sums exceeds `tolerance` by more than their round-off
+// (N·ε relative: the exact ratio exceeds it too; NaN, no contact, too).
+bool surely_unbalanced(const Simulation::Measures& m, double tolerance) {
+  return !(m.unbalanced_force <= (1 + 1e-5) * tolerance);
 }
 
 double whole_unbalanced_force(Simulation& sim) {
@@ -200,9 +209,16 @@ void StressRotation::control(Simulation& sim) {
     // Settled: f_unb/f_av within the tolerance, and a bed (at least as many contacts as bodies:
     // while the cloud falls, a few collisions make f_av large and the ratio small).
     if (s - stage_start_ >= spec_.min_stage_steps && s % spec_.check_every == 0 &&
-        whole_says(sim, [&](const Simulation& w) {
-          return w.contact_count() >= body_count(w) && equilibrium(w, spec_.deposition_tolerance);
-        })) {
+        whole_says(
+            sim,
+            [&](const Simulation::Measures& m) {
+              return m.contacts < body_count(sim) ||
+                     surely_unbalanced(m, spec_.deposition_tolerance);
+            },
+            [&](const Simulation& w) {
+              return w.contact_count() >= body_count(w) &&
+                     equilibrium(w, spec_.deposition_tolerance);
+            })) {
       carve(sim);
       enter(sim, kReequilibration);
       if (spec_.quasi_static_dt_s > 0) sim.set_dt(spec_.quasi_static_dt_s);
@@ -217,9 +233,14 @@ void StressRotation::control(Simulation& sim) {
     // In equilibrium when f_unb/f_av is within the tolerance, or when nothing touches any more
     // (gravity off, the bed's contacts unloaded and parted: no force to balance).
     if (s - stage_start_ >= spec_.min_stage_steps && s % spec_.check_every == 0 &&
-        whole_says(sim, [&](const Simulation& w) {
-          return equilibrium(w, spec_.tolerance) || w.contact_count() == 0;
-        }))
+        whole_says(
+            sim,
+            [&](const Simulation::Measures& m) {
+              return m.contacts > 0 && surely_unbalanced(m, spec_.tolerance);
+            },
+            [&](const Simulation& w) {
+              return equilibrium(w, spec_.tolerance) || w.contact_count() == 0;
+            }))
       enter(sim, kIsotropic);
     return;
   }
@@ -231,7 +252,10 @@ void StressRotation::control(Simulation& sim) {
   if (s % spec_.check_every != 0) return;
   const double error = (sigma_ - t).norm() / spec_.p_Pa;
   if (!(error <= spec_.stress_tolerance &&
-        whole_says(sim, [&](const Simulation& w) { return equilibrium(w, spec_.tolerance); }))) {
+        whole_says(
+            sim,
+            [&](const Simulation::Measures& m) { return surely_unbalanced(m, spec_.tolerance); },
+            [&](const Simulation& w) { return equilibrium(w, spec_.tolerance); }))) {
     const std::int64_t limit =
         stage_ == kIsotropic ? spec_.max_stage_steps : spec_.max_increment_steps;
     if (s - increment_start_ >= limit) {
