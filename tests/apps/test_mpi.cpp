@@ -691,7 +691,9 @@ void expect_same_lab_run(const fs::path& one, const fs::path& other, const std::
 // by mutation: with the checks on each process's own part the processes disagree on the stage
 // and the run hangs or parts; with the walls' loads summed per process, then over processes,
 // the runs part at round-off once a servo works within its speed limit; with the membranes
-// found from each process's own states, the plane-strain curve differs (its reference volume).
+// found from each process's own states, the plane-strain curve differs (its reference volume);
+// with the preparation's check deciding "surely unsettled" from each process's sums at 0.9 of
+// the unbalanced-force tolerance instead of beyond their round-off, the runs part.
 // (Not told apart here: the interface shear's start reading the states of the last rebuild
 // instead of the present ones, its void ratio at the start does not change in the printed
 // digits; the carving's energy counted on every process instead of by the owners, the settled
