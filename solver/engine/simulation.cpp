@@ -1645,7 +1645,8 @@ void Simulation::step() {
     auto walls_and_fields = [&] {
       if (domain_) {
         zero_all_walls_ = true;  // (a wall loaded elsewhere has loads here after the sum)
-        accumulate_walls();
+        // (exact sums are formed from every process's wall contacts: no sums of its own first)
+        if (!exact_wall_loads()) accumulate_walls();
         domain_->reduce_walls(*this);
       } else {
         accumulate_walls();
@@ -1795,10 +1796,7 @@ double Simulation::kinetic_energy_of(const std::vector<std::uint8_t>* touching) 
   double e = 0;
   for (std::size_t i = 0; i < p_.size(); ++i) {
     if (p_.clump[i] >= 0 || (touching && !(*touching)[i])) continue;
-    // In a cell: the fluctuations about the mean field (YADE's utils.kineticEnergy).
-    const Eigen::Vector3d v =
-        periodic_ ? Eigen::Vector3d(p_.vel[i] - cell_.vel_grad * p_.pos[i]) : p_.vel[i];
-    e += 0.5 * p_.mass[i] * v.squaredNorm() + 0.5 * p_.inertia[i] * p_.angvel[i].squaredNorm();
+    e += particle_kinetic_energy(i);
   }
   for (const auto& c : clumps_) {  // (members skipped, as YADE)
     bool t = !touching;
@@ -1806,6 +1804,13 @@ double Simulation::kinetic_energy_of(const std::vector<std::uint8_t>* touching) 
     if (t) e += clump_kinetic_energy(c);
   }
   return e;
+}
+
+double Simulation::particle_kinetic_energy(std::size_t i) const {
+  // In a cell: the fluctuations about the mean field (YADE's utils.kineticEnergy).
+  const Eigen::Vector3d v =
+      periodic_ ? Eigen::Vector3d(p_.vel[i] - cell_.vel_grad * p_.pos[i]) : p_.vel[i];
+  return 0.5 * p_.mass[i] * v.squaredNorm() + 0.5 * p_.inertia[i] * p_.angvel[i].squaredNorm();
 }
 
 double Simulation::kinetic_energy() const {
@@ -1925,10 +1930,8 @@ double Simulation::unbalanced_force() const {
 
 Simulation::Measures Simulation::approximate_measures(bool kinetic_in_contact) const {
   const bool split = domain_ && !roles_.empty() && !gathered_;
-  auto mine = [&](std::size_t i) { return !split || roles_[i] == kOwned; };
-  // Σ|F| over the free bodies and their number, Σ|f| over the contacts and their number, the
-  // kinetic and the elastic energy.
-  std::vector<double> s(6, 0.0);
+  // The contacts' Σ|f|, number and elastic energy, each counted at the owner of its first body.
+  std::vector<double> c(3, 0.0);
   std::vector<std::uint8_t> touching(kinetic_in_contact ? p_.size() : 0, 0);
   for (std::size_t k = 0; k < hist_.size(); ++k) {
     const auto& h = hist_[k];
@@ -1937,43 +1940,42 @@ Simulation::Measures Simulation::approximate_measures(bool kinetic_in_contact) c
       touching[h.a] = 1;
       if (h.b < kWallBase) touching[h.b] = 1;
     }
-    if (!mine(h.a)) continue;  // (a contact counts at the owner of its first body)
-    s[2] += (h.fn * h.normal + h.shear_force).norm();
-    s[3] += 1;
-    s[5] += contact_elastic_energy(k).sum();
+    if (split && roles_[h.a] != kOwned) continue;
+    c[0] += (h.fn * h.normal + h.shear_force).norm();
+    c[1] += 1;
+    c[2] += contact_elastic_energy(k).sum();
   }
-  for (std::size_t i = 0; i < p_.size(); ++i) {
-    if (!mine(i)) continue;
-    if (!p_.fixed[i]) {
-      s[0] += (p_.force[i] + p_.mass[i] * cfg_.gravity).norm();
-      s[1] += 1;
-    }
-    if (p_.clump[i] >= 0 || (kinetic_in_contact && !touching[i])) continue;
-    const Eigen::Vector3d v =
-        periodic_ ? Eigen::Vector3d(p_.vel[i] - cell_.vel_grad * p_.pos[i]) : p_.vel[i];
-    s[4] += 0.5 * p_.mass[i] * v.squaredNorm() + 0.5 * p_.inertia[i] * p_.angvel[i].squaredNorm();
-  }
-  for (std::size_t k = 0; k < clumps_.size(); ++k) {
-    const ClumpBody& c = clumps_[k];
-    if (split && (c.members.empty() ? !domain_->root() : !clump_owned(k))) continue;
-    Eigen::Vector3d f = c.mass * cfg_.gravity;
-    bool t = !kinetic_in_contact;
-    for (const std::uint32_t m : c.members) {
-      f += p_.force[m];
-      t = t || touching[m] != 0;
-    }
-    s[0] += f.norm();
-    s[1] += 1;
-    if (t) s[4] += clump_kinetic_energy(c);
-  }
-  if (split) domain_->add_over_processes(s);
+  if (split) domain_->add_over_processes(c);
+  // The free bodies' Σ|F|, number and kinetic energy (each process's own, summed over them).
+  const auto b = owned_sums<3>(
+      [&](std::size_t i, double* t) {
+        const bool free = !p_.fixed[i];
+        t[0] = free ? (p_.force[i] + p_.mass[i] * cfg_.gravity).norm() : 0.0;
+        t[1] = free ? 1.0 : 0.0;
+        t[2] = p_.clump[i] >= 0 || (kinetic_in_contact && !touching[i])
+                   ? 0.0
+                   : particle_kinetic_energy(i);
+      },
+      [&](std::size_t k, double* t) {
+        const ClumpBody& cl = clumps_[k];
+        Eigen::Vector3d f = cl.mass * cfg_.gravity;
+        bool touches = !kinetic_in_contact;
+        for (const std::uint32_t m : cl.members) {
+          f += p_.force[m];
+          touches = touches || touching[m] != 0;
+        }
+        t[0] = f.norm();
+        t[1] = 1.0;
+        t[2] = touches ? clump_kinetic_energy(cl) : 0.0;
+      },
+      false);
   Measures m;
-  m.unbalanced_force = s[1] == 0 || s[3] == 0 || s[2] == 0
+  m.unbalanced_force = b[1] == 0 || c[1] == 0 || c[0] == 0
                            ? std::numeric_limits<double>::quiet_NaN()
-                           : (s[0] / s[1]) / (s[2] / s[3]);
-  m.kinetic_J = s[4];
-  m.elastic_J = s[5];
-  m.contacts = static_cast<std::size_t>(s[3]);
+                           : (b[0] / b[1]) / (c[0] / c[1]);
+  m.kinetic_J = b[2];
+  m.elastic_J = c[2];
+  m.contacts = static_cast<std::size_t>(c[1]);
   return m;
 }
 

@@ -465,6 +465,8 @@ class Simulation {
                  bool over_domain = false) const;
   /// Kinetic energy of all bodies, or of those marked in `touching`.
   double kinetic_energy_of(const std::vector<std::uint8_t>* touching) const;
+  /// A particle's kinetic energy, translation and rotation (in a cell: about the mean field).
+  double particle_kinetic_energy(std::size_t i) const;
   Eigen::Matrix3d servo_base_gradient_ = Eigen::Matrix3d::Zero();  // its off-diagonal part
   bool outlet_ = false;
   Eigen::Vector3d keep_lo_ = Eigen::Vector3d::Zero(), keep_hi_ = Eigen::Vector3d::Zero();
