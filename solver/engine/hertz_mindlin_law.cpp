@@ -3,6 +3,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "glibc_powers.hpp"
 #include "simd_level.hpp"
 
 namespace gs::solver {
@@ -57,17 +58,27 @@ template <bool kPeriodic>
   auto out3 = [&](Batch::Field f, int j, const V3& x) { batch.set3(f, j, x); };
   // Three passes, so that the two without calls vectorise: the geometry (its normal,
   // penetration and contact point go to NX, PEN, PTX, the arms to C1X, C2X), the powers of the
-  // penetration (glibc's pow, scalar, as YADE calls it), then the law. Each lane's operations
-  // and their order are those of one scalar pass: the same bits.
+  // penetration (glibc's pow, as YADE calls it: computed where certain, glibc_powers.hpp, and
+  // called for the other lanes), then the law. Each lane's operations and their order are those
+  // of one scalar pass: the same bits.
   for (int j = 0; j < count; ++j) {
     const LaneGeometry g = lane_geometry(batch, j);
     out3(Batch::C1X, j, g.c1);
     out3(Batch::C2X, j, g.c2);
   }
   double pow15[ContactBatch::kLanes], pow05[ContactBatch::kLanes];
+  bool certain15[ContactBatch::kLanes], certain05[ContactBatch::kLanes];
   for (int j = 0; j < count; ++j) {
-    pow15[j] = std::pow(batch.v[Batch::PEN][j], 1.5);
-    pow05[j] = std::pow(batch.v[Batch::PEN][j], 0.5);
+    const CertainPower a = glibc_pow_three_halves(batch.v[Batch::PEN][j]);
+    const CertainPower b = glibc_pow_half(batch.v[Batch::PEN][j]);
+    pow15[j] = a.value;
+    pow05[j] = b.value;
+    certain15[j] = a.certain;
+    certain05[j] = b.certain;
+  }
+  for (int j = 0; j < count; ++j) {
+    if (!certain15[j]) pow15[j] = std::pow(batch.v[Batch::PEN][j], 1.5);
+    if (!certain05[j]) pow05[j] = std::pow(batch.v[Batch::PEN][j], 0.5);
   }
   for (int j = 0; j < count; ++j) {
     const double r1 = batch.v[Batch::R1][j], r2 = batch.v[Batch::R2][j];

@@ -4,14 +4,18 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <random>
 #include <string>
 #include <vector>
 
 #include "errors.hpp"
+#include "glibc_powers.hpp"
 #include "hertz_mindlin_law.hpp"
 #include "scene_file.hpp"
 #include "simulation.hpp"
@@ -151,6 +155,52 @@ TEST(HertzMindlin, FallingSpheresMatchYade) {
 }
 
 // Bad input: one line naming the file, the field and the value.
+// The law's powers of the penetration, computed where certain (glibc_powers.hpp), are glibc's
+// pow to the bit; the uncertain lanes (left to pow) include every x whose pow(x, 0.5) is not the
+// correctly rounded sqrt(x), and they are few enough for the shortcut to pay.
+TEST(HertzMindlin, PowersAreGlibcsPow) {
+  std::mt19937_64 rng(20261205);
+  std::uniform_real_distribution<double> log_x(std::log(1e-13), std::log(1e-1));
+  const int n = 2000000;
+  int certain_half = 0, certain_three_halves = 0, sqrt_differs = 0;
+  for (int i = 0; i < n; ++i) {
+    // Penetrations (log-uniform over the range contacts see), then any positive double.
+    const double x = i % 2 == 0 ? std::exp(log_x(rng))
+                                : std::bit_cast<double>((rng() >> 1) & 0x7fefffffffffffffull);
+    const CertainPower h = glibc_pow_half(x), t = glibc_pow_three_halves(x);
+    const bool penetration = i % 2 == 0;
+    if (h.certain) {
+      certain_half += penetration;
+      ASSERT_EQ(std::bit_cast<std::uint64_t>(h.value),
+                std::bit_cast<std::uint64_t>(std::pow(x, 0.5)))
+          << std::hexfloat << x;
+    }
+    if (t.certain) {
+      certain_three_halves += penetration;
+      ASSERT_EQ(std::bit_cast<std::uint64_t>(t.value),
+                std::bit_cast<std::uint64_t>(std::pow(x, 1.5)))
+          << std::hexfloat << x;
+    }
+    if (std::pow(x, 0.5) != std::sqrt(x)) {
+      ++sqrt_differs;
+      EXPECT_FALSE(h.certain) << std::hexfloat << x;
+    }
+  }
+  EXPECT_GT(sqrt_differs, 100);           // (the hard cases were met: about 0.1 % of doubles)
+  EXPECT_GT(certain_half, 0.85 * n / 2);  // (of the penetrations: 90 % expected)
+  EXPECT_GT(certain_three_halves, 0.85 * n / 2);
+  // Where pow is not a plain power of a positive normal number: left to pow.
+  for (const double x :
+       {0.0, -0.0, -1e-6, 0x1p-1000, 0x1p-1074, 0x1p1000, HUGE_VAL, -HUGE_VAL, std::nan("")}) {
+    EXPECT_FALSE(glibc_pow_half(x).certain) << x;
+    EXPECT_FALSE(glibc_pow_three_halves(x).certain) << x;
+  }
+  // Results on a power of two (whose lower neighbour is half an ulp away): left to pow.
+  EXPECT_FALSE(glibc_pow_half(0x1p-20).certain);
+  EXPECT_FALSE(glibc_pow_three_halves(0x1p-20).certain);
+  EXPECT_TRUE(glibc_pow_half(2e-6).certain);
+}
+
 TEST(HertzMindlin, SceneRejectsBadParameters) {
   const auto dir =
       std::filesystem::temp_directory_path() / ("gs_hertz_" + std::to_string(::getpid()));
