@@ -21,9 +21,10 @@ def write_stl(walls_txt, path, name):
         b.write("endsolid %s\n" % name)
 
 
-def hertz_input(data_file, skin_m, dt_s, young_grain_pa, en_grain, mu_grain):
+def hertz_input(data_file, skin_m, dt_s, young_grain_pa, en_grain, mu_grain, mesh_options=""):
     """The LIGGGHTS input up to `fix nve/sphere`: the data file, the Verlet skin, the Hertz model
-    with the grains (type 1) and steel (type 2; the wall mesh walls.stl), gravity along -z."""
+    with the grains (type 1) and steel (type 2; the wall mesh walls.stl, with mesh_options
+    appended to its `fix mesh/surface`), gravity along -z."""
     model = "model hertz tangential history"
     return f"""atom_style granular
 atom_modify map array
@@ -43,7 +44,7 @@ pair_style gran {model}
 pair_coeff * *
 timestep {dt_s}
 fix gravi all gravity 9.81 vector 0.0 0.0 -1.0
-fix cad all mesh/surface file walls.stl type 2
+fix cad all mesh/surface file walls.stl type 2{(" " + mesh_options) if mesh_options else ""}
 fix walls all wall/gran {model} mesh n_meshes 1 meshes cad
 fix integr all nve/sphere
 """

@@ -2,7 +2,8 @@
 """LIGGGHTS 3.8 input for DEM8 Case 1 (silo discharge, M1; docs/dem8.md): the spheres of a CSV
 (id,x,y,z,r: a frame of a granoscope run of data/scenes/dem8_silo_laptop.toml) at rest, type 1
 (M1), the benchmark's steel silo (written as an STL from its walls .txt, read by
-`fix mesh/surface`, type 2), dt = 1.5 us, gravity. A sphere whose centre leaves the fixed domain,
+`fix mesh/surface`, type 2; `curvature_tolerant yes`: the small-orifice mesh has a triangle
+whose smallest angle, 0.26 deg, fails LIGGGHTS' mesh check), dt = 1.5 us, gravity. A sphere whose centre leaves the fixed domain,
 whose bottom is the orifice plane, is lost (thermo_modify lost ignore), as the benchmark's
 script erases those below it.
 
@@ -28,7 +29,7 @@ with open(os.path.join(d, "silo.data"), "w") as f:
         f.write("%d 1 %.17g 2500 %.17g %.17g %.17g\n" % (k + 1, 2 * r, x, y, z))
 write_stl(walls, os.path.join(d, "walls.stl"), "silo")
 with open(os.path.join(d, "in.silo"), "w") as f:
-    f.write(f"""{hertz_input("silo.data", 0.0004, 1.5e-6, 1.0e9, 0.5, 0.3)}thermo_style custom step atoms ke
+    f.write(f"""{hertz_input("silo.data", 0.0004, 1.5e-6, 1.0e9, 0.5, 0.3, "curvature_tolerant yes")}thermo_style custom step atoms ke
 thermo_modify lost ignore norm no
 thermo {every}
 run 1

@@ -7,7 +7,8 @@
 # runs it with 1 and 2 threads (contact = "yade": one wall per triangle, as YADE's facets), and
 # LIGGGHTS 3.8 (liggghts_dem8_silo.py: `gran model hertz`, the same materials, the silo as an
 # STL, the same Verlet skin as the scene's, 0.4 mm; its Hertz damping is its own) when installed.
-# Particle-steps count the spheres at the start.
+# Particle-steps count the spheres at the start. ORIFICE=small: the small-orifice silo instead
+# (RUN_DIR a run of data/scenes/dem8_silo_small_laptop.toml).
 #   bench/solver/run_dem8_silo_bench.sh RUN_DIR [BUILD_DIR]   (needs yade and ../shared/dem8)
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
@@ -21,12 +22,18 @@ work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 [ -x "$gs" ] || { echo "build first (scripts/build)"; exit 1; }
 steps=${STEPS:-2000}
+case ${ORIFICE:-large} in
+  large) scene=dem8_silo_laptop; z_orifice=-0.0554222 ;;
+  small) scene=dem8_silo_small_laptop; z_orifice=-0.0593008 ;;
+  *) echo "ORIFICE: large or small"; exit 1 ;;
+esac
+walls=$d8/case1_silo/walls_${ORIFICE:-large}_orifice.txt
 traj=$run/trajectory.h5
 [ -f "$traj" ] || traj=$run/trajectory.h5.partial
 "$gs" convert "$traj" "$work/frame.csv" --frame "${FRAME:--1}" > /dev/null
-"$py" - "$root/data/scenes/dem8_silo_laptop.toml" "$work" "$d8" "$steps" <<'PY'
+"$py" - "$root/data/scenes/$scene.toml" "$work" "$d8" "$steps" "$scene" <<'PY'
 import csv, re, sys
-scene, work, d8, steps = sys.argv[1:5]
+scene, work, d8, steps, name = sys.argv[1:6]
 rows = list(csv.DictReader(open(work + "/frame.csv")))
 with open(work + "/packing.csv", "w") as f:
     f.write("id,x,y,z,r\n")
@@ -35,7 +42,7 @@ with open(work + "/packing.csv", "w") as f:
 s = open(scene).read()
 s = re.sub(r"\n\[fill\].*?(?=\n\[)", "\n", s, flags=re.S)          # no filling: the packing
 s = re.sub(r"\n\[\[walls\]\].*?(?=\n\[)", "\n", s, flags=re.S)  # no lid: the orifice open
-s = s.replace('name = "dem8_silo_laptop"', 'name = "silo_bench"\npacking = "packing.csv"')
+s = s.replace('name = "%s"' % name, 'name = "silo_bench"\npacking = "packing.csv"')
 s = s.replace('"../../../shared/dem8/', '"%s/' % d8).replace('contact = "merged"', 'contact = "yade"')
 s = re.sub(r"\nsteps = .*", "\nsteps = %s" % steps, s)
 s = re.sub(r"\nevery = .*", "\nevery = 100000000", s)
@@ -48,15 +55,15 @@ for t in 1 2; do
   "$gs" simulate "$work/silo.toml" --threads $t -q -o "$work/run$t" > "$work/gs$t.txt"
 done
 if command -v liggghts > /dev/null; then
-  "$py" "$here/liggghts_dem8_silo.py" "$work/packing.csv" "$d8/case1_silo/walls_large_orifice.txt" \
-    -0.0554222 "$steps" 500 "$work/lig"
+  "$py" "$here/liggghts_dem8_silo.py" "$work/packing.csv" "$walls" "$z_orifice" "$steps" 500 \
+    "$work/lig"
   (cd "$work/lig" && liggghts -in in.silo > log.txt 2>&1)
 fi
-yade -n -x -j1 "$here/yade_dem8_silo.py" "$work/packing.csv" \
-  "$d8/case1_silo/walls_large_orifice.txt" -0.0554222 M1 "$steps" > "$work/yade.txt" 2>&1
-"$py" - "$work" "$steps" "$n" <<'PY'
+yade -n -x -j1 "$here/yade_dem8_silo.py" "$work/packing.csv" "$walls" "$z_orifice" M1 "$steps" \
+  > "$work/yade.txt" 2>&1
+"$py" - "$work" "$steps" "$n" "${ORIFICE:-large}" <<'PY'
 import csv, re, sys
-work, steps, n = sys.argv[1], int(sys.argv[2]), int(sys.argv[3])
+work, steps, n, orifice = sys.argv[1], int(sys.argv[2]), int(sys.argv[3]), sys.argv[4]
 y = open(work + "/yade.txt").read()
 yt = float(re.search(r"wall time ([0-9.]+)", y).group(1))
 ye = int(re.search(r"erased (\d+)", y).group(1))
@@ -72,7 +79,7 @@ for t in (1, 2):
     s = float(re.search(r"steps of \d+ particles in ([0-9.]+) s", out).group(1))
     rem = float(list(csv.DictReader(open("%s/run%d/history.csv" % (work, t))))[-1]["removed"])
     rows.append(("granoscope, %d thread%s" % (t, "s" if t > 1 else ""), s, int(rem)))
-print("DEM8 Case 1 (large orifice, M1), %d spheres from rest, %d steps of 1.5 us:" % (n, steps))
+print("DEM8 Case 1 (%s orifice, M1), %d spheres from rest, %d steps of 1.5 us:" % (orifice, n, steps))
 print("  %-26s %8s %16s %7s %8s" % ("run", "time s", "particle-steps/s", "ratio", "removed"))
 base = n * steps / rows[0][1]
 for name, t, e in rows:
