@@ -10,7 +10,8 @@
 // rounded, differs from pow(x, 0.5) for about 0.1 % of doubles).
 //
 // Everywhere else the answer is certain: if the exact value t lies within 0.45 ulp of a double q,
-// every other double is more than 0.55 ulp from t, so a result within 0.54 ulp of t is q. The
+// every other double is more than 0.55 ulp from t, so a result within 0.54 ulp of t is q (this
+// holds for any pow within 0.55 ulp: glibc before 2.28 was correctly rounded, musl uses Arm's). The
 // functions below find q and |t - q| from a correctly rounded sqrt and exact error terms (fma),
 // and report whether the answer is certain; the caller calls pow for the other lanes (about 10 %).
 // Outside [2^-900, 2^900], at zero, for negative or NaN x, and where q or its neighbour crosses a
