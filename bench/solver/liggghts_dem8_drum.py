@@ -10,7 +10,7 @@ import math
 import os
 import sys
 
-from liggghts_dem8_common import write_stl
+from liggghts_dem8_common import hertz_input_types, write_stl
 
 parts, walls, skin, steps, d = sys.argv[1:6]
 steps = int(steps)
@@ -29,29 +29,10 @@ with open(os.path.join(d, "drum.data"), "w") as f:
         t, rho = (2, 2000) if r > 0.0015 else (1, 2500)
         f.write("%d %d %.17g %d %.17g %.17g %.17g\n" % (k + 1, t, 2 * r, rho, x, y, z))
 write_stl(walls, os.path.join(d, "walls.stl"), "drum")
-model = "model hertz tangential history"
 with open(os.path.join(d, "in.drum"), "w") as f:
-    f.write(f"""atom_style granular
-atom_modify map array
-boundary f f f
-newton off
-communicate single vel yes
-units si
-hard_particles yes
-read_data drum.data
-neighbor {skin} bin
-neigh_modify delay 0
-fix m1 all property/global youngsModulus peratomtype 1.0e9 0.5e9 2.1e11
-fix m2 all property/global poissonsRatio peratomtype 0.2 0.2 0.2
-fix m3 all property/global coefficientRestitution peratomtypepair 3 0.5 0.45 0.4 0.45 0.4 0.4 0.4 0.4 0.4
-fix m4 all property/global coefficientFriction peratomtypepair 3 0.3 0.2 0.2 0.2 0.4 0.2 0.2 0.2 0.2
-pair_style gran {model}
-pair_coeff * *
-timestep 8.0e-7
-fix gravi all gravity 9.81 vector 0.0 0.0 -1.0
-fix cad all mesh/surface file walls.stl type 3
-fix walls all wall/gran {model} mesh n_meshes 1 meshes cad
-fix turn all move/mesh mesh cad rotate origin 0. 0. 0. axis 0. 1. 0. period {2 * math.pi / 2.0!r}
+    f.write(f"""{hertz_input_types("drum.data", skin, 8.0e-7, [1.0e9, 0.5e9, 2.1e11],
+                                  [[0.5, 0.45, 0.4], [0.45, 0.4, 0.4], [0.4, 0.4, 0.4]],
+                                  [[0.3, 0.2, 0.2], [0.2, 0.4, 0.2], [0.2, 0.2, 0.2]])}fix turn all move/mesh mesh cad rotate origin 0. 0. 0. axis 0. 1. 0. period {2 * math.pi / 2.0!r}
 fix integr all nve/sphere
 thermo_style custom step atoms ke
 thermo_modify lost ignore norm no
