@@ -1233,7 +1233,7 @@ Scene load_scene(const std::filesystem::path& path, int sweep_point,
   const auto* sol = r.table("solver", true);
   r.only(sol, "solver",
          {"dt_s", "dt_safety", "damping", "gravity_m_s2", "steps", "threads", "skin_m",
-          "max_overlap_ratio", "max_energy_residual"});
+          "max_overlap_ratio", "max_energy_residual", "order"});
   if (specimen) {
     auto& sp = s.specimen.emplace();
     const bool periodic2d = s.test == "biaxial_periodic";
@@ -1353,6 +1353,14 @@ Scene load_scene(const std::filesystem::path& path, int sweep_point,
   s.config.skin = r.number(sol, "solver", "skin_m", false, 0);
   s.config.max_overlap_ratio = r.positive(sol, "solver", "max_overlap_ratio", false, 0.1);
   s.config.max_energy_residual = r.positive(sol, "solver", "max_energy_residual", false, 0.2);
+  // "file" (the default, YADE's order: the results to the bit of YADE's) or "spatial".
+  const std::string order = r.string(sol, "solver", "order", false, "file");
+  if (order != "file" && order != "spatial")
+    r.fail("solver.order", "expected \"file\" or \"spatial\"", order);
+  s.spatial_order = order == "spatial";
+  if (s.spatial_order && !s.test.empty())
+    r.fail("solver.order",
+           "\"spatial\" is for plain scenes (the laboratory tests keep the file's order)", s.test);
 
   const auto* out = r.table("output", false);
   r.only(out, "output",

@@ -118,6 +118,9 @@ struct Scene {
     std::optional<CellServo> servo;  // control / target / servo_gain / max_rate_1_s
   };
   std::optional<CellSpec> cell;
+  /// [solver] order = "spatial": the particles loaded (not those a [fill] inserts) renumbered
+  /// along a Morton curve before the run (spatial_order.hpp); their ids unchanged.
+  bool spatial_order = false;
   std::int64_t steps = 0;
   OutputSpec output;
   std::vector<std::pair<std::string, std::string>> parameters;  // flattened, for run metadata

@@ -21,6 +21,7 @@
 #include "errors.hpp"
 #include "hdf5_trajectory.hpp"
 #include "mesh_walls.hpp"
+#include "spatial_order.hpp"
 #include "text_parse.hpp"
 
 namespace gs::solver {
@@ -271,6 +272,32 @@ std::string history_row(Simulation& sim, const std::vector<std::int64_t>& track_
   return row;
 }
 
+// [solver] order = "spatial": the loaded particles (those before a [fill]'s) renumbered along a
+// Morton curve through cells of the largest diameter; clump members follow them; ids unchanged.
+void order_spatially(Scene& scene) {
+  const std::size_t n = scene.fill ? scene.fill_first : scene.particles.size();
+  if (n < 2) return;
+  std::vector<Eigen::Vector3d> centres(n);
+  double d_max = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    centres[i] = scene.particles[i].position;
+    d_max = std::max(d_max, 2 * scene.particles[i].radius);
+  }
+  const auto order = spatial_order(centres, d_max);
+  std::vector<std::uint32_t> new_index(n);
+  std::vector<Particle> moved(scene.particles.size());
+  for (std::size_t i = 0; i < n; ++i) {
+    new_index[order[i]] = static_cast<std::uint32_t>(i);
+    moved[i] = std::move(scene.particles[order[i]]);
+  }
+  std::move(scene.particles.begin() + static_cast<std::ptrdiff_t>(n), scene.particles.end(),
+            moved.begin() + static_cast<std::ptrdiff_t>(n));
+  scene.particles = std::move(moved);
+  for (auto& c : scene.clumps)
+    for (auto& m : c.members)
+      if (m < n) m = new_index[m];
+}
+
 }  // namespace
 
 void write_run_results(const fs::path& path, const RunResults& r) {
@@ -342,6 +369,7 @@ RunOutcome run_scene(Scene scene, const RunOptions& a) {
          " s exceeds the P-wave time step " + value_str(scene.dt_pwave) +
          " s (YADE's PWaveTimeStep); the run may be unstable");
 
+  if (scene.spatial_order) order_spatially(scene);
   Simulation sim(scene.config, scene.particles, scene.walls);
   std::vector<Particle>().swap(scene.particles);  // (the engine holds them now: not twice)
   if (!scene.clumps.empty()) sim.set_clumps(scene.clumps);
