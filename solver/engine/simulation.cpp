@@ -597,6 +597,7 @@ void Simulation::attach_histories(const std::vector<ContactHistory>* from) {
   const std::vector<ContactHistory>& old = from ? *from : hist_;
   const std::size_t m = old.size();
   ++pairs_version_;
+  active_valid_ = false;  // (the pairs renumbered, histories restored: was_real_ from hist_)
   if (facet_forces_) pair_facet_.assign(np, 0);
   // A pair that stays in the list keeps its stiffnesses and limits (contact_params of the same
   // radii and material, so the same values) when nothing they are computed from has changed;
@@ -1248,7 +1249,13 @@ int Simulation::fill_batch(std::size_t& i, std::size_t end, ContactBatch& batch,
       in_reach = !(!facet_gap_.empty() && facet_gap_[k] > nl_.moved) &&
                  wall_may_touch(walls_[b - kWallBase], p_.pos[a], p_.radius[a]);
     }
-    hist_[k].real = hist_[k].real & in_reach;
+    // (a contact out of reach ends; hist_[k] untouched for the others out of reach, seldom
+    // a branch taken)
+    if (was_real_[k] & !in_reach) hist_[k].real = false;
+    // (pass 2 reads the history's first 88 bytes: fetched now, together for the batch)
+    __builtin_prefetch(&hist_[k], 1);
+    __builtin_prefetch(reinterpret_cast<const char*>(&hist_[k]) + 80, 1);
+    __builtin_prefetch(&params_[k]);
     near[m] = static_cast<std::uint32_t>(k);
     m += in_reach;
   }
@@ -1551,6 +1558,17 @@ void Simulation::step() {
   const bool indexed = !deferred_.empty();
   const std::size_t nv = indexed ? visit_.size() : np;
   const int threads = std::max(1, cfg_.threads);
+  // Which pairs were contacts: the last step's active_ (only a step sets ContactHistory::real
+  // true, and it sets active_ with it; what clears real between steps leaves a superset), or
+  // after a build or restore, hist_ read once.
+  if (active_valid_ && active_.size() == np) {
+    was_real_.swap(active_);
+  } else {
+    with_room(was_real_, np);
+    was_real_.resize(np);
+    for (std::size_t k = 0; k < np; ++k) was_real_[k] = hist_[k].real;
+  }
+  active_valid_ = false;  // (until this step ends)
   with_room(active_, np);
   active_.assign(np, 0);
   // (one thread keeps no loads per pair, only its walls'; threads keep the rows split_pairs
@@ -1769,6 +1787,7 @@ void Simulation::step() {
       place_rotated_facets(w);
     }
   }
+  active_valid_ = true;  // (what clears real from here to the next step leaves a superset)
   time_ += dt;
   ++step_;
   for (const std::uint32_t w : timed_walls_)

@@ -535,6 +535,12 @@ class Simulation {
   bool gathered_ = false;                // set_gathered
   std::vector<std::uint8_t> uncounted_;  // retired here by an outlet, not counted yet
   bool exact_wall_loads_ = false;        // set_exact_wall_loads
+  // Per pair, whether it was a contact after the last step (ContactHistory::real, or a superset
+  // of it): the last step's active_ when no build or restore came between (active_valid_),
+  // else read from hist_. The pass reads this compact array and touches hist_[k] only for the
+  // pairs within reach or a contact to end, not every candidate's 160 bytes each step.
+  std::vector<std::uint8_t> was_real_;
+  bool active_valid_ = false;  // active_ ⊇ the contacts (set at a step's end, cleared by a build)
 };
 
 // (Simulation::owned_sums: a template, so that one process's sums stay plain loops.)
