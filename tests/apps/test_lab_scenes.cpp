@@ -290,6 +290,10 @@ TEST(LabScenes, BadScenesExitTwoWithOneLine) {
       {"negative preparation pressure",
        {"[preparation]", "[preparation]\npressure_Pa = -1.0",
         "preparation.pressure_Pa: negative (-1)"}},
+      {"spatial order in a test",
+       {"damping = 0.2", "damping = 0.2\norder = \"spatial\"",
+        "solver.order: \"spatial\" is for plain scenes (the laboratory tests keep the file's "
+        "order) (triaxial)"}},
       {"unknown test",
        {"test = \"triaxial\"", "test = \"oedometer\"",
         "scene.test: expected \"triaxial\", \"plane_strain\", \"direct_shear\", "
