@@ -113,18 +113,22 @@ struct WallState {
 
 /// History of one contact (YADE's CohFrictPhys + ScGeom state that survives between steps).
 /// `b` is a particle index, or walls are encoded as b = kWallBase + wall index.
+/// One is kept per candidate pair and streamed through every step: the fields a step reads and
+/// writes come first (without the twist, the first 113 bytes), the pair's names after them,
+/// 152 bytes in all (the checkpoint keeps its own record; see Simulation::save_checkpoint).
 struct ContactHistory {
-  std::uint32_t a = 0, b = 0;
-  bool real = false;                                 // in contact after this step's geometry
+  // Results of the current step (for output and monitors).
+  double fn = 0, overlap = 0;
   Eigen::Vector3d normal = Eigen::Vector3d::Zero();  // last step's unit normal (a -> b)
   Eigen::Vector3d shear_force = Eigen::Vector3d::Zero();
   Eigen::Vector3d bending = Eigen::Vector3d::Zero();
-  Eigen::Vector3d twist = Eigen::Vector3d::Zero();
-  // Results of the current step (for output and monitors).
-  Eigen::Vector3d point = Eigen::Vector3d::Zero();
-  double fn = 0, overlap = 0;
-  double kn = 0, ks = 0, kr = 0;
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();  // (of the current step)
+  bool real = false;                                // in contact after this step's geometry
+  std::uint32_t a = 0, b = 0;
+  Eigen::Vector3d twist = Eigen::Vector3d::Zero();  // (zero unless twisting moments are on)
 };
+
+static_assert(sizeof(ContactHistory) == 152, "the layout the contact pass prefetches");
 
 inline constexpr std::uint32_t kWallBase = 0x80000000u;
 

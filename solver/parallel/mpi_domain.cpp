@@ -16,7 +16,7 @@ constexpr int kState = 16;
 // With the loads (for output on process 0).
 constexpr int kFullState = kState + 6;
 // A contact history.
-constexpr int kHistory = 23;
+constexpr int kHistory = 20;
 
 void put3(double*& o, const Eigen::Vector3d& v) {
   *o++ = v[0];
@@ -72,9 +72,6 @@ void pack_history(const ContactHistory& h, std::vector<double>& o) {
   put3(x, h.point);
   *x++ = h.fn;
   *x++ = h.overlap;
-  *x++ = h.kn;
-  *x++ = h.ks;
-  *x++ = h.kr;
 }
 
 std::vector<ContactHistory> unpack_histories(const std::vector<double>& in) {
@@ -92,9 +89,6 @@ std::vector<ContactHistory> unpack_histories(const std::vector<double>& in) {
     h.point = get3(x);
     h.fn = *x++;
     h.overlap = *x++;
-    h.kn = *x++;
-    h.ks = *x++;
-    h.kr = *x++;
   }
   return out;
 }

@@ -395,7 +395,9 @@ TEST(Physics, ExtraRebuildsCarryEveryHistoryInPlace) {
       ASSERT_NE(it, touching.end()) << threads;
       ASSERT_EQ(it->second->shear_force, h.shear_force) << threads;
       ASSERT_EQ(it->second->bending, h.bending) << threads;
-      ASSERT_EQ(it->second->kn, h.kn) << threads;
+      ASSERT_EQ(it->second->normal, h.normal) << threads;
+      ASSERT_EQ(it->second->fn, h.fn) << threads;
+      ASSERT_EQ(it->second->point, h.point) << threads;
       ++matched;
     }
     EXPECT_EQ(matched, touching.size()) << threads;
