@@ -541,7 +541,7 @@ class Simulation {
   // Per pair, whether it was a contact after the last step (ContactHistory::real, or a superset
   // of it): the last step's active_ when no build or restore came between (active_valid_),
   // else read from hist_. The pass reads this compact array and touches hist_[k] only for the
-  // pairs within reach or a contact to end, not every candidate's 160 bytes each step.
+  // pairs within reach or a contact to end, not every candidate's history each step.
   std::vector<std::uint8_t> was_real_;
   bool active_valid_ = false;  // active_ ⊇ the contacts (set at a step's end, cleared by a build)
 };
