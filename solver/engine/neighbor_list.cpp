@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "contact_geometry.hpp"
+#include "thread_team.hpp"
 
 namespace gs::solver {
 
@@ -420,17 +421,19 @@ void NeighborList::build(const ParticleState& p, const std::vector<WallState>& w
   with_room(pairs, found_.size());
   pairs.resize(found_.size());
   for (const auto& pr : found_) pairs[cell_fill_[pr.first]++] = pr;
-#pragma omp parallel for num_threads(nt) schedule(static)
-  for (std::size_t i = 0; i < n; ++i) {
-    auto* b = pairs.data() + first_start_[i];
-    auto* e = pairs.data() + first_start_[i + 1];
-    for (auto* x = b + 1; x < e; ++x) {  // insertion sort (a handful of partners)
-      const auto v = *x;
-      auto* y = x;
-      for (; y > b && (y - 1)->second > v.second; --y) *y = *(y - 1);
-      *y = v;
+  run_on_team(nt, [&] {
+#pragma omp for schedule(static)
+    for (std::size_t i = 0; i < n; ++i) {
+      auto* b = pairs.data() + first_start_[i];
+      auto* e = pairs.data() + first_start_[i + 1];
+      for (auto* x = b + 1; x < e; ++x) {  // insertion sort (a handful of partners)
+        const auto v = *x;
+        auto* y = x;
+        for (; y > b && (y - 1)->second > v.second; --y) *y = *(y - 1);
+        *y = v;
+      }
     }
-  }
+  });
 }
 
 void NeighborList::build_periodic(const ParticleState& p, const PeriodicCell& cell, bool planar_z) {

@@ -17,6 +17,7 @@
 #include "errors.hpp"
 #include "hertz_mindlin_law.hpp"
 #include "newton_integrator.hpp"
+#include "thread_team.hpp"
 
 namespace gs::solver {
 
@@ -625,8 +626,7 @@ void Simulation::attach_histories(const std::vector<ContactHistory>* from) {
   // 1. Each new pair's old index (kNew: a new pair), each share walking the old list from a
   //    binary search for its first pair. The map is increasing.
   std::vector<std::uint32_t> attach_from(np);  // (4 B a pair, while attaching only)
-#pragma omp parallel num_threads(threads)
-  {
+  run_on_team(threads, [&] {
     const auto nt = static_cast<std::size_t>(omp_get_num_threads());
     const auto t = static_cast<std::size_t>(omp_get_thread_num());
     const std::size_t k0 = np * t / nt, k1 = np * (t + 1) / nt;
@@ -644,7 +644,7 @@ void Simulation::attach_histories(const std::vector<ContactHistory>* from) {
                            ? static_cast<std::uint32_t>(o)
                            : kNew;
     }
-  }
+  });
   // 2. In place, the kept histories (and parameters) move to their new indices; no second copy
   //    of them is held. Each share [k0, k1) of the new list first saves the entries it takes
   //    from outside itself (another share's, or past the new end); after a barrier it moves
@@ -662,8 +662,7 @@ void Simulation::attach_histories(const std::vector<ContactHistory>* from) {
     hist_.resize(span);
     with_room(params_, reuse ? span : np);  // (parameters not reused are computed afresh)
     params_.resize(reuse ? span : np);
-#pragma omp parallel num_threads(threads)
-    {
+    run_on_team(threads, [&] {
       const auto nt = static_cast<std::size_t>(omp_get_num_threads());
       const auto t = static_cast<std::size_t>(omp_get_thread_num());
       const std::size_t k0 = np * t / nt, k1 = np * (t + 1) / nt;
@@ -703,74 +702,77 @@ void Simulation::attach_histories(const std::vector<ContactHistory>* from) {
           if (reuse) params_[e.k] = e.q;
         }
       }
-    }
+    });
     if (error) std::rethrow_exception(error);
     hist_.resize(np);
     params_.resize(np);
   }
   // 3. Each pair's history and parameters.
-#pragma omp parallel num_threads(threads)
-  try {
-    const auto nt = static_cast<std::size_t>(omp_get_num_threads());
-    const auto t = static_cast<std::size_t>(omp_get_thread_num());
-    const std::size_t k0 = np * t / nt, k1 = np * (t + 1) / nt;
-    for (std::size_t k = k0; k < k1; ++k) {
-      const auto pr = nl_.pairs[k];
-      const std::uint32_t o = attach_from[k];
-      const bool kept = o != kNew;
-      if (!kept)
-        hist_[k] = ContactHistory{};
-      else if (from)
-        hist_[k] = (*from)[o];
-      hist_[k].a = pr.first;
-      hist_[k].b = pr.second;
-      const WallSpec* ws = pr.second >= kWallBase ? &walls_[pr.second - kWallBase].spec : nullptr;
-      if (kept && reuse) {
-        if (cfg_.law == ContactLaw::HertzMindlin) continue;  // (set_friction_deg: linear law only)
-        params_[k].tan_friction =
-            ws && ws->friction_deg >= 0 ? std::tan(ws->friction_deg * M_PI / 180.0) : tan_material;
-        continue;
+  run_on_team(threads, [&] {
+    try {
+      const auto nt = static_cast<std::size_t>(omp_get_num_threads());
+      const auto t = static_cast<std::size_t>(omp_get_thread_num());
+      const std::size_t k0 = np * t / nt, k1 = np * (t + 1) / nt;
+      for (std::size_t k = k0; k < k1; ++k) {
+        const auto pr = nl_.pairs[k];
+        const std::uint32_t o = attach_from[k];
+        const bool kept = o != kNew;
+        if (!kept)
+          hist_[k] = ContactHistory{};
+        else if (from)
+          hist_[k] = (*from)[o];
+        hist_[k].a = pr.first;
+        hist_[k].b = pr.second;
+        const WallSpec* ws = pr.second >= kWallBase ? &walls_[pr.second - kWallBase].spec : nullptr;
+        if (kept && reuse) {
+          if (cfg_.law == ContactLaw::HertzMindlin)
+            continue;  // (set_friction_deg: linear law only)
+          params_[k].tan_friction = ws && ws->friction_deg >= 0
+                                        ? std::tan(ws->friction_deg * M_PI / 180.0)
+                                        : tan_material;
+          continue;
+        }
+        const double ra = p_.radius[pr.first];
+        const double rb = pr.second >= kWallBase ? ra : p_.radius[pr.second];
+        const bool facet2r = ws && ws->shape == WallShape::Facets && !ws->plane_radii;
+        if (cfg_.law == ContactLaw::HertzMindlin) {
+          // Walls flat (radius 1e5 m, YADE's hertzian facets) or YADE's default radii (a box R, a
+          // facet 2R); m* of the dynamic bodies; the pair's restitution and friction. (E*, G*, R*
+          // and m* are symmetric to the bit, so the order of the two bodies does not matter.)
+          const int ia = p_.material[pr.first], ib = ws ? ws->material : p_.material[pr.second];
+          const Material &A = material_at(ia), &B = material_at(ib);
+          const double r_wall = cfg_.hertz_flat_walls ? 1e5 : facet2r ? 2 * ra : ra;
+          const double ma = p_.fixed[pr.first] ? 0.0 : p_.mass[pr.first];
+          const double mb = ws || p_.fixed[pr.second] ? 0.0 : p_.mass[pr.second];
+          const std::size_t nm = 1 + cfg_.more_materials.size();
+          const std::size_t cell = static_cast<std::size_t>(ia) * nm + static_cast<std::size_t>(ib);
+          const double en =
+              cfg_.pair_restitution.empty() ? A.restitution : cfg_.pair_restitution[cell];
+          double phi = cfg_.pair_friction_deg.empty() ? -1 : cfg_.pair_friction_deg[cell];
+          if (phi < 0) phi = std::min(A.friction_deg, B.friction_deg);
+          params_[k] =
+              hertz_mindlin_params({A.young_ec, A.poisson}, {B.young_ec, B.poisson}, ra,
+                                   ws ? r_wall : rb, ma, mb, en, std::tan(phi * M_PI / 180.0));
+        } else if (facet2r) {  // YADE: the facet is 2R, first
+          params_[k] = contact_params(cfg_.material, 2 * ra, ra, cfg_.twist_beta, cfg_.twist_eta);
+        } else {
+          params_[k] = contact_params(cfg_.material, ra, rb, cfg_.twist_beta, cfg_.twist_eta);
+        }
+        if (disk_thickness_ > 0 && !ws &&
+            !(mat.normal_stiffness_N_m > 0)) {  // disks: a line contact of Ec per unit thickness
+          params_[k].kn = mat.young_ec * disk_thickness_;
+          params_[k].ks = mat.stiffness_ratio * params_[k].kn;
+          params_[k].kr = mat.rolling_beta * params_[k].ks * ra * rb;
+        }
+        if (pr.second >= kWallBase) {
+          const double wf = walls_[pr.second - kWallBase].spec.friction_deg;
+          if (wf >= 0) params_[k].tan_friction = std::tan(wf * M_PI / 180.0);
+        }
       }
-      const double ra = p_.radius[pr.first];
-      const double rb = pr.second >= kWallBase ? ra : p_.radius[pr.second];
-      const bool facet2r = ws && ws->shape == WallShape::Facets && !ws->plane_radii;
-      if (cfg_.law == ContactLaw::HertzMindlin) {
-        // Walls flat (radius 1e5 m, YADE's hertzian facets) or YADE's default radii (a box R, a
-        // facet 2R); m* of the dynamic bodies; the pair's restitution and friction. (E*, G*, R*
-        // and m* are symmetric to the bit, so the order of the two bodies does not matter.)
-        const int ia = p_.material[pr.first], ib = ws ? ws->material : p_.material[pr.second];
-        const Material &A = material_at(ia), &B = material_at(ib);
-        const double r_wall = cfg_.hertz_flat_walls ? 1e5 : facet2r ? 2 * ra : ra;
-        const double ma = p_.fixed[pr.first] ? 0.0 : p_.mass[pr.first];
-        const double mb = ws || p_.fixed[pr.second] ? 0.0 : p_.mass[pr.second];
-        const std::size_t nm = 1 + cfg_.more_materials.size();
-        const std::size_t cell = static_cast<std::size_t>(ia) * nm + static_cast<std::size_t>(ib);
-        const double en =
-            cfg_.pair_restitution.empty() ? A.restitution : cfg_.pair_restitution[cell];
-        double phi = cfg_.pair_friction_deg.empty() ? -1 : cfg_.pair_friction_deg[cell];
-        if (phi < 0) phi = std::min(A.friction_deg, B.friction_deg);
-        params_[k] =
-            hertz_mindlin_params({A.young_ec, A.poisson}, {B.young_ec, B.poisson}, ra,
-                                 ws ? r_wall : rb, ma, mb, en, std::tan(phi * M_PI / 180.0));
-      } else if (facet2r) {  // YADE: the facet is 2R, first
-        params_[k] = contact_params(cfg_.material, 2 * ra, ra, cfg_.twist_beta, cfg_.twist_eta);
-      } else {
-        params_[k] = contact_params(cfg_.material, ra, rb, cfg_.twist_beta, cfg_.twist_eta);
-      }
-      if (disk_thickness_ > 0 && !ws &&
-          !(mat.normal_stiffness_N_m > 0)) {  // disks: a line contact of Ec per unit thickness
-        params_[k].kn = mat.young_ec * disk_thickness_;
-        params_[k].ks = mat.stiffness_ratio * params_[k].kn;
-        params_[k].kr = mat.rolling_beta * params_[k].ks * ra * rb;
-      }
-      if (pr.second >= kWallBase) {
-        const double wf = walls_[pr.second - kWallBase].spec.friction_deg;
-        if (wf >= 0) params_[k].tan_friction = std::tan(wf * M_PI / 180.0);
-      }
+    } catch (...) {
+      keep_error();
     }
-  } catch (...) {
-    keep_error();
-  }
+  });
   if (error) std::rethrow_exception(error);
   params_key_valid_ = true;
   params_radius_ = p_.radius;
@@ -1606,9 +1608,9 @@ void Simulation::step() {
   double max_overlap_ratio = 0;
   bool finite = true;
   // One parallel region per step (a region per loop lets the idle thread fall asleep between
-  // them, and waking it costs more than the loops on small systems).
-#pragma omp parallel num_threads(threads)
-  {
+  // them, and waking it costs more than the loops on small systems); with one thread, none
+  // (run_on_team: the constructs below then run orphaned).
+  auto region = [&] {
     const std::size_t nt = static_cast<std::size_t>(omp_get_num_threads());
     if (nt == 1) {
       // One thread: the loads go straight onto the particles, in pair order, which is the
@@ -1748,7 +1750,8 @@ void Simulation::step() {
       chunk_sums_[kSums * c + 3] = sums.external_power;
       chunk_sums_[kSums * c + 4] = sums.damping;
     }
-  }
+  };
+  run_on_team(threads, region);
   const bool hertz = cfg_.law == ContactLaw::HertzMindlin;
   for (std::size_t c = 0; c < chunks; ++c) {
     ledger_.friction_dissipation += chunk_sums_[kSums * c];
