@@ -242,8 +242,36 @@ void Simulation::remove_outflow() {
     // the counts between steps reads the same on every process)
     if (domain_->stale(any)) domain_->rebuild(*this);
   } else if (any) {
-    invalidate_neighbors();  // (its pairs go with the rebuild before the next step)
+    drop_removed_pairs();  // (or the rebuild before the next step drops them)
   }
+}
+
+void Simulation::drop_removed_pairs() {
+  // (a list to be built anyway, or a periodic one, whose images the pass does not index:
+  // the build drops them)
+  if (nl_.ref_pos.empty() || periodic_ || hist_.size() != nl_.pairs.size()) {
+    invalidate_neighbors();
+    return;
+  }
+  auto gone = [&](std::uint32_t k) {
+    const auto [a, b] = nl_.pairs[k];
+    return p_.removed[a] != 0 || (b < kWallBase && p_.removed[b] != 0);
+  };
+  if (!indexed_pass()) {  // (every pair was visited: now all but the dropped)
+    const std::size_t np = nl_.pairs.size();
+    pass_pairs_.resize(np);
+    for (std::size_t k = 0; k < np; ++k) pass_pairs_[k] = static_cast<std::uint32_t>(k);
+    pass_wall_pairs_ = wall_pairs_;
+  }
+  for (const std::uint32_t k : pass_pairs_)
+    if (gone(k)) dropped_.push_back(k);
+  std::erase_if(pass_pairs_, gone);
+  std::erase_if(pass_wall_pairs_, gone);
+  // (a deferred pair admitted in the last step and not in the next is marked apart there)
+  std::erase_if(deferred_groups_,
+                [&](const DeferredGroup& g) { return p_.removed[g.particle] != 0; });
+  pairs_dropped_ = true;
+  visit_valid_ = false;
 }
 
 void Simulation::share_all_states() {
@@ -828,6 +856,9 @@ void Simulation::attach_histories(const std::vector<ContactHistory>* from) {
   admitted_prev_.clear();
   visit_valid_ = false;
   pass_pairs_.clear();
+  pass_wall_pairs_.clear();
+  pairs_dropped_ = false;
+  dropped_.clear();
   if (facets)
     for (const std::uint32_t k : wall_pairs_)
       if (facet_gap_[k] > 0) deferred_.push_back(k);
@@ -1017,7 +1048,7 @@ void Simulation::accumulate_walls() {
     for (const auto& [k, L] : wall_loads_) add(k, L);
     return;
   }
-  for (const std::uint32_t k : deferred_.empty() ? wall_pairs_ : visit_wall_)
+  for (const std::uint32_t k : indexed_pass() ? visit_wall_ : wall_pairs_)
     if (active_[k]) add(k, loads_[load_slot_[k]]);
 }
 
@@ -1046,7 +1077,7 @@ std::vector<double> Simulation::wall_load_records() const {
     for (const auto& [k, L] : wall_loads_) put(k, L);
     return out;
   }
-  for (const std::uint32_t k : deferred_.empty() ? wall_pairs_ : visit_wall_)
+  for (const std::uint32_t k : indexed_pass() ? visit_wall_ : wall_pairs_)
     if (active_[k]) put(k, loads_[load_slot_[k]]);
   return out;
 }
@@ -1187,7 +1218,14 @@ namespace {
 }  // namespace
 
 void Simulation::admit_deferred() {
-  if (deferred_.empty()) return;
+  if (deferred_.empty()) {
+    if (pairs_dropped_ && !visit_valid_) {  // (only dropped pairs: the pass's own lists)
+      visit_ = pass_pairs_;
+      visit_wall_ = pass_wall_pairs_;
+      visit_valid_ = true;
+    }
+    return;
+  }
   // A deferred pair's gap has closed by at most its particle's displacement since the build plus
   // the largest wall displacement (NeighborList::stale's bound, per particle): the pairs of each
   // particle whose gap is within that bound this step are visited, the others provably do not
@@ -1575,11 +1613,13 @@ void Simulation::step() {
   bool stale = nl_.stale(p_, walls_, cell_ptr(), &moving_walls_);
   if (domain_) stale = domain_->stale(stale);
   if (stale) rebuild_neighbors();
+  for (const std::uint32_t k : dropped_) hist_[k].real = false;  // (what the build would drop)
+  dropped_.clear();
   admit_deferred();
   const double dt = cfg_.dt;
   const std::size_t np = nl_.pairs.size();
   // The pairs the contact pass visits: all, or visit_ while some facet pairs are deferred.
-  const bool indexed = !deferred_.empty();
+  const bool indexed = indexed_pass();
   const std::size_t nv = indexed ? visit_.size() : np;
   const int threads = std::max(1, cfg_.threads);
   // Which pairs were contacts: the last step's active_ (only a step sets ContactHistory::real

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "mesh_walls.hpp"
 #include "simulation.hpp"
 
 using namespace gs;
@@ -109,6 +110,125 @@ TEST(Outlet, RejectsAnEmptyRegion) {
   solver::Simulation sim(falling(), column(), {});
   EXPECT_THROW(sim.set_outlet(Eigen::Vector3d(0, 0, 1), Eigen::Vector3d(1, 1, 0)),
                std::invalid_argument);
+}
+
+namespace {
+
+// A block of 4 x 4 x 8 spheres (radii 0.996-1 mm, 2 mm apart: touching or a few µm apart) sliding
+// down a vertical wall of 6 x 12 squares of facets (YADE's contacts) at x = -1 mm through the
+// outlet plane z = 0, gravity 30 degrees off the vertical pressing it onto the wall: sphere pairs,
+// facet pairs within reach and facet pairs deferred, in contact as their spheres leave.
+std::vector<Particle> block() {
+  std::vector<Particle> ps;
+  for (int k = 0; k < 8; ++k)
+    for (int j = 0; j < 4; ++j)
+      for (int i = 0; i < 4; ++i) {
+        Particle p;
+        p.id = static_cast<std::int64_t>(ps.size());
+        p.radius = 1e-3 * (1 - 0.002 * ((i + 2 * j + k) % 3));
+        p.position = {2e-3 * i + p.radius - 1.001e-3, 2e-3 * j, 1.2e-3 + 2e-3 * k};
+        ps.push_back(p);
+      }
+  return ps;
+}
+
+solver::MeshTriangles side_wall() {
+  solver::MeshTriangles m;
+  const int ny = 6, nz = 12;
+  const double y0 = -2e-3, z0 = -30e-3, hy = 12e-3 / ny, hz = 50e-3 / nz, x = -1e-3;
+  for (int a = 0; a < ny; ++a)
+    for (int b = 0; b < nz; ++b) {
+      const Eigen::Vector3d p00(x, y0 + a * hy, z0 + b * hz),
+          p10(x, y0 + (a + 1) * hy, z0 + b * hz), p01(x, y0 + a * hy, z0 + (b + 1) * hz),
+          p11(x, y0 + (a + 1) * hy, z0 + (b + 1) * hz);
+      m.triangles.push_back({p00, p10, p11});
+      m.triangles.push_back({p00, p11, p01});
+      m.group.push_back("side");
+      m.group.push_back("side");
+    }
+  return m;
+}
+
+solver::SimulationConfig block_config(int threads) {
+  solver::SimulationConfig c = falling();
+  c.material.friction_deg = 30;
+  c.dt = 1e-5;
+  c.damping = 0.1;
+  c.threads = threads;
+  c.gravity = Eigen::Vector3d(-9.81 * std::sin(M_PI / 6), 0, -9.81 * std::cos(M_PI / 6));
+  return c;
+}
+
+solver::Simulation block_run(int threads) {
+  solver::Simulation sim(block_config(threads), block(),
+                         solver::mesh_walls(side_wall(), solver::MeshContact::YadeParity));
+  sim.set_outlet(Eigen::Vector3d(-1, -1, 0), Eigen::Vector3d(1, 1, 1));
+  return sim;
+}
+
+void expect_same_state(const solver::Simulation& a, const solver::Simulation& b, int step) {
+  ASSERT_EQ(a.removed_count(), b.removed_count()) << "step " << step;
+  ASSERT_EQ(a.contact_count(), b.contact_count()) << "step " << step;
+  ASSERT_EQ(a.particles().pos, b.particles().pos) << "step " << step;
+  ASSERT_EQ(a.particles().vel, b.particles().vel) << "step " << step;
+  ASSERT_EQ(a.particles().angvel, b.particles().angvel) << "step " << step;
+  ASSERT_EQ(a.walls()[0].force, b.walls()[0].force) << "step " << step;
+}
+
+}  // namespace
+
+// Exact answer: a sphere leaving through the outlet takes its pairs out of the contact pass
+// without a neighbour-list build (Simulation::drop_removed_pairs). The run must be the run whose
+// list is built anew after every removal (as it was before; forced here through
+// invalidate_neighbors) to the bit, after every step and between steps (the contact count read
+// right after a removal), on one thread and two, and through a checkpoint written right after a
+// removal; and it must build its list fewer times.
+TEST(Outlet, RemovalDropsPairsWithoutABuildAndChangesNoBit) {
+  solver::Simulation dropped = block_run(1), rebuilt = block_run(1), two = block_run(2);
+  const auto path = std::filesystem::temp_directory_path() / "gs_outlet_dropped_checkpoint.bin";
+  std::filesystem::remove(path);
+  int removal_steps = 0;
+  std::size_t contacts_at_removal = 0;
+  for (int s = 1; s <= 9000; ++s) {
+    const std::size_t before = dropped.removed_count();
+    dropped.step();
+    rebuilt.step();
+    two.step();
+    if (rebuilt.removed_count() != before) {
+      rebuilt.invalidate_neighbors();
+      ++removal_steps;
+      contacts_at_removal += dropped.contact_count();
+      if (removal_steps == 20) dropped.save_checkpoint(path);
+    }
+    expect_same_state(dropped, rebuilt, s);
+    expect_same_state(dropped, two, s);
+    if (HasFatalFailure()) return;
+  }
+  // (the case is what it is meant to be: spheres leave on many steps, in contact as they
+  // leave, and the list is built fewer times)
+  EXPECT_GT(removal_steps, 40);
+  EXPECT_GT(dropped.removed_count(), 64u);
+  std::printf(
+      "%zu spheres out on %d steps, %zu contacts just after them, list builds %lld (%lld "
+      "building after every removal)\n",
+      dropped.removed_count(), removal_steps, contacts_at_removal,
+      static_cast<long long>(dropped.neighbor_list_builds()),
+      static_cast<long long>(rebuilt.neighbor_list_builds()));
+  EXPECT_GT(contacts_at_removal, 0u);
+  EXPECT_LT(dropped.neighbor_list_builds(), rebuilt.neighbor_list_builds());
+  // The checkpoint after the 20th removal, resumed, ends where the straight run does.
+  ASSERT_TRUE(std::filesystem::exists(path));
+  solver::Simulation resumed = block_run(1);
+  resumed.load_checkpoint(path);
+  std::filesystem::remove(path);
+  const std::int64_t left = 9000 - resumed.step_count();
+  ASSERT_GT(left, 0);
+  solver::Simulation straight = block_run(1);
+  straight.run(resumed.step_count());
+  resumed.run(left);
+  straight.run(left);
+  expect_same_state(resumed, straight, 9000);
+  expect_same_state(resumed, dropped, 9000);
 }
 
 namespace {
