@@ -1756,20 +1756,16 @@ void Simulation::step() {
       }
     };
     // Without clumps, a periodic cell or processes the integration reads none of what that
-    // thread writes, so the others go on to integrate (nowait; the integration's chunks are
-    // then taken as the threads come, which changes no sum: they are kept per chunk).
-    if (clumps_.empty() && !periodic_ && !domain_) {
-#pragma omp single nowait
-      walls_and_fields();
-    } else {
+    // thread writes: the walls come after it, on the thread that ends its share first (below).
+    const bool walls_after = clumps_.empty() && !periodic_ && !domain_;
+    if (!walls_after) {
 #pragma omp single
       walls_and_fields();  // (implicit barrier: the integration uses the clumps' and cell's)
     }
 
     // Integration, with the work of gravity and of applied loads over this step (velocities of
     // the step, before the update) and the damping dissipation, summed per fixed chunk.
-#pragma omp for schedule(dynamic) reduction(&& : finite)
-    for (std::size_t c = 0; c < chunks; ++c) {
+    auto integrate_chunk = [&](std::size_t c) {
       double fr = 0, ro = 0;
       const std::size_t begin = c * kChunk, end = std::min(n, (c + 1) * kChunk);
       const std::uint8_t* roles = roles_.empty() ? nullptr : roles_.data();
@@ -1783,12 +1779,34 @@ void Simulation::step() {
                                                                  cfg_.damping, dt, field_, roles)
                                : integrate_particles(p_, begin, end, cfg_.gravity, cfg_.damping, dt,
                                                      !clumps_.empty(), roles);
-      finite = finite && sums.finite;
       chunk_sums_[kSums * c] = fr;
       chunk_sums_[kSums * c + 1] = ro;
       chunk_sums_[kSums * c + 2] = sums.gravity_power;
       chunk_sums_[kSums * c + 3] = sums.external_power;
       chunk_sums_[kSums * c + 4] = sums.damping;
+      return sums.finite;
+    };
+    if (nt > 1 && split_first_.size() == nt + 1) {
+      // Each thread the chunks that start in its share of the contact pass: the particles whose
+      // loads it has just summed, still in its core's cache (taken as they came, half the
+      // chunks were the other core's, and the integration of the 53k box cost 1.8 times the
+      // one thread's). Each chunk's sums are its own, whichever thread forms them.
+      const std::size_t t = static_cast<std::size_t>(omp_get_thread_num());
+      const std::size_t c0 = (split_first_[t] + kChunk - 1) / kChunk;
+      const std::size_t c1 = (split_first_[t + 1] + kChunk - 1) / kChunk;
+      bool mine = true;
+      for (std::size_t c = c0; c < c1; ++c) mine = integrate_chunk(c) && mine;
+      if (!mine) {
+#pragma omp atomic write
+        finite = false;
+      }  // (the region's end is the barrier)
+    } else {
+#pragma omp for schedule(dynamic) reduction(&& : finite)
+      for (std::size_t c = 0; c < chunks; ++c) finite = integrate_chunk(c) && finite;
+    }
+    if (walls_after) {
+#pragma omp single nowait
+      walls_and_fields();  // (the region's end is the barrier)
     }
   };
   run_on_team(threads, region);
