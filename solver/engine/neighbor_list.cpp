@@ -296,11 +296,12 @@ void NeighborList::build(const ParticleState& p, const std::vector<WallState>& w
         while (z < dims[2] && cell_start_[static_cast<std::size_t>(z + 1) * layer] <= target) ++z;
         return k == 0 ? 0 : z;
       };
-      auto& out = found_by_thread_[static_cast<std::size_t>(t)];
+      auto& out = found_by_thread_[static_cast<std::size_t>(t)].pairs;
       out.clear();
       sphere_pairs(out, first_layer(t), first_layer(t + 1));
     }
-    for (const auto& part : found_by_thread_) found_.insert(found_.end(), part.begin(), part.end());
+    for (const auto& part : found_by_thread_)
+      found_.insert(found_.end(), part.pairs.begin(), part.pairs.end());
   }
   // The large particles: with each other, and with the slots of the cells their reach covers.
   auto same_clump = [&](std::uint32_t a, std::uint32_t b) {
