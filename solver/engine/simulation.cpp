@@ -1650,6 +1650,9 @@ void Simulation::step() {
   // One parallel region per step (a region per loop lets the idle thread fall asleep between
   // them, and waking it costs more than the loops on small systems); with one thread, none
   // (run_on_team: the constructs below then run orphaned).
+  const bool resplit = threads > 1 && (split_version_ != pairs_version_ || shares_unbalanced() ||
+                                       split_threads_ != static_cast<std::size_t>(threads));
+  if (threads > 1 && !resplit) ++share_steps_;
   auto region = [&] {
     const std::size_t nt = static_cast<std::size_t>(omp_get_num_threads());
     if (nt == 1) {
@@ -1661,11 +1664,14 @@ void Simulation::step() {
       // loads straight onto them, as one thread does; the few particles also loaded by another
       // share's pairs (mixed) are gathered afterwards from loads_ in pair order. The sums are
       // the serial pass's for any number of threads.
+      // (a new split only when the list, the team or the balance changed: decided before the
+      // region, so that the step's other loops pay no barrier for it)
+      if (resplit || nt != static_cast<std::size_t>(threads)) {
 #pragma omp single
-      {
-        if (split_version_ != pairs_version_ || split_threads_ != nt || shares_unbalanced())
+        {
           split_pairs(nt);
-        ++share_steps_;
+          ++share_steps_;
+        }
       }
       const std::size_t t = static_cast<std::size_t>(omp_get_thread_num());
       std::size_t begin = split_pair_[t], end = split_pair_[t + 1];
