@@ -263,9 +263,11 @@ void Simulation::drop_removed_pairs() {
     for (std::size_t k = 0; k < np; ++k) pass_pairs_[k] = static_cast<std::uint32_t>(k);
     pass_wall_pairs_ = wall_pairs_;
   }
-  for (const std::uint32_t k : pass_pairs_)
-    if (gone(k)) dropped_.push_back(k);
-  std::erase_if(pass_pairs_, gone);
+  std::erase_if(pass_pairs_, [&](std::uint32_t k) {
+    if (!gone(k)) return false;
+    dropped_.push_back(k);  // (in pair order)
+    return true;
+  });
   std::erase_if(pass_wall_pairs_, gone);
   // (a deferred pair admitted in the last step and not in the next is marked apart there)
   std::erase_if(deferred_groups_,
