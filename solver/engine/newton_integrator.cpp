@@ -10,6 +10,10 @@
 #include "rigid_clump.hpp"
 #include "simd_level.hpp"
 
+#if GS_SIMD_X86
+#include <immintrin.h>
+#endif
+
 namespace gs::solver {
 
 namespace {
@@ -285,6 +289,137 @@ void integrate_clump_batch(ClumpBatch& b, int count, V3 g, double damping, doubl
   integrate_clumps_generic(b, count, g, damping, dt);
 }
 
+#if GS_SIMD_X86
+// The batch's gather and scatter for eight consecutive particles with AVX-512 transposes: a
+// particle's 3-vectors lie one after the other (x0 y0 z0 x1 …), 24 doubles in three registers,
+// turned into one register per component and back by two-source permutes. Only moves: each
+// lane's arithmetic (the kernel, pos + vel·dt, rot + ω·dt) is the scalar code's, so the bits are
+// those of the one-particle-at-a-time gather and scatter (docs/physics.md).
+static_assert(sizeof(Eigen::Vector3d) == 3 * sizeof(double));
+static_assert(sizeof(Eigen::Quaterniond) == 4 * sizeof(double));
+
+struct Aos3 {
+  __m512d a, b, c;  // (x0 y0 z0 x1 y1 z1 x2 y2), (z2 x3 y3 z3 x4 y4 z4 x5), (y5 z5 x6 … z7)
+};
+
+__attribute__((target("avx512f"))) inline void aos_to_soa(const double* src, double* x, double* y,
+                                                          double* z) {
+  const __m512d a = _mm512_loadu_pd(src), b = _mm512_loadu_pd(src + 8),
+                c = _mm512_loadu_pd(src + 16);
+  // (_mm512_set_epi64 lists the lanes from the highest down)
+  const __m512d tx = _mm512_permutex2var_pd(a, _mm512_set_epi64(0, 0, 15, 12, 9, 6, 3, 0), b);
+  const __m512d ty = _mm512_permutex2var_pd(a, _mm512_set_epi64(0, 0, 0, 13, 10, 7, 4, 1), b);
+  const __m512d tz = _mm512_permutex2var_pd(a, _mm512_set_epi64(0, 0, 0, 14, 11, 8, 5, 2), b);
+  _mm512_store_pd(x, _mm512_permutex2var_pd(tx, _mm512_set_epi64(13, 10, 5, 4, 3, 2, 1, 0), c));
+  _mm512_store_pd(y, _mm512_permutex2var_pd(ty, _mm512_set_epi64(14, 11, 8, 4, 3, 2, 1, 0), c));
+  _mm512_store_pd(z, _mm512_permutex2var_pd(tz, _mm512_set_epi64(15, 12, 9, 4, 3, 2, 1, 0), c));
+}
+
+__attribute__((target("avx512f"))) inline Aos3 soa_to_aos(__m512d x, __m512d y, __m512d z) {
+  const __m512d ta = _mm512_permutex2var_pd(x, _mm512_set_epi64(10, 2, 0, 9, 1, 0, 8, 0), y);
+  const __m512d tb = _mm512_permutex2var_pd(x, _mm512_set_epi64(5, 0, 12, 4, 0, 11, 3, 0), y);
+  const __m512d tc = _mm512_permutex2var_pd(x, _mm512_set_epi64(0, 15, 7, 0, 14, 6, 0, 13), y);
+  return {_mm512_permutex2var_pd(ta, _mm512_set_epi64(7, 6, 9, 4, 3, 8, 1, 0), z),
+          _mm512_permutex2var_pd(tb, _mm512_set_epi64(7, 12, 5, 4, 11, 2, 1, 10), z),
+          _mm512_permutex2var_pd(tc, _mm512_set_epi64(15, 6, 5, 14, 3, 2, 13, 0), z)};
+}
+
+__attribute__((target("avx512f"))) inline void store_aos(double* dst, const Aos3& v) {
+  _mm512_storeu_pd(dst, v.a);
+  _mm512_storeu_pd(dst + 8, v.b);
+  _mm512_storeu_pd(dst + 16, v.c);
+}
+
+/// The batch's lanes [j0, j0 + 8) from particles i0 + j0 … (fields as integrate_range puts them).
+__attribute__((target("avx512f"))) void gather8_avx512(const ParticleState& p, std::size_t i,
+                                                       ParticleBatch& b, int j) {
+  using F = ParticleBatch::Field;
+  auto put3 = [&](F f, const std::vector<Eigen::Vector3d>& v) {
+    aos_to_soa(v[i].data(), &b.v[f][j], &b.v[f + 1][j], &b.v[f + 2][j]);
+  };
+  put3(F::VX, p.vel);
+  put3(F::WX, p.angvel);
+  put3(F::FX, p.force);
+  put3(F::TX, p.torque);
+  put3(F::EX, p.external_force);
+  // Quaternions (x y z w each) → one register per coefficient.
+  const double* q = p.ori[i].coeffs().data();
+  const __m512d q0 = _mm512_loadu_pd(q), q1 = _mm512_loadu_pd(q + 8), q2 = _mm512_loadu_pd(q + 16),
+                q3 = _mm512_loadu_pd(q + 24);
+  const __m512i lo = _mm512_set_epi64(13, 9, 5, 1, 12, 8, 4, 0);    // x0..3 | y0..3
+  const __m512i hi = _mm512_set_epi64(15, 11, 7, 3, 14, 10, 6, 2);  // z0..3 | w0..3
+  const __m512d xy03 = _mm512_permutex2var_pd(q0, lo, q1),
+                zw03 = _mm512_permutex2var_pd(q0, hi, q1);
+  const __m512d xy47 = _mm512_permutex2var_pd(q2, lo, q3),
+                zw47 = _mm512_permutex2var_pd(q2, hi, q3);
+  const __m512i first = _mm512_set_epi64(11, 10, 9, 8, 3, 2, 1, 0);
+  const __m512i second = _mm512_set_epi64(15, 14, 13, 12, 7, 6, 5, 4);
+  _mm512_store_pd(&b.v[F::QX][j], _mm512_permutex2var_pd(xy03, first, xy47));
+  _mm512_store_pd(&b.v[F::QY][j], _mm512_permutex2var_pd(xy03, second, xy47));
+  _mm512_store_pd(&b.v[F::QZ][j], _mm512_permutex2var_pd(zw03, first, zw47));
+  _mm512_store_pd(&b.v[F::QW][j], _mm512_permutex2var_pd(zw03, second, zw47));
+  _mm512_store_pd(&b.v[F::MASS][j], _mm512_loadu_pd(&p.mass[i]));
+  _mm512_store_pd(&b.v[F::INERTIA][j], _mm512_loadu_pd(&p.inertia[i]));
+  for (int k = 0; k < 8; ++k) {
+    b.v[F::FIXED][j + k] = p.fixed[i + static_cast<std::size_t>(k)];
+    b.v[F::ROT_BLOCKED][j + k] = p.rot_blocked[i + static_cast<std::size_t>(k)];
+  }
+}
+
+/// Writes lanes [j, j + 8) back to particles i …: velocities, positions (pos + vel·dt), rotation
+/// vectors (rot + ω·dt) and, where no lane needs the exact rotation, orientations. Returns
+/// whether every position and velocity is finite and whether a lane needs the exact rotation.
+__attribute__((target("avx512f"))) void scatter8_avx512(ParticleState& p, std::size_t i,
+                                                        const ParticleBatch& b, int j, double dt,
+                                                        bool& finite, bool& large) {
+  using F = ParticleBatch::Field;
+  const __m512d vdt = _mm512_set1_pd(dt);
+  const __m512d vx = _mm512_load_pd(&b.v[F::VX][j]), vy = _mm512_load_pd(&b.v[F::VY][j]),
+                vz = _mm512_load_pd(&b.v[F::VZ][j]);
+  const __m512d wx = _mm512_load_pd(&b.v[F::WX][j]), wy = _mm512_load_pd(&b.v[F::WY][j]),
+                wz = _mm512_load_pd(&b.v[F::WZ][j]);
+  store_aos(p.vel[i].data(), soa_to_aos(vx, vy, vz));
+  const Aos3 w = soa_to_aos(wx, wy, wz);
+  store_aos(p.angvel[i].data(), w);
+  // pos + vel·dt per component, and its squared norm x² + (y² + z²) for the finite check
+  alignas(64) double px[8], py[8], pz[8];
+  aos_to_soa(p.pos[i].data(), px, py, pz);
+  const __m512d nx = _mm512_add_pd(_mm512_load_pd(px), _mm512_mul_pd(vx, vdt));
+  const __m512d ny = _mm512_add_pd(_mm512_load_pd(py), _mm512_mul_pd(vy, vdt));
+  const __m512d nz = _mm512_add_pd(_mm512_load_pd(pz), _mm512_mul_pd(vz, vdt));
+  store_aos(p.pos[i].data(), soa_to_aos(nx, ny, nz));
+  const __m512d n2 = _mm512_add_pd(_mm512_mul_pd(nx, nx),
+                                   _mm512_add_pd(_mm512_mul_pd(ny, ny), _mm512_mul_pd(nz, nz)));
+  const __mmask8 pos_ok = _mm512_cmp_pd_mask(n2, _mm512_set1_pd(HUGE_VAL), _CMP_LT_OQ);
+  const __mmask8 vel_ok =
+      _mm512_cmp_pd_mask(_mm512_load_pd(&b.v[F::FINITE][j]), _mm512_setzero_pd(), _CMP_NEQ_UQ);
+  finite = finite && (pos_ok & vel_ok) == 0xff;
+  // rot + ω·dt, on the interleaved components directly
+  double* r = p.rot[i].data();
+  _mm512_storeu_pd(r, _mm512_add_pd(_mm512_loadu_pd(r), _mm512_mul_pd(w.a, vdt)));
+  _mm512_storeu_pd(r + 8, _mm512_add_pd(_mm512_loadu_pd(r + 8), _mm512_mul_pd(w.b, vdt)));
+  _mm512_storeu_pd(r + 16, _mm512_add_pd(_mm512_loadu_pd(r + 16), _mm512_mul_pd(w.c, vdt)));
+  large = _mm512_cmp_pd_mask(_mm512_load_pd(&b.v[F::LARGE_ANGLE][j]), _mm512_setzero_pd(),
+                             _CMP_NEQ_UQ) != 0;
+  if (large) return;  // (the caller updates this block's orientations one by one)
+  const __m512d qx = _mm512_load_pd(&b.v[F::QX][j]), qy = _mm512_load_pd(&b.v[F::QY][j]),
+                qz = _mm512_load_pd(&b.v[F::QZ][j]), qw = _mm512_load_pd(&b.v[F::QW][j]);
+  const __m512i first = _mm512_set_epi64(11, 10, 9, 8, 3, 2, 1, 0);
+  const __m512i second = _mm512_set_epi64(15, 14, 13, 12, 7, 6, 5, 4);
+  const __m512d xy03 = _mm512_permutex2var_pd(qx, first, qy),
+                xy47 = _mm512_permutex2var_pd(qx, second, qy);
+  const __m512d zw03 = _mm512_permutex2var_pd(qz, first, qw),
+                zw47 = _mm512_permutex2var_pd(qz, second, qw);
+  const __m512i lo = _mm512_set_epi64(13, 9, 5, 1, 12, 8, 4, 0);
+  const __m512i hi = _mm512_set_epi64(15, 11, 7, 3, 14, 10, 6, 2);
+  double* q = p.ori[i].coeffs().data();
+  _mm512_storeu_pd(q, _mm512_permutex2var_pd(xy03, lo, zw03));
+  _mm512_storeu_pd(q + 8, _mm512_permutex2var_pd(xy03, hi, zw03));
+  _mm512_storeu_pd(q + 16, _mm512_permutex2var_pd(xy47, lo, zw47));
+  _mm512_storeu_pd(q + 24, _mm512_permutex2var_pd(xy47, hi, zw47));
+}
+#endif
+
 template <bool kMembers, bool kRoles = false>
 IntegrationSums integrate_range(ParticleState& p, std::size_t begin, std::size_t end,
                                 const Eigen::Vector3d& gravity, double damping, double dt,
@@ -293,6 +428,9 @@ IntegrationSums integrate_range(ParticleState& p, std::size_t begin, std::size_t
   IntegrationSums sums;
   ParticleBatch b;
   std::size_t lane_index[ParticleBatch::kLanes];
+#if GS_SIMD_X86
+  [[maybe_unused]] const bool wide = simd_level() == SimdLevel::Avx512;  // (8 lanes at a time)
+#endif
   // Of a clump member the clump update overwrites the position and orientation, so only the
   // rotation vector and the finite check are left (true: it was one).
   auto member = [&](std::size_t i) {
@@ -335,7 +473,15 @@ IntegrationSums integrate_range(ParticleState& p, std::size_t begin, std::size_t
       b.v[f + 1][j] = x[1];
       b.v[f + 2][j] = x[2];
     };
-    for (int j = 0; j < count; ++j) {
+    int j0 = 0;  // (the lanes below j0 gathered eight at a time)
+#if GS_SIMD_X86
+    if constexpr (!kMembers && !kRoles) {
+      if (wide)
+        for (; j0 + 8 <= count; j0 += 8)
+          gather8_avx512(p, i0 + static_cast<std::size_t>(j0), b, j0);
+    }
+#endif
+    for (int j = j0; j < count; ++j) {
       const std::size_t i = lane(j);
       put(F::VX, j, p.vel[i]);
       put(F::WX, j, p.angvel[i]);
@@ -354,10 +500,37 @@ IntegrationSums integrate_range(ParticleState& p, std::size_t begin, std::size_t
     integrate_batch(b, count, V3(gravity), damping, dt);
     auto get = [&](F f, int j) { return V3(b.v[f][j], b.v[f + 1][j], b.v[f + 2][j]); };
     for (int j = 0; j < count; ++j) {
-      const std::size_t i = lane(j);
       sums.gravity_power += b.v[F::GRAVITY_POWER][j];
       sums.external_power += b.v[F::EXTERNAL_POWER][j];
       sums.damping += b.v[F::DAMPING][j];
+    }
+    // A large rotation in one step, or an orientation that was not a unit quaternion.
+    auto exact_rotation = [&](std::size_t i) {
+      const Eigen::Vector3d w = p.angvel[i];
+      const double a = w.norm();
+      if (a > 0) p.ori[i] = Eigen::Quaterniond(Eigen::AngleAxisd(a * dt, w / a)) * p.ori[i];
+      p.ori[i].normalize();
+    };
+#if GS_SIMD_X86
+    if constexpr (!kMembers && !kRoles) {
+      for (int j = 0; j < j0; j += 8) {
+        bool large = false;
+        const std::size_t i = i0 + static_cast<std::size_t>(j);
+        scatter8_avx512(p, i, b, j, dt, sums.finite, large);
+        if (!large) continue;
+        for (int k = j; k < j + 8; ++k) {
+          const std::size_t ik = i0 + static_cast<std::size_t>(k);
+          if (b.v[F::LARGE_ANGLE][k] == 0)
+            p.ori[ik] =
+                Eigen::Quaterniond(b.v[F::QW][k], b.v[F::QX][k], b.v[F::QY][k], b.v[F::QZ][k]);
+          else
+            exact_rotation(ik);
+        }
+      }
+    }
+#endif
+    for (int j = j0; j < count; ++j) {
+      const std::size_t i = lane(j);
       const V3 vel = get(F::VX, j), angvel = get(F::WX, j);
       vel.store(p.vel[i]);
       angvel.store(p.angvel[i]);
@@ -370,11 +543,7 @@ IntegrationSums integrate_range(ParticleState& p, std::size_t begin, std::size_t
         p.ori[i] = Eigen::Quaterniond(b.v[F::QW][j], b.v[F::QX][j], b.v[F::QY][j], b.v[F::QZ][j]);
         continue;
       }
-      // A large rotation in one step, or an orientation that was not a unit quaternion.
-      const Eigen::Vector3d w = p.angvel[i];
-      const double a = w.norm();
-      if (a > 0) p.ori[i] = Eigen::Quaterniond(Eigen::AngleAxisd(a * dt, w / a)) * p.ori[i];
-      p.ori[i].normalize();
+      exact_rotation(i);
     }
   }
   return sums;
