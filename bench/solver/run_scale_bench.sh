@@ -4,7 +4,8 @@
 # preparation: 1 663 spheres, coordination ~5, not a lattice) replicated side by side to about
 # 50 000, 500 000 and 1 000 000 spheres (make_tiled_specimen.py), at rest between six fixed box
 # walls, no gravity, the same steps for every code:
-#   granoscope 1 process × 1 and 2 threads, 2 processes (mpirun) × 1 thread;
+#   granoscope 1 process × 1 and 2 threads, 2 processes (mpirun) × 1 thread, and 1 process × 1
+#   and 2 threads with the particles in spatial order ([solver] order = "spatial");
 #   YADE 2023.02a -j1 and -j2 (yade_scale_case.py: the same law and material);
 #   LIGGGHTS 3.8 on 1 and 2 MPI ranks (liggghts_case.py: hooke + rolling friction, same Ec, ρ, dt).
 # Prints particle-steps/s with ratios to granoscope 1 × 1, the largest memory (max RSS) per
@@ -15,6 +16,7 @@
 # from it the fraction of a run that frames every 1 000 steps would take.
 #   bench/solver/run_scale_bench.sh [BUILD_DIR]
 #   SIZES="50000 500000 1000000" STEPS="200 40 20" BASELINES=1 (0: granoscope only)
+#   REPEAT=1 (rounds of granoscope's runs: the medians are printed, and the thread ratios of each)
 # (needs: apt-get install libopenmpi-dev openmpi-bin; --no-install-recommends yade liggghts)
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
@@ -29,6 +31,7 @@ mpi="mpirun --allow-run-as-root --oversubscribe --mca btl_vader_single_copy_mech
 read -r -a sizes <<< "${SIZES:-50000 500000 1000000}"
 read -r -a stepss <<< "${STEPS:-200 40 20}"
 baselines=${BASELINES:-1}
+repeat=${REPEAT:-1}
 
 # 1. The prepared specimen: the triaxial scene's preparation, stopped once it is written.
 "$gs" simulate "$root/data/scenes/triaxial.toml" --threads 2 -q -o "$work/prep" > /dev/null 2>&1 &
@@ -82,20 +85,41 @@ for k in "${!sizes[@]}"; do
   read -r n lx ly lz tiles <<< "$("$py" "$here/make_tiled_specimen.py" "$work/prep/specimen.h5" "$target" "$work/p.csv")"
   scene "$work/p.csv" "$lx" "$ly" "$lz" $((steps + 1)) 1000000000 "$work/s.toml"
   scene "$work/p.csv" "$lx" "$ly" "$lz" $((steps + 1)) $((steps / 4)) "$work/o.toml"
+  # The same scene with the particles renumbered along a Morton curve ([solver] order).
+  sed 's/^max_overlap_ratio = 0.5$/&\norder = "spatial"/' "$work/s.toml" > "$work/s_spatial.toml"
   echo
   echo "== $n spheres ($tiles copies), box $lx x $ly x $lz m, $steps steps"
   # (each rate from a 1-step and a (1 + STEPS)-step run: the first step left out)
-  ours() {  # label threads launcher...
+  ours() {  # label threads launcher... (the scene: $scene_toml)
     local label=$1 threads=$2
     shift 2
-    "$@" "$gs" simulate "$work/s.toml" --threads "$threads" --steps 1 -q -o "$work/r" > "$work/$label.1"
-    "$@" "$gs" simulate "$work/s.toml" --threads "$threads" -q -o "$work/r" > "$work/$label.n"
+    "$@" "$gs" simulate "$scene_toml" --threads "$threads" --steps 1 -q -o "$work/r" > "$work/$label.1"
+    "$@" "$gs" simulate "$scene_toml" --threads "$threads" -q -o "$work/r" > "$work/$label.n"
     "$py" -c "import sys; print($n*$steps/(float(sys.argv[2])-float(sys.argv[1])))" \
       "$(secs "$work/$label.1")" "$(secs "$work/$label.n")"
   }
-  r11=$(ours t11 1 /usr/bin/time -f %M -o "$work/m11")
-  r12=$(ours t12 2)
-  r21=$(ours t21 1 $mpi -np 2 sh -c "/usr/bin/time -f %M -o $work/m21.\$OMPI_COMM_WORLD_RANK \"\$0\" \"\$@\"")
+  # REPEAT rounds, each running every configuration once (interleaved, so that a slow spell
+  # of the machine touches all of them); each rate is the median of its rounds, and the
+  # two-thread ratios are given per round too.
+  r11s=() r12s=() r21s=() s11s=() s12s=() t11s=()
+  for _ in $(seq "$repeat"); do
+    scene_toml=$work/s.toml
+    r11s+=("$(ours t11 1 /usr/bin/time -f %M -o "$work/m11")")
+    t11s+=("$(secs "$work/t11.n")")
+    r12s+=("$(ours t12 2)")
+    r21s+=("$(ours t21 1 $mpi -np 2 sh -c "/usr/bin/time -f %M -o $work/m21.\$OMPI_COMM_WORLD_RANK \"\$0\" \"\$@\"")")
+    scene_toml=$work/s_spatial.toml
+    s11s+=("$(ours u11 1)")
+    s12s+=("$(ours u12 2)")
+  done
+  median() { printf '%s\n' "$@" | sort -g | awk '{v[NR] = $1} END {print (NR % 2) ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2}'; }
+  r11=$(median "${r11s[@]}") r12=$(median "${r12s[@]}") r21=$(median "${r21s[@]}")
+  s11=$(median "${s11s[@]}") s12=$(median "${s12s[@]}")
+  rounds=""
+  for j in "${!r11s[@]}"; do
+    rounds+=$("$py" -c "import sys; a = [float(x) for x in sys.argv[1:]]; print(' %.2f/%.2f' % (a[1] / a[0], a[3] / a[2]))" \
+      "${r11s[$j]}" "${r12s[$j]}" "${s11s[$j]}" "${s12s[$j]}")
+  done
   "$gs" simulate "$work/o.toml" --threads 1 -q -o "$work/ro" > "$work/to"
   out_mb=$(du -sm "$work/ro" | cut -f1)
   y1=0 y2=0 ym=0 l1=0 l2=0 lm=0
@@ -114,23 +138,30 @@ for k in "${!sizes[@]}"; do
     lm=$(cat "$work/ml")
   fi
   "$py" - "$n" "$steps" "$r11" "$r12" "$r21" \
-    "$(cat "$work/m11")" "$(cat "$work/m21.0")" "$(cat "$work/m21.1")" "$(secs "$work/t11.n")" "$(secs "$work/to")" \
-    "$out_mb" "$y1" "$y2" "$ym" "$l1" "$l2" "$lm" <<'PY'
+    "$(cat "$work/m11")" "$(cat "$work/m21.0")" "$(cat "$work/m21.1")" "$(median "${t11s[@]}")" "$(secs "$work/to")" \
+    "$out_mb" "$y1" "$y2" "$ym" "$l1" "$l2" "$lm" "$s11" "$s12" "$repeat" "$rounds" <<'PY'
 import sys
 n, steps = int(sys.argv[1]), int(sys.argv[2])
 r11, r12, r21 = (float(x) for x in sys.argv[3:6])
 m11, m21a, m21b = (float(x) for x in sys.argv[6:9])
 t11, to, out_mb = float(sys.argv[9]), float(sys.argv[10]), float(sys.argv[11])
 y1, y2, ym, l1, l2, lm = (float(x) for x in sys.argv[12:18])
+s11, s12 = float(sys.argv[18]), float(sys.argv[19])
+repeat, rounds = int(sys.argv[20]), sys.argv[21]
 print("  %-40s %16s %8s %14s" % ("run", "particle-steps/s", "ratio", "kB per sphere"))
 rows = [("granoscope, 1 process x 1 thread", r11, m11), ("granoscope, 1 process x 2 threads", r12, None),
-        ("granoscope, 2 processes x 1 thread", r21, max(m21a, m21b))]
+        ("granoscope, 2 processes x 1 thread", r21, max(m21a, m21b)),
+        ("granoscope, spatial order, 1 x 1", s11, None),
+        ("granoscope, spatial order, 1 x 2", s12, None)]
 if y1:
     rows += [("YADE -j1", y1, ym), ("YADE -j2", y2, None), ("LIGGGHTS, 1 rank", l1, lm),
              ("LIGGGHTS, 2 ranks (mpirun)", l2, None)]
 for label, r, m in rows:
     print("  %-40s %16.3g %7.2fx %14s" % (label, r, r / r11, "%.2f" % (m / n) if m else ""))
 print("  (memory: the largest resident set of the process, or of either process, over the run)")
+print("  (granoscope: the median of %d interleaved rounds)" % repeat)
+print("  two threads / one thread: file order %.2fx, spatial order %.2fx (medians);"
+      " per round, file/spatial:%s" % (r12 / r11, s12 / s11, rounds))
 # The frames run: 4 more frames than the plain run (every STEPS/4 and the last; step 0's is
 # written before the timer starts in both).
 frame = (to - t11) / 4
