@@ -112,7 +112,9 @@ for k in "${!sizes[@]}"; do
     s11s+=("$(ours u11 1)")
     s12s+=("$(ours u12 2)")
   done
-  median() { printf '%s\n' "$@" | sort -g | awk '{v[NR] = $1} END {print (NR % 2) ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2}'; }
+  # (a rate is left out when its STEPS took no longer than the 1-step run: too few steps for
+  # this machine's noise; nan when every round's was)
+  median() { printf '%s\n' "$@" | awk '$1 + 0 > 0' | sort -g | awk '{v[NR] = $1} END {print NR == 0 ? "nan" : (NR % 2) ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2}'; }
   r11=$(median "${r11s[@]}") r12=$(median "${r12s[@]}") r21=$(median "${r21s[@]}")
   s11=$(median "${s11s[@]}") s12=$(median "${s12s[@]}")
   rounds=""

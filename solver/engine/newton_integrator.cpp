@@ -330,7 +330,19 @@ __attribute__((target("avx512f"))) inline void store_aos(double* dst, const Aos3
   _mm512_storeu_pd(dst + 16, v.c);
 }
 
-/// The batch's lanes [j0, j0 + 8) from particles i0 + j0 … (fields as integrate_range puts them).
+/// The index vectors of the quaternion transposes. Two quaternions (x y z w x y z w) per
+/// register: `xy` takes x0..x3 | y0..y3 and `zw` z0..z3 | w0..w3 from two registers (and, the
+/// other way, puts them back); `low` and `high` join the halves of particles 0-3 and 4-7.
+struct QuatIndex {
+  __m512i xy, zw, low, high;
+};
+
+__attribute__((target("avx512f"))) inline QuatIndex quat_index() {
+  return {_mm512_set_epi64(13, 9, 5, 1, 12, 8, 4, 0), _mm512_set_epi64(15, 11, 7, 3, 14, 10, 6, 2),
+          _mm512_set_epi64(11, 10, 9, 8, 3, 2, 1, 0), _mm512_set_epi64(15, 14, 13, 12, 7, 6, 5, 4)};
+}
+
+/// The batch's lanes [j, j + 8) from particles i … i + 7 (the fields integrate_range puts).
 __attribute__((target("avx512f"))) void gather8_avx512(const ParticleState& p, std::size_t i,
                                                        ParticleBatch& b, int j) {
   using F = ParticleBatch::Field;
@@ -343,21 +355,18 @@ __attribute__((target("avx512f"))) void gather8_avx512(const ParticleState& p, s
   put3(F::TX, p.torque);
   put3(F::EX, p.external_force);
   // Quaternions (x y z w each) → one register per coefficient.
+  const QuatIndex ix = quat_index();
   const double* q = p.ori[i].coeffs().data();
   const __m512d q0 = _mm512_loadu_pd(q), q1 = _mm512_loadu_pd(q + 8), q2 = _mm512_loadu_pd(q + 16),
                 q3 = _mm512_loadu_pd(q + 24);
-  const __m512i lo = _mm512_set_epi64(13, 9, 5, 1, 12, 8, 4, 0);    // x0..3 | y0..3
-  const __m512i hi = _mm512_set_epi64(15, 11, 7, 3, 14, 10, 6, 2);  // z0..3 | w0..3
-  const __m512d xy03 = _mm512_permutex2var_pd(q0, lo, q1),
-                zw03 = _mm512_permutex2var_pd(q0, hi, q1);
-  const __m512d xy47 = _mm512_permutex2var_pd(q2, lo, q3),
-                zw47 = _mm512_permutex2var_pd(q2, hi, q3);
-  const __m512i first = _mm512_set_epi64(11, 10, 9, 8, 3, 2, 1, 0);
-  const __m512i second = _mm512_set_epi64(15, 14, 13, 12, 7, 6, 5, 4);
-  _mm512_store_pd(&b.v[F::QX][j], _mm512_permutex2var_pd(xy03, first, xy47));
-  _mm512_store_pd(&b.v[F::QY][j], _mm512_permutex2var_pd(xy03, second, xy47));
-  _mm512_store_pd(&b.v[F::QZ][j], _mm512_permutex2var_pd(zw03, first, zw47));
-  _mm512_store_pd(&b.v[F::QW][j], _mm512_permutex2var_pd(zw03, second, zw47));
+  const __m512d xy03 = _mm512_permutex2var_pd(q0, ix.xy, q1),
+                zw03 = _mm512_permutex2var_pd(q0, ix.zw, q1);
+  const __m512d xy47 = _mm512_permutex2var_pd(q2, ix.xy, q3),
+                zw47 = _mm512_permutex2var_pd(q2, ix.zw, q3);
+  _mm512_store_pd(&b.v[F::QX][j], _mm512_permutex2var_pd(xy03, ix.low, xy47));
+  _mm512_store_pd(&b.v[F::QY][j], _mm512_permutex2var_pd(xy03, ix.high, xy47));
+  _mm512_store_pd(&b.v[F::QZ][j], _mm512_permutex2var_pd(zw03, ix.low, zw47));
+  _mm512_store_pd(&b.v[F::QW][j], _mm512_permutex2var_pd(zw03, ix.high, zw47));
   _mm512_store_pd(&b.v[F::MASS][j], _mm512_loadu_pd(&p.mass[i]));
   _mm512_store_pd(&b.v[F::INERTIA][j], _mm512_loadu_pd(&p.inertia[i]));
   for (int k = 0; k < 8; ++k) {
@@ -366,9 +375,10 @@ __attribute__((target("avx512f"))) void gather8_avx512(const ParticleState& p, s
   }
 }
 
-/// Writes lanes [j, j + 8) back to particles i …: velocities, positions (pos + vel·dt), rotation
-/// vectors (rot + ω·dt) and, where no lane needs the exact rotation, orientations. Returns
-/// whether every position and velocity is finite and whether a lane needs the exact rotation.
+/// Writes lanes [j, j + 8) back to particles i … i + 7: velocities, positions (pos + vel·dt),
+/// rotation vectors (rot + ω·dt) and, unless a lane needs the exact rotation (then `large` is
+/// set and the caller writes the eight orientations), orientations. Clears `finite` when a
+/// position or velocity is not finite.
 __attribute__((target("avx512f"))) void scatter8_avx512(ParticleState& p, std::size_t i,
                                                         const ParticleBatch& b, int j, double dt,
                                                         bool& finite, bool& large) {
@@ -404,19 +414,16 @@ __attribute__((target("avx512f"))) void scatter8_avx512(ParticleState& p, std::s
   if (large) return;  // (the caller updates this block's orientations one by one)
   const __m512d qx = _mm512_load_pd(&b.v[F::QX][j]), qy = _mm512_load_pd(&b.v[F::QY][j]),
                 qz = _mm512_load_pd(&b.v[F::QZ][j]), qw = _mm512_load_pd(&b.v[F::QW][j]);
-  const __m512i first = _mm512_set_epi64(11, 10, 9, 8, 3, 2, 1, 0);
-  const __m512i second = _mm512_set_epi64(15, 14, 13, 12, 7, 6, 5, 4);
-  const __m512d xy03 = _mm512_permutex2var_pd(qx, first, qy),
-                xy47 = _mm512_permutex2var_pd(qx, second, qy);
-  const __m512d zw03 = _mm512_permutex2var_pd(qz, first, qw),
-                zw47 = _mm512_permutex2var_pd(qz, second, qw);
-  const __m512i lo = _mm512_set_epi64(13, 9, 5, 1, 12, 8, 4, 0);
-  const __m512i hi = _mm512_set_epi64(15, 11, 7, 3, 14, 10, 6, 2);
+  const QuatIndex ix = quat_index();
+  const __m512d xy03 = _mm512_permutex2var_pd(qx, ix.low, qy),
+                xy47 = _mm512_permutex2var_pd(qx, ix.high, qy);
+  const __m512d zw03 = _mm512_permutex2var_pd(qz, ix.low, qw),
+                zw47 = _mm512_permutex2var_pd(qz, ix.high, qw);
   double* q = p.ori[i].coeffs().data();
-  _mm512_storeu_pd(q, _mm512_permutex2var_pd(xy03, lo, zw03));
-  _mm512_storeu_pd(q + 8, _mm512_permutex2var_pd(xy03, hi, zw03));
-  _mm512_storeu_pd(q + 16, _mm512_permutex2var_pd(xy47, lo, zw47));
-  _mm512_storeu_pd(q + 24, _mm512_permutex2var_pd(xy47, hi, zw47));
+  _mm512_storeu_pd(q, _mm512_permutex2var_pd(xy03, ix.xy, zw03));
+  _mm512_storeu_pd(q + 8, _mm512_permutex2var_pd(xy03, ix.zw, zw03));
+  _mm512_storeu_pd(q + 16, _mm512_permutex2var_pd(xy47, ix.xy, zw47));
+  _mm512_storeu_pd(q + 24, _mm512_permutex2var_pd(xy47, ix.zw, zw47));
 }
 #endif
 
