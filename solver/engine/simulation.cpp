@@ -888,25 +888,6 @@ void Simulation::attach_histories(const std::vector<ContactHistory>* from) {
     for (const std::uint32_t k : wall_pairs_)
       if (!is_deferred_[k]) pass_wall_pairs_.push_back(k);
   }
-  if (std::max(1, cfg_.threads) == 1) return;  // (the per-particle lists serve threads only)
-  // Pairs of each particle in pair order (entry = pair << 1 | 1 when the particle is the
-  // second body).
-  const std::size_t n = p_.size();
-  pair_start_.assign(n + 1, 0);
-  for (std::size_t k = 0; k < np; ++k) {
-    const auto [a, b] = nl_.pairs[k];
-    ++pair_start_[a + 1];
-    if (b < kWallBase) ++pair_start_[b + 1];
-  }
-  for (std::size_t i = 0; i < n; ++i) pair_start_[i + 1] += pair_start_[i];
-  with_room(pair_of_, pair_start_[n]);
-  pair_of_.resize(pair_start_[n]);
-  std::vector<std::uint32_t> fill(pair_start_.begin(), pair_start_.end() - 1);
-  for (std::size_t k = 0; k < np; ++k) {
-    const auto [a, b] = nl_.pairs[k];
-    pair_of_[fill[a]++] = static_cast<std::uint32_t>(k << 1);
-    if (b < kWallBase) pair_of_[fill[b]++] = static_cast<std::uint32_t>(k << 1 | 1u);
-  }
 }
 
 std::pair<double, std::size_t> Simulation::wall_stiffness(std::size_t w) const {
@@ -1589,14 +1570,36 @@ void Simulation::split_pairs(std::size_t nt) {
   for (std::size_t i = 0; i < n; ++i)
     if (split_mixed_[i]) split_mixed_list_.push_back(static_cast<std::uint32_t>(i));
   // Rows for the loads kept per pair: those of a mixed particle's pairs (for its gather) and of
-  // the wall pairs (for the walls' resultants); 4 B a pair instead of 128.
+  // the wall pairs (for the walls' resultants); 4 B a pair instead of 128. And each mixed
+  // particle's pairs in pair order (entry = pair << 1, | 1 when the particle is the second
+  // body), the gather's order: a counting sort of the entries, in pair order, by the particle's
+  // place in split_mixed_list_ (a few per cent of the particles: no list for the others).
   with_room(load_slot_, np);
   load_slot_.resize(np);
+  const std::size_t nm = split_mixed_list_.size();
+  auto slot_of = [&](std::uint32_t i) {
+    return static_cast<std::size_t>(
+        std::lower_bound(split_mixed_list_.begin(), split_mixed_list_.end(), i) -
+        split_mixed_list_.begin());
+  };
+  mixed_start_.assign(nm + 1, 0);
   std::uint32_t rows = 0;
   for (std::size_t k = 0; k < np; ++k) {
     const auto [a, b] = nl_.pairs[k];
-    const bool kept = b >= kWallBase || split_mixed_[a] || split_mixed_[b];
-    load_slot_[k] = kept ? rows++ : std::numeric_limits<std::uint32_t>::max();
+    const bool ma = split_mixed_[a] != 0, mb = b < kWallBase && split_mixed_[b] != 0;
+    load_slot_[k] = b >= kWallBase || ma || mb ? rows++ : std::numeric_limits<std::uint32_t>::max();
+    if (ma) ++mixed_start_[slot_of(a) + 1];
+    if (mb) ++mixed_start_[slot_of(b) + 1];
+  }
+  for (std::size_t m = 0; m < nm; ++m) mixed_start_[m + 1] += mixed_start_[m];
+  mixed_pairs_.resize(mixed_start_[nm]);
+  std::vector<std::uint32_t> fill(mixed_start_.begin(), mixed_start_.end() - 1);
+  for (std::size_t k = 0; k < np; ++k) {
+    if (load_slot_[k] == std::numeric_limits<std::uint32_t>::max()) continue;
+    const auto [a, b] = nl_.pairs[k];
+    if (split_mixed_[a]) mixed_pairs_[fill[slot_of(a)]++] = static_cast<std::uint32_t>(k << 1);
+    if (b < kWallBase && split_mixed_[b])
+      mixed_pairs_[fill[slot_of(b)]++] = static_cast<std::uint32_t>(k << 1 | 1u);
   }
   with_room(loads_, rows);
   loads_.resize(rows);
@@ -1704,16 +1707,16 @@ void Simulation::step() {
         const std::uint32_t i = split_mixed_list_[m];
         V3 f(p_.external_force[i]), tq;
         double fr = 0, ro = 0;  // dissipation of the pairs whose body 1 this particle is
-        for (std::uint32_t e = pair_start_[i]; e < pair_start_[i + 1]; ++e) {
-          const std::uint32_t k = pair_of_[e] >> 1;
+        for (std::uint32_t e = mixed_start_[m]; e < mixed_start_[m + 1]; ++e) {
+          const std::uint32_t k = mixed_pairs_[e] >> 1;
           if (!active_[k]) continue;
           const std::uint32_t r = load_slot_[k];
           const ContactLoads& L = loads_[r];
-          if ((pair_of_[e] & 1u) == 0) {
+          if ((mixed_pairs_[e] & 1u) == 0) {
             fr += dissipation_[2 * r];
             ro += dissipation_[2 * r + 1];
           }
-          const bool first = (pair_of_[e] & 1u) == 0 && nl_.pairs[k].second < kWallBase;
+          const bool first = (mixed_pairs_[e] & 1u) == 0 && nl_.pairs[k].second < kWallBase;
           if (first) {  // body 1 of a sphere pair
             f += L.force1;
             tq += L.arm1;

@@ -516,9 +516,10 @@ class Simulation {
   std::vector<double> chunk_sums_;  // per chunk: friction, rolling, gravity, external, damping
   std::vector<double> particle_dissipation_;  // friction and rolling of the step, per body 1
   std::vector<double> dissipation_;           // friction and rolling dissipation, rows as loads_
-  // Pairs of each particle, in pair order (CSR), and the wall pairs: loads are gathered per
-  // particle in parallel with the sums in the order of a serial pass over the pairs.
-  std::vector<std::uint32_t> pair_start_, pair_of_, wall_pairs_;
+  // Pairs of each mixed particle (split_mixed_list_ order), in pair order (CSR), and the wall
+  // pairs: loads are gathered per particle in parallel with the sums in the order of a serial
+  // pass over the pairs.
+  std::vector<std::uint32_t> mixed_start_, mixed_pairs_, wall_pairs_;
   // Threads' shares of the contact pass (split_pairs), for pairs_version_ and split_threads_.
   std::uint64_t pairs_version_ = 0, split_version_ = ~std::uint64_t{0};
   std::size_t split_threads_ = 0;
