@@ -279,30 +279,6 @@ void NeighborList::build(const ParticleState& p, const std::vector<WallState>& w
         z0, z1);
   };
   const int nt = threads > 1 && active >= 20000 && dims[2] >= 2 * threads ? threads : 1;
-  if (nt == 1) {
-    sphere_pairs(found_, 0, dims[2]);
-  } else {
-    found_by_thread_.resize(static_cast<std::size_t>(nt));
-    const std::size_t layer = static_cast<std::size_t>(dims[0]) * dims[1];
-    const std::uint32_t slots = cell_start_[ncells];
-#pragma omp parallel num_threads(nt)
-    {
-      const int t = omp_get_thread_num(), n_t = omp_get_num_threads();
-      // The layers from the first whose particles reach this share's start.
-      auto first_layer = [&](int k) {
-        if (k == n_t) return dims[2];
-        const std::uint64_t target = static_cast<std::uint64_t>(slots) * k / n_t;
-        int z = 0;
-        while (z < dims[2] && cell_start_[static_cast<std::size_t>(z + 1) * layer] <= target) ++z;
-        return k == 0 ? 0 : z;
-      };
-      auto& out = found_by_thread_[static_cast<std::size_t>(t)].pairs;
-      out.clear();
-      sphere_pairs(out, first_layer(t), first_layer(t + 1));
-    }
-    for (const auto& part : found_by_thread_)
-      found_.insert(found_.end(), part.pairs.begin(), part.pairs.end());
-  }
   // The large particles: with each other, and with the slots of the cells their reach covers.
   auto same_clump = [&](std::uint32_t a, std::uint32_t b) {
     return clumped && p.clump[a] >= 0 && p.clump[a] == p.clump[b];
@@ -369,13 +345,14 @@ void NeighborList::build(const ParticleState& p, const std::vector<WallState>& w
   facet_sorted_.resize(facet_entries_.size());
   for (std::size_t e = 0; e < facet_entries_.size(); ++e)
     facet_sorted_[cell_fill_[facet_cell_[e]]++] = facet_entries_[e];
-  for (std::size_t i = 0; i < n; ++i) {
-    if (gone(i)) continue;
+  // The walls within reach of particle i, appended to out (seen: scratch).
+  auto wall_pairs = [&](std::size_t i, std::vector<std::pair<std::uint32_t, std::uint32_t>>& out,
+                        std::vector<std::uint32_t>& seen) {
     const std::uint32_t own = cell_of_particle_[i];
     const double reach = p.radius[i] + skin;
     if (is_big_[i]) {
       // A large particle: the facets of every cell its reach covers, each wall paired once.
-      walls_seen_.clear();
+      seen.clear();
       const Eigen::Vector3d span = Eigen::Vector3d::Constant(reach);
       const auto c0 = cell_of(p.pos[i] - span), c1 = cell_of(p.pos[i] + span);
       for (int z = c0[2]; z <= c1[2]; ++z)
@@ -384,12 +361,11 @@ void NeighborList::build(const ParticleState& p, const std::vector<WallState>& w
             const std::uint32_t ci = index_of(x, y, z);
             for (std::uint32_t e = facet_start_[ci]; e < facet_start_[ci + 1]; ++e) {
               const FacetEntry fe = facet_sorted_[e];
-              if (std::find(walls_seen_.begin(), walls_seen_.end(), fe.wall) != walls_seen_.end())
-                continue;
+              if (std::find(seen.begin(), seen.end(), fe.wall) != seen.end()) continue;
               const auto& wall = walls[fe.wall];
               if (facet_near(wall.facets[fe.facet], wall.pos, p.pos[i], reach)) {
-                found_.emplace_back(static_cast<std::uint32_t>(i), kWallBase + fe.wall);
-                walls_seen_.push_back(fe.wall);
+                out.emplace_back(static_cast<std::uint32_t>(i), kWallBase + fe.wall);
+                seen.push_back(fe.wall);
               }
             }
           }
@@ -401,7 +377,7 @@ void NeighborList::build(const ParticleState& p, const std::vector<WallState>& w
       if (fe.wall == last) continue;
       const auto& wall = walls[fe.wall];
       if (facet_near(wall.facets[fe.facet], wall.pos, p.pos[i], reach)) {
-        found_.emplace_back(static_cast<std::uint32_t>(i), kWallBase + fe.wall);
+        out.emplace_back(static_cast<std::uint32_t>(i), kWallBase + fe.wall);
         last = fe.wall;
       }
     }
@@ -410,19 +386,12 @@ void NeighborList::build(const ParticleState& p, const std::vector<WallState>& w
       const double dist = wall.spec.shape == WallShape::Box
                               ? box_distance(wall.pos, wall.spec.half_extents, p.pos[i])
                               : (p.pos[i] - wall.pos).dot(wall.normal);
-      if (dist < p.radius[i] + skin)
-        found_.emplace_back(static_cast<std::uint32_t>(i), kWallBase + w);
+      if (dist < p.radius[i] + skin) out.emplace_back(static_cast<std::uint32_t>(i), kWallBase + w);
     }
-  }
-  // Sorted by (a, b): a counting sort on a, then each particle's few partners in order.
-  first_start_.assign(n + 1, 0);
-  for (const auto& pr : found_) ++first_start_[pr.first + 1];
-  for (std::size_t i = 0; i < n; ++i) first_start_[i + 1] += first_start_[i];
-  cell_fill_.assign(first_start_.begin(), first_start_.end() - 1);
-  with_room(pairs, found_.size());
-  pairs.resize(found_.size());
-  for (const auto& pr : found_) pairs[cell_fill_[pr.first]++] = pr;
-  run_on_team(nt, [&] {
+  };
+  // Sorted by (a, b): a counting sort on a, then each particle's few partners in order (the
+  // pairs being distinct, the order they were found in does not matter).
+  auto sort_partners = [&] {
 #pragma omp for schedule(static)
     for (std::size_t i = 0; i < n; ++i) {
       auto* b = pairs.data() + first_start_[i];
@@ -434,7 +403,72 @@ void NeighborList::build(const ParticleState& p, const std::vector<WallState>& w
         *y = v;
       }
     }
-  });
+  };
+  if (nt == 1) {
+    sphere_pairs(found_, 0, dims[2]);
+    for (std::size_t i = 0; i < n; ++i)
+      if (!gone(i)) wall_pairs(i, found_, walls_seen_);
+    first_start_.assign(n + 1, 0);
+    for (const auto& pr : found_) ++first_start_[pr.first + 1];
+    for (std::size_t i = 0; i < n; ++i) first_start_[i + 1] += first_start_[i];
+    cell_fill_.assign(first_start_.begin(), first_start_.end() - 1);
+    with_room(pairs, found_.size());
+    pairs.resize(found_.size());
+    for (const auto& pr : found_) pairs[cell_fill_[pr.first]++] = pr;
+    sort_partners();
+    return;
+  }
+  // Threads: each finds the sphere pairs of layers of cells holding a share of the particles and
+  // the wall pairs of a share of the particles, counts its pairs per body 1, and places them
+  // (the first thread the large particles' too) from offsets formed per particle in thread order.
+  found_by_thread_.resize(static_cast<std::size_t>(nt));
+  const std::size_t layer = static_cast<std::size_t>(dims[0]) * dims[1];
+  const std::uint32_t slots = cell_start_[ncells];
+#pragma omp parallel num_threads(nt)
+  {
+    const int t = omp_get_thread_num(), n_t = omp_get_num_threads();
+    // The layers from the first whose particles reach this share's start.
+    auto first_layer = [&](int k) {
+      if (k == n_t) return dims[2];
+      const std::uint64_t target = static_cast<std::uint64_t>(slots) * k / n_t;
+      int z = 0;
+      while (z < dims[2] && cell_start_[static_cast<std::size_t>(z + 1) * layer] <= target) ++z;
+      return k == 0 ? 0 : z;
+    };
+    ThreadPairs& mine = found_by_thread_[static_cast<std::size_t>(t)];
+    mine.pairs.clear();
+    sphere_pairs(mine.pairs, first_layer(t), first_layer(t + 1));
+    const std::size_t i0 = n * static_cast<std::size_t>(t) / static_cast<std::size_t>(n_t);
+    const std::size_t i1 = n * static_cast<std::size_t>(t + 1) / static_cast<std::size_t>(n_t);
+    for (std::size_t i = i0; i < i1; ++i)
+      if (!gone(i)) wall_pairs(i, mine.pairs, mine.seen);
+    mine.counts.assign(n, 0);
+    if (t == 0)
+      for (const auto& pr : found_) ++mine.counts[pr.first];
+    for (const auto& pr : mine.pairs) ++mine.counts[pr.first];
+#pragma omp barrier
+#pragma omp single
+    {
+      first_start_.resize(n + 1);
+      std::uint32_t at = 0;
+      for (std::size_t i = 0; i < n; ++i) {
+        first_start_[i] = at;
+        for (auto& part : found_by_thread_) {
+          const std::uint32_t c = part.counts[i];
+          part.counts[i] = at;  // (this thread's first place for body 1 = i)
+          at += c;
+        }
+      }
+      first_start_[n] = at;
+      with_room(pairs, at);
+      pairs.resize(at);
+    }
+    if (t == 0)
+      for (const auto& pr : found_) pairs[mine.counts[pr.first]++] = pr;
+    for (const auto& pr : mine.pairs) pairs[mine.counts[pr.first]++] = pr;
+#pragma omp barrier
+    sort_partners();
+  }
 }
 
 void NeighborList::build_periodic(const ParticleState& p, const PeriodicCell& cell, bool planar_z) {

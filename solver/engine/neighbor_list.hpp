@@ -86,6 +86,8 @@ struct NeighborList {
   // every pair found, made the two threads' search slower than one thread's)
   struct alignas(64) ThreadPairs {
     std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs;
+    std::vector<std::uint32_t> counts;  // pairs per body 1, then their first places
+    std::vector<std::uint32_t> seen;    // walls_seen_ of this thread
   };
   std::vector<ThreadPairs> found_by_thread_;
   std::vector<std::uint32_t> first_start_;

@@ -1639,7 +1639,7 @@ void Simulation::step() {
   }
   active_valid_ = false;  // (until this step ends)
   with_room(active_, np);
-  active_.assign(np, 0);
+  active_.resize(np);  // (zeroed in the region below, each thread its share of the pairs)
   // (one thread keeps no loads per pair, only its walls'; threads keep the rows split_pairs
   // gives)
   wall_loads_.clear();
@@ -1663,6 +1663,7 @@ void Simulation::step() {
     if (nt == 1) {
       // One thread: the loads go straight onto the particles, in pair order, which is the
       // order the gather below sums them in, so the results are the same as with more threads.
+      std::fill(active_.begin(), active_.end(), std::uint8_t{0});
       serial_pass(nv, indexed, max_overlap_ratio);
     } else {
       // Each thread takes a share of the particles with their pairs as body 1 and sums their
@@ -1688,6 +1689,8 @@ void Simulation::step() {
             std::lower_bound(visit_.begin(), visit_.end(), static_cast<std::uint32_t>(end)) -
             visit_.begin());
       }
+      std::fill(active_.begin() + static_cast<std::ptrdiff_t>(split_pair_[t]),
+                active_.begin() + static_cast<std::ptrdiff_t>(split_pair_[t + 1]), std::uint8_t{0});
       double my_max_overlap = 0;
       const double start = omp_get_wtime();
       if (indexed)
