@@ -1577,11 +1577,9 @@ void Simulation::split_pairs(std::size_t nt) {
   with_room(load_slot_, np);
   load_slot_.resize(np);
   const std::size_t nm = split_mixed_list_.size();
-  auto slot_of = [&](std::uint32_t i) {
-    return static_cast<std::size_t>(
-        std::lower_bound(split_mixed_list_.begin(), split_mixed_list_.end(), i) -
-        split_mixed_list_.begin());
-  };
+  std::vector<std::uint32_t> slot(n);  // (read for the mixed particles only)
+  for (std::size_t m = 0; m < nm; ++m) slot[split_mixed_list_[m]] = static_cast<std::uint32_t>(m);
+  auto slot_of = [&](std::uint32_t i) { return slot[i]; };
   mixed_start_.assign(nm + 1, 0);
   std::uint32_t rows = 0;
   for (std::size_t k = 0; k < np; ++k) {
