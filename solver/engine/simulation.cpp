@@ -565,6 +565,7 @@ void Simulation::rebuild_local(const std::vector<ContactHistory>& received, bool
     if (at != nl_.pairs.end() && *at == key)
       hist_[static_cast<std::size_t>(at - nl_.pairs.begin())] = h;
   }
+  active_valid_ = false;  // (contacts received: the next step reads hist_)
   classify_walls();
 }
 
@@ -628,7 +629,7 @@ void Simulation::attach_histories(const std::vector<ContactHistory>* from) {
   const std::vector<ContactHistory>& old = from ? *from : hist_;
   const std::size_t m = old.size();
   ++pairs_version_;
-  active_valid_ = false;  // (the pairs renumbered, histories restored: was_real_ from hist_)
+  active_valid_ = false;  // (until the pairs' flags are set below)
   if (facet_forces_) pair_facet_.assign(np, 0);
   // A pair that stays in the list keeps its stiffnesses and limits (contact_params of the same
   // radii and material, so the same values) when nothing they are computed from has changed;
@@ -737,7 +738,10 @@ void Simulation::attach_histories(const std::vector<ContactHistory>* from) {
     hist_.resize(np);
     params_.resize(np);
   }
-  // 3. Each pair's history and parameters.
+  // 3. Each pair's history and parameters, and whether it is a contact (active_, read by the
+  //    next step as the last step's: hist_ is not read again for it).
+  with_room(active_, np);
+  active_.resize(np);
   run_on_team(threads, [&] {
     try {
       const auto nt = static_cast<std::size_t>(omp_get_num_threads());
@@ -753,6 +757,7 @@ void Simulation::attach_histories(const std::vector<ContactHistory>* from) {
           hist_[k] = (*from)[o];
         hist_[k].a = pr.first;
         hist_[k].b = pr.second;
+        active_[k] = hist_[k].real ? 1 : 0;
         const WallSpec* ws = pr.second >= kWallBase ? &walls_[pr.second - kWallBase].spec : nullptr;
         if (kept && reuse) {
           if (cfg_.law == ContactLaw::HertzMindlin)
@@ -888,6 +893,7 @@ void Simulation::attach_histories(const std::vector<ContactHistory>* from) {
     for (const std::uint32_t k : wall_pairs_)
       if (!is_deferred_[k]) pass_wall_pairs_.push_back(k);
   }
+  active_valid_ = true;  // (a superset of the contacts: the deferred pairs are not)
 }
 
 std::pair<double, std::size_t> Simulation::wall_stiffness(std::size_t w) const {

@@ -540,11 +540,13 @@ class Simulation {
   std::vector<std::uint8_t> uncounted_;  // retired here by an outlet, not counted yet
   bool exact_wall_loads_ = false;        // set_exact_wall_loads
   // Per pair, whether it was a contact after the last step (ContactHistory::real, or a superset
-  // of it): the last step's active_ when no build or restore came between (active_valid_),
-  // else read from hist_. The pass reads this compact array and touches hist_[k] only for the
-  // pairs within reach or a contact to end, not every candidate's history each step.
+  // of it): the last step's active_, or the flags attach_histories set from the histories it
+  // placed (active_valid_), else read from hist_. The pass reads this compact array and touches
+  // hist_[k] only for the pairs within reach or a contact to end, not every candidate's
+  // history each step.
   std::vector<std::uint8_t> was_real_;
-  bool active_valid_ = false;  // active_ ⊇ the contacts (set at a step's end, cleared by a build)
+  bool active_valid_ = false;  // active_ ⊇ the contacts (set at a step's end and by
+                               // attach_histories, cleared where contacts are received)
   // Particles taken out by the outlet since the build: their pairs are dropped from the pass
   // (pass_pairs_, pass_wall_pairs_, deferred_groups_) instead of the list being built anew
   // (the hopper took 300 of its 766 builds for them). dropped_ lists the dropped pairs of
