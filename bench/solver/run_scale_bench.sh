@@ -15,7 +15,9 @@
 # run again with a frame with contacts every STEPS/4 steps, giving the time of one frame, and
 # from it the fraction of a run that frames every 1 000 steps would take.
 #   bench/solver/run_scale_bench.sh [BUILD_DIR]
-#   SIZES="50000 500000 1000000" STEPS="200 40 20" BASELINES=1 (0: granoscope only)
+#   SIZES="50000 500000 1000000" STEPS="400 100 60" BASELINES=1 (0: granoscope only)
+#   (20 steps at 10^6 took 4 s against a 1-step run of about 1 s whose time, frames included,
+#   varies by tenths: its thread ratios ranged from 1.4 to 1.8; 60 steps give them to +-0.03)
 #   REPEAT=1 (rounds of granoscope's runs: the medians are printed, and the thread ratios of each)
 # (needs: apt-get install libopenmpi-dev openmpi-bin; --no-install-recommends yade liggghts)
 set -euo pipefail
@@ -29,7 +31,7 @@ trap 'rm -rf "$work"' EXIT
 [ -x "$gs" ] || { echo "build first (scripts/build)"; exit 1; }
 mpi="mpirun --allow-run-as-root --oversubscribe --mca btl_vader_single_copy_mechanism none"
 read -r -a sizes <<< "${SIZES:-50000 500000 1000000}"
-read -r -a stepss <<< "${STEPS:-200 40 20}"
+read -r -a stepss <<< "${STEPS:-400 100 60}"
 baselines=${BASELINES:-1}
 repeat=${REPEAT:-1}
 
