@@ -14,6 +14,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "aggregation_amg.hpp"
 #include "delaunay_mesh.hpp"
 
 #ifdef _OPENMP
@@ -358,17 +359,20 @@ const char* hhd_solver_name(HhdSolver s) {
       return "bicgstab";
     case HhdSolver::Projection:
       return "projection";
+    case HhdSolver::ProjectionAmg:
+      return "projection-amg";
   }
   return "?";
 }
 
 HhdSolver hhd_solver_from_name(const std::string& name) {
-  for (auto s : {HhdSolver::Auto, HhdSolver::Projection, HhdSolver::Cholmod, HhdSolver::Ldlt,
-                 HhdSolver::Cg, HhdSolver::BiCgStab})
+  for (auto s : {HhdSolver::Auto, HhdSolver::Projection, HhdSolver::ProjectionAmg,
+                 HhdSolver::Cholmod, HhdSolver::Ldlt, HhdSolver::Cg, HhdSolver::BiCgStab})
     if (name == hhd_solver_name(s)) return s;
   throw std::invalid_argument(
-      "unknown HHD solver, expected auto, projection, cholmod, ldlt, cg or bicgstab (" + name +
-      ")");
+      "unknown HHD solver, expected auto, projection, projection-amg, cholmod, ldlt, cg or "
+      "bicgstab (" +
+      name + ")");
 }
 
 P1Geometry p1_geometry(const HhdMesh& m) {
@@ -502,10 +506,12 @@ HhdResult helmholtz_hodge(const HhdMesh& m, const std::vector<Eigen::Vector3d>& 
   r.report.unknowns = static_cast<std::size_t>(n);
   HhdSolver solver = o.solver;
   if (solver == HhdSolver::Auto) solver = m.dim == 3 ? HhdSolver::Projection : HhdSolver::Cholmod;
-  const double tolerance = o.tolerance > 0.0                 ? o.tolerance
-                           : solver == HhdSolver::Projection ? kHhdProjectionTolerance
-                                                             : kHhdTolerance;
+  const bool projection = solver == HhdSolver::Projection || solver == HhdSolver::ProjectionAmg;
+  const double tolerance = o.tolerance > 0.0 ? o.tolerance
+                           : projection      ? kHhdProjectionTolerance
+                                             : kHhdTolerance;
   const bool iterative = solver == HhdSolver::Cg || solver == HhdSolver::BiCgStab ||
+                         solver == HhdSolver::ProjectionAmg ||
                          (solver == HhdSolver::Projection && m.dim == 3);
   r.report.tolerance = iterative ? tolerance : 0.0;
   r.report.solver = hhd_solver_name(solver);
@@ -550,6 +556,35 @@ HhdResult helmholtz_hodge(const HhdMesh& m, const std::vector<Eigen::Vector3d>& 
             [&](const Eigen::MatrixXd& q) { return Eigen::MatrixXd(s.solve(q)); }, tolerance,
             o.max_iterations, r.report.iterations_v, r.report.converged, o.poll);
         r.report.seconds_solve += seconds_since(t0);
+      }
+      break;
+    }
+    case HhdSolver::ProjectionAmg: {
+      // u and path (b)'s v (eq 18 itself in 2D) by AMG-preconditioned CG to kHhdTolerance (or
+      // the tolerance asked for, if smaller); in 3D eq 18's projection with the V-cycle as the
+      // Laplacian part of its preconditioner.
+      t0 = Clock::now();
+      const AmgHierarchy h = build_amg(k);
+      r.report.seconds_factor = seconds_since(t0);
+      t0 = Clock::now();
+      bool conv = true;
+      x = amg_pcg(h, rhs, std::min(tolerance, kHhdTolerance), o.max_iterations,
+                  r.report.iterations_u, conv);
+      r.report.converged = conv;
+      r.report.seconds_solve = seconds_since(t0);
+      if (o.poll) o.poll();
+      if (m.dim == 3) {
+        t0 = Clock::now();
+        v_coulomb = x.rightCols(3);
+        bool conv_v = true;
+        x.rightCols(3) = projection_pcg(
+            m, g, idx, Eigen::MatrixXd(-b18),
+            [&](const Eigen::MatrixXd& q) { return amg_vcycle(h, q); }, tolerance, o.max_iterations,
+            r.report.iterations_v, conv_v, o.poll);
+        r.report.converged = r.report.converged && conv_v;
+        r.report.seconds_solve += seconds_since(t0);
+      } else {
+        r.report.iterations_v = r.report.iterations_u;
       }
       break;
     }

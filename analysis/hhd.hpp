@@ -40,10 +40,12 @@ enum class HhdSolver {
   Auto,        // 3D: Projection; 2D: Cholmod (in 2D path (b) is eq 18 exactly)
   Projection,  // eq 18 as the paper defines it, solved as a projection (3D: PCG on CᵀMC with the
                // Laplacian factor and block Jacobi; 2D: path (b), the same system)
-  Cholmod,     // path (b): Laplacian, CHOLMOD Cholesky (supernodal/simplicial as CHOLMOD picks)
-  Ldlt,        // path (c): Laplacian, Eigen SimplicialLDLT (AMD ordering)
-  Cg,          // path (b) iterative: Laplacian, Jacobi-preconditioned conjugate gradients
-  BiCgStab,    // path (a): eq 17 and eq 18 as written, BiCGSTAB (the paper's)
+  ProjectionAmg,  // the same projection with an aggregation-AMG V-cycle in place of the
+                  // Laplacian factor, and u, path (b)'s v by AMG-preconditioned CG (no factor)
+  Cholmod,        // path (b): Laplacian, CHOLMOD Cholesky (supernodal/simplicial as CHOLMOD picks)
+  Ldlt,           // path (c): Laplacian, Eigen SimplicialLDLT (AMD ordering)
+  Cg,             // path (b) iterative: Laplacian, Jacobi-preconditioned conjugate gradients
+  BiCgStab,       // path (a): eq 17 and eq 18 as written, BiCGSTAB (the paper's)
 };
 const char* hhd_solver_name(HhdSolver s);
 /// Default relative residual of the iterative paths `cg` and `bicgstab`, per system.
@@ -51,7 +53,8 @@ inline constexpr double kHhdTolerance = 1e-10;
 /// Default relative residual of eq 18 for `projection` in 3D: ∇×v is then within ~0.5× this of
 /// the exact projection (measured, docs/hhd.md), ∇×v ⊥ h to round-off whatever the tolerance.
 inline constexpr double kHhdProjectionTolerance = 1e-7;
-/// "auto", "projection", "cholmod", "ldlt", "cg", "bicgstab"; throws std::invalid_argument
+/// "auto", "projection", "projection-amg", "cholmod", "ldlt", "cg", "bicgstab"; throws
+/// std::invalid_argument
 /// listing them.
 HhdSolver hhd_solver_from_name(const std::string& name);
 

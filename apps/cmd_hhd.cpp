@@ -54,7 +54,8 @@ void add_field_options(CLI::App* s, FieldArgs& a) {
   s->add_option(
       "--solver", a.solver,
       "auto (default: projection in 3D, cholmod in 2D) | projection (eq 18's L2 projection: "
-      "PCG preconditioned by the Laplacian factor) | cholmod (path b: Laplacian, gauge as a "
+      "PCG preconditioned by the Laplacian factor) | projection-amg (the same projection with an "
+      "AMG V-cycle for the Laplacian: no factor) | cholmod (path b: Laplacian, gauge as a "
       "penalty) | ldlt (path c) | cg (path b, iterative) | bicgstab (path a: eq 17-18 as "
       "written, the paper's)");
   s->add_option("--tolerance", a.tolerance,

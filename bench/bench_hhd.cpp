@@ -115,11 +115,13 @@ struct Path {
 };
 
 const std::vector<Path>& paths() {
-  static const std::vector<Path> p = {{"bicgstab", "path a  bicgstab (paper)", HhdSolver::BiCgStab},
-                                      {"projection", "projection (default)", HhdSolver::Projection},
-                                      {"cholmod", "path b  cholmod", HhdSolver::Cholmod},
-                                      {"cg", "path b' cg (Jacobi)", HhdSolver::Cg},
-                                      {"ldlt", "path c  ldlt (Eigen)", HhdSolver::Ldlt}};
+  static const std::vector<Path> p = {
+      {"bicgstab", "path a  bicgstab (paper)", HhdSolver::BiCgStab},
+      {"projection", "projection (default)", HhdSolver::Projection},
+      {"projection-amg", "projection, AMG", HhdSolver::ProjectionAmg},
+      {"cholmod", "path b  cholmod", HhdSolver::Cholmod},
+      {"cg", "path b' cg (Jacobi)", HhdSolver::Cg},
+      {"ldlt", "path c  ldlt (Eigen)", HhdSolver::Ldlt}};
   return p;
 }
 

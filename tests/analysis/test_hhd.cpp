@@ -176,6 +176,44 @@ TEST(Hhd, ProjectionIsEq18OnRandomPoints) {
   EXPECT_GT(p.norm_div_v, 3.0 * p.norm_curl_v);
 }
 
+TEST(Hhd, ProjectionAmgIsTheSameProjection) {
+  // The projection with the AMG V-cycle in place of the Laplacian factor, and u and path (b)'s
+  // v by AMG-preconditioned CG: the same decomposition to the solvers' tolerances.
+  const auto m = test::random_cube_mesh(2500, 21);
+  std::vector<Eigen::Vector3d> nodal;
+  for (const auto& p : m.points) nodal.push_back(test::vortex_source_translation(p));
+  const auto xi = simplex_mean(m, nodal);
+  const auto p = helmholtz_hodge(m, xi);  // auto: the projection with the factor
+  HhdOptions o;
+  o.solver = HhdSolver::ProjectionAmg;
+  const auto q = helmholtz_hodge(m, xi, o);
+  EXPECT_EQ(q.report.solver, "projection-amg");
+  EXPECT_TRUE(q.report.converged);
+  EXPECT_LE(q.report.residual_eq18, kHhdProjectionTolerance);
+  EXPECT_LE(q.report.residual_eq17, 1e-10);
+  double diff = 0.0;
+  for (std::size_t k = 0; k < xi.size(); ++k)
+    diff += p.measure[k] * (q.curl_v[k] - p.curl_v[k]).squaredNorm();
+  EXPECT_LT(std::sqrt(diff), 1e-6 * p.norm_curl_v);
+  const auto cosine = [](double dot, double x, double y) { return std::abs(dot) / (x * y); };
+  EXPECT_LT(cosine(q.dot_curl_harmonic, q.norm_curl_v, q.norm_harmonic), 1e-8);
+  EXPECT_LT(cosine(q.dot_grad_harmonic, q.norm_grad_u, q.norm_harmonic), 1e-8);
+  EXPECT_LT((q.u - p.u).norm(), 1e-8 * p.u.norm());
+  EXPECT_LT((q.v_coulomb - p.v_coulomb).norm(), 1e-8 * p.v_coulomb.norm());
+  // 2D: path (b) by AMG-CG, the factor's answer to its tolerance.
+  const auto m2 = box_mesh(2, 24, 5);
+  AnalyticField f;
+  f.dim = 2;
+  std::vector<Eigen::Vector3d> nodal2;
+  for (const auto& x : m2.points) nodal2.push_back(f.xi(x));
+  const auto xi2 = simplex_mean(m2, nodal2);
+  const auto c2 = helmholtz_hodge(m2, xi2);  // auto: cholmod in 2D
+  const auto a2 = helmholtz_hodge(m2, xi2, o);
+  EXPECT_TRUE(a2.report.converged);
+  EXPECT_LT((a2.u - c2.u).norm(), 1e-8 * c2.u.norm());
+  EXPECT_LT((a2.v - c2.v).norm(), 1e-8 * c2.v.norm());
+}
+
 // L2 errors (centroid values, measure-weighted RMS) of the parts and RMS nodal errors of the
 // potentials against the analytic decomposition of AnalyticField.
 struct Errors {
