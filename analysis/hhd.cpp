@@ -585,6 +585,7 @@ HhdResult helmholtz_hodge(const HhdMesh& m, const std::vector<Eigen::Vector3d>& 
         r.report.seconds_solve += seconds_since(t0);
       } else {
         r.report.iterations_v = r.report.iterations_u;
+        r.report.tolerance = std::min(tolerance, kHhdTolerance);  // (no projection iterations)
       }
       break;
     }
