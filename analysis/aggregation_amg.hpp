@@ -16,7 +16,7 @@ namespace gs::analysis {
 struct AmgOptions {
   double strength = 0.08;  // i, j strongly connected when |a_ij| >= strength·sqrt(a_ii a_jj)
   int coarsest = 400;      // a level this small (unknowns) is solved directly (dense Cholesky)
-  int sweeps = 2;          // damped Jacobi sweeps before and after the coarse correction
+  int sweeps = 1;          // damped Jacobi sweeps before and after the coarse correction
   int max_levels = 12;
 };
 
@@ -31,7 +31,7 @@ struct AmgLevel {
 struct AmgHierarchy {
   std::vector<AmgLevel> levels;          // finest first; the last one's a is the coarsest
   Eigen::LLT<Eigen::MatrixXd> coarsest;  // dense Cholesky of the coarsest matrix
-  int sweeps = 2;
+  int sweeps = 1;
 };
 
 /// Builds the hierarchy of a symmetric positive definite matrix (full symmetric storage).

@@ -59,7 +59,7 @@ TEST(AggregationAmg, PcgMatchesADirectSolve) {
     bool ok = false;
     const Eigen::MatrixXd x = amg_pcg(h, b, 1e-12, 500, its, ok);
     EXPECT_TRUE(ok);
-    EXPECT_LT(its, 25) << "jump " << jump;  // (12 and 13 here; Jacobi-CG needs hundreds)
+    EXPECT_LT(its, 25) << "jump " << jump;  // (17 and 18 here; Jacobi-CG needs hundreds)
     const Eigen::SimplicialLDLT<SpMat> direct(a);
     const Eigen::MatrixXd xd = direct.solve(b);
     EXPECT_LT((x - xd).norm(), 1e-9 * xd.norm()) << "jump " << jump;
