@@ -122,41 +122,35 @@ AmgHierarchy build_amg(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& 
   a.makeCompressed();
   while (true) {
     AmgLevel L;
-    L.a = a;
+    L.a = std::move(a);
     const Eigen::VectorXd diag = L.a.diagonal();
     if (diag.size() > 0 && !(diag.minCoeff() > 0.0))
       throw std::invalid_argument("AMG: non-positive diagonal entry (" +
                                   std::to_string(diag.minCoeff()) + ")");
     L.inv_diag = diag.cwiseInverse();
-    const bool last = L.a.rows() <= o.coarsest ||
-                      static_cast<int>(h.levels.size()) + 1 >= std::max(1, o.max_levels);
-    if (!last) {
-      int nc = 0;
-      const std::vector<int> agg = aggregates(L.a, diag, o.strength, nc);
-      if (nc >= L.a.rows()) {  // (no coarsening: every unknown its own aggregate)
-        h.levels.push_back(std::move(L));
-        break;
-      }
-      const double lambda = largest_eigenvalue(L.a, L.inv_diag);
-      L.omega = 4.0 / (3.0 * lambda);
-      RowMat pt(L.a.rows(), nc);
-      std::vector<Eigen::Triplet<double, int>> t;
-      t.reserve(agg.size());
-      for (std::size_t i = 0; i < agg.size(); ++i) t.emplace_back(static_cast<int>(i), agg[i], 1.0);
-      pt.setFromTriplets(t.begin(), t.end());
-      const RowMat ap = L.a * pt;
-      RowMat dap = L.inv_diag.asDiagonal() * ap;
-      dap *= L.omega;
-      L.p = pt - dap;
-      L.p.prune(0.0);
-      L.r = L.p.transpose();
-      a = L.r * (L.a * L.p);
-      a.makeCompressed();
+    int nc = 0;
+    std::vector<int> agg;
+    if (L.a.rows() > o.coarsest && static_cast<int>(h.levels.size()) + 1 < o.max_levels)
+      agg = aggregates(L.a, diag, o.strength, nc);
+    if (agg.empty() || nc >= L.a.rows()) {  // (the coarsest level: small, or no coarsening)
       h.levels.push_back(std::move(L));
-      continue;
+      break;
     }
+    // P = (I − ω D⁻¹A) P_t, P_t the constant on each aggregate; the next level RᵀAP, R = Pᵀ.
+    L.omega = 4.0 / (3.0 * largest_eigenvalue(L.a, L.inv_diag));
+    RowMat pt(L.a.rows(), nc);
+    std::vector<Eigen::Triplet<double, int>> t;
+    t.reserve(agg.size());
+    for (std::size_t i = 0; i < agg.size(); ++i) t.emplace_back(static_cast<int>(i), agg[i], 1.0);
+    pt.setFromTriplets(t.begin(), t.end());
+    RowMat smooth = L.inv_diag.asDiagonal() * (L.a * pt);
+    smooth *= L.omega;
+    L.p = pt - smooth;
+    L.p.prune(0.0);
+    L.r = L.p.transpose();
+    a = L.r * (L.a * L.p);
+    a.makeCompressed();
     h.levels.push_back(std::move(L));
-    break;
   }
   h.coarsest.compute(Eigen::MatrixXd(h.levels.back().a));
   if (h.coarsest.info() != Eigen::Success)

@@ -543,20 +543,24 @@ HhdResult helmholtz_hodge(const HhdMesh& m, const std::vector<Eigen::Vector3d>& 
     x = factor.solve(rhs);
     r.report.seconds_solve = seconds_since(t0);
   };
+  // 3D: eq 18's projection from path (b)'s solution in x (kept as v_coulomb), with solve_k
+  // (K⁻¹ or an approximation of it, per column) in its preconditioner.
+  auto project = [&](auto&& solve_k) {
+    t0 = Clock::now();
+    v_coulomb = x.rightCols(3);
+    bool converged = true;
+    x.rightCols(3) = projection_pcg(m, g, idx, Eigen::MatrixXd(-b18), solve_k, tolerance,
+                                    o.max_iterations, r.report.iterations_v, converged, o.poll);
+    r.report.converged = r.report.converged && converged;
+    r.report.seconds_solve += seconds_since(t0);
+  };
   switch (solver) {
     case HhdSolver::Projection: {
       Eigen::CholmodDecomposition<SpMat, Eigen::Lower> s;
       direct(s);  // u, and path (b)'s v (eq 18 itself in 2D)
       if (o.poll) o.poll();
-      if (m.dim == 3) {
-        t0 = Clock::now();
-        v_coulomb = x.rightCols(3);
-        x.rightCols(3) = projection_pcg(
-            m, g, idx, Eigen::MatrixXd(-b18),
-            [&](const Eigen::MatrixXd& q) { return Eigen::MatrixXd(s.solve(q)); }, tolerance,
-            o.max_iterations, r.report.iterations_v, r.report.converged, o.poll);
-        r.report.seconds_solve += seconds_since(t0);
-      }
+      if (m.dim == 3)
+        project([&](const Eigen::MatrixXd& q) { return Eigen::MatrixXd(s.solve(q)); });
       break;
     }
     case HhdSolver::ProjectionAmg: {
@@ -574,15 +578,7 @@ HhdResult helmholtz_hodge(const HhdMesh& m, const std::vector<Eigen::Vector3d>& 
       r.report.seconds_solve = seconds_since(t0);
       if (o.poll) o.poll();
       if (m.dim == 3) {
-        t0 = Clock::now();
-        v_coulomb = x.rightCols(3);
-        bool conv_v = true;
-        x.rightCols(3) = projection_pcg(
-            m, g, idx, Eigen::MatrixXd(-b18),
-            [&](const Eigen::MatrixXd& q) { return amg_vcycle(h, q); }, tolerance, o.max_iterations,
-            r.report.iterations_v, conv_v, o.poll);
-        r.report.converged = r.report.converged && conv_v;
-        r.report.seconds_solve += seconds_since(t0);
+        project([&](const Eigen::MatrixXd& q) { return amg_vcycle(h, q); });
       } else {
         r.report.iterations_v = r.report.iterations_u;
         r.report.tolerance = std::min(tolerance, kHhdTolerance);  // (no projection iterations)

@@ -404,28 +404,14 @@ void NeighborList::build(const ParticleState& p, const std::vector<WallState>& w
       }
     }
   };
-  if (nt == 1) {
-    sphere_pairs(found_, 0, dims[2]);
-    for (std::size_t i = 0; i < n; ++i)
-      if (!gone(i)) wall_pairs(i, found_, walls_seen_);
-    first_start_.assign(n + 1, 0);
-    for (const auto& pr : found_) ++first_start_[pr.first + 1];
-    for (std::size_t i = 0; i < n; ++i) first_start_[i + 1] += first_start_[i];
-    cell_fill_.assign(first_start_.begin(), first_start_.end() - 1);
-    with_room(pairs, found_.size());
-    pairs.resize(found_.size());
-    for (const auto& pr : found_) pairs[cell_fill_[pr.first]++] = pr;
-    sort_partners();
-    return;
-  }
-  // Threads: each finds the sphere pairs of layers of cells holding a share of the particles and
+  // Each thread finds the sphere pairs of layers of cells holding a share of the particles and
   // the wall pairs of a share of the particles, counts its pairs per body 1, and places them
   // (the first thread the large particles' too) from offsets formed per particle in thread order.
+  // (One thread runs the block without a team: run_on_team.)
   found_by_thread_.resize(static_cast<std::size_t>(nt));
   const std::size_t layer = static_cast<std::size_t>(dims[0]) * dims[1];
   const std::uint32_t slots = cell_start_[ncells];
-#pragma omp parallel num_threads(nt)
-  {
+  run_on_team(nt, [&] {
     const int t = omp_get_thread_num(), n_t = omp_get_num_threads();
     // The layers from the first whose particles reach this share's start.
     auto first_layer = [&](int k) {
@@ -468,7 +454,7 @@ void NeighborList::build(const ParticleState& p, const std::vector<WallState>& w
     for (const auto& pr : mine.pairs) pairs[mine.counts[pr.first]++] = pr;
 #pragma omp barrier
     sort_partners();
-  }
+  });
 }
 
 void NeighborList::build_periodic(const ParticleState& p, const PeriodicCell& cell, bool planar_z) {

@@ -87,14 +87,13 @@ struct NeighborList {
   struct alignas(64) ThreadPairs {
     std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs;
     std::vector<std::uint32_t> counts;  // pairs per body 1, then their first places
-    std::vector<std::uint32_t> seen;    // walls_seen_ of this thread
+    std::vector<std::uint32_t> seen;    // walls already paired with a large particle
   };
   std::vector<ThreadPairs> found_by_thread_;
   std::vector<std::uint32_t> first_start_;
   std::vector<std::uint32_t> big_;  // particles kept out of the grid (mixed sizes)
   std::vector<char> is_big_;
   std::vector<double> radius_scratch_;
-  std::vector<std::uint32_t> walls_seen_;
   struct PeriodicPair {
     std::uint32_t a, b;
     Eigen::Vector3i cd;
