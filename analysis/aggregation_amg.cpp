@@ -1,9 +1,14 @@
 // Smoothed-aggregation algebraic multigrid: aggregation by strong connections, a tentative
 // prolongation by the constant on each aggregate, smoothed by one damped Jacobi step, Galerkin
 // coarse matrices, a symmetric V-cycle with damped Jacobi sweeps (Vaněk, Mandel & Brezina 1996).
+//
+// The right-hand sides travel as one row-major block (a node's columns side by side), so every
+// pass over a matrix serves all of them; rows go to the threads, and each row's sums are taken in
+// the matrix's order whatever the number of threads or columns (the same bits).
 #include "aggregation_amg.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -12,35 +17,167 @@ namespace gs::analysis {
 namespace {
 
 using RowMat = Eigen::SparseMatrix<double, Eigen::RowMajor, int>;
+using Block = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+using Index = Eigen::Index;
 
-// A·X for a few columns, rows on the threads (each row's sum in the matrix's order: the same
-// result for any number of threads).
-Eigen::MatrixXd times(const RowMat& a, const Eigen::MatrixXd& x) {
-  const Eigen::Index rows = a.rows(), cols = x.cols();
-  Eigen::MatrixXd y(rows, cols);
+// Rows below this are not worth waking the threads for.
+constexpr Index kParallelRows = 8192;
+
+// For every row i of A: sums s_c = Σ_e a_ie x_(j_e, c) over the row in storage order, then
+// row(i, s). C columns known at compile time (C = 0: x.cols() at run time).
+template <int C, class Row>
+void for_rows_fixed(const RowMat& a, const Block& x, Row&& row) {
+  const Index n = a.rows();
   const int* outer = a.outerIndexPtr();
   const int* inner = a.innerIndexPtr();
   const double* val = a.valuePtr();
-#pragma omp parallel for schedule(static)
-  for (Eigen::Index i = 0; i < rows; ++i) {
-    for (Eigen::Index c = 0; c < cols; ++c) {
-      double s = 0.0;
-      for (int e = outer[i]; e < outer[i + 1]; ++e) s += val[e] * x(inner[e], c);
-      y(i, c) = s;
+  const double* xd = x.data();
+  if constexpr (C > 0) {
+#pragma omp parallel for schedule(static) if (n >= kParallelRows)
+    for (Index i = 0; i < n; ++i) {
+      std::array<double, C> s{};  // (a fresh local per row: the sums stay in registers)
+      for (int e = outer[i]; e < outer[i + 1]; ++e) {
+        const double v = val[e];
+        const double* xr = xd + static_cast<Index>(inner[e]) * C;
+        for (int c = 0; c < C; ++c) s[static_cast<std::size_t>(c)] += v * xr[c];
+      }
+      row(i, s.data());
+    }
+  } else {
+    const Index cols = x.cols();
+#pragma omp parallel if (n >= kParallelRows)
+    {
+      std::vector<double> s(static_cast<std::size_t>(cols));
+#pragma omp for schedule(static)
+      for (Index i = 0; i < n; ++i) {
+        std::fill(s.begin(), s.end(), 0.0);
+        for (int e = outer[i]; e < outer[i + 1]; ++e) {
+          const double v = val[e];
+          const double* xr = xd + static_cast<Index>(inner[e]) * cols;
+          for (Index c = 0; c < cols; ++c) s[static_cast<std::size_t>(c)] += v * xr[c];
+        }
+        row(i, s.data());
+      }
     }
   }
+}
+
+template <class Row>
+void for_rows(const RowMat& a, const Block& x, Row&& row) {
+  switch (x.cols()) {
+    case 1:
+      return for_rows_fixed<1>(a, x, row);
+    case 2:
+      return for_rows_fixed<2>(a, x, row);
+    case 3:
+      return for_rows_fixed<3>(a, x, row);
+    case 4:
+      return for_rows_fixed<4>(a, x, row);
+    default:
+      return for_rows_fixed<0>(a, x, row);
+  }
+}
+
+// A·X.
+Block times(const RowMat& a, const Block& x) {
+  const Index cols = x.cols();
+  Block y(a.rows(), cols);
+  for_rows(a, x, [&](Index i, const double* s) {
+    for (Index c = 0; c < cols; ++c) y(i, c) = s[c];
+  });
   return y;
+}
+
+// B − A·X.
+Block residual(const RowMat& a, const Block& x, const Block& b) {
+  const Index cols = x.cols();
+  Block y(a.rows(), cols);
+  for_rows(a, x, [&](Index i, const double* s) {
+    for (Index c = 0; c < cols; ++c) y(i, c) = b(i, c) - s[c];
+  });
+  return y;
+}
+
+// One damped Jacobi sweep: X + ω D⁻¹ (B − A·X).
+Block jacobi(const AmgLevel& L, const Block& x, const Block& b) {
+  const Index cols = x.cols();
+  Block y(L.a.rows(), cols);
+  for_rows(L.a, x, [&](Index i, const double* s) {
+    const double w = L.omega * L.inv_diag(i);
+    for (Index c = 0; c < cols; ++c) y(i, c) = x(i, c) + w * (b(i, c) - s[c]);
+  });
+  return y;
+}
+
+// A·B of two sparse matrices (Gustavson: row by row with a dense accumulator), rows on the
+// threads; each entry summed in A's row order, then B's, for any number of threads.
+RowMat multiply(const RowMat& a, const RowMat& b) {
+  const Index n = a.rows(), m = b.cols();
+  const int* ao = a.outerIndexPtr();
+  const int* ai = a.innerIndexPtr();
+  const double* av = a.valuePtr();
+  const int* bo = b.outerIndexPtr();
+  const int* bi = b.innerIndexPtr();
+  const double* bv = b.valuePtr();
+  std::vector<int> outer(static_cast<std::size_t>(n) + 1, 0);
+#pragma omp parallel if (n >= kParallelRows)
+  {
+    std::vector<Index> mark(static_cast<std::size_t>(m), -1);
+#pragma omp for schedule(static)
+    for (Index i = 0; i < n; ++i) {
+      int count = 0;
+      for (int e = ao[i]; e < ao[i + 1]; ++e)
+        for (int f = bo[ai[e]]; f < bo[ai[e] + 1]; ++f) {
+          auto& mk = mark[static_cast<std::size_t>(bi[f])];
+          if (mk != i) {
+            mk = i;
+            ++count;
+          }
+        }
+      outer[static_cast<std::size_t>(i) + 1] = count;
+    }
+  }
+  for (Index i = 0; i < n; ++i)
+    outer[static_cast<std::size_t>(i) + 1] += outer[static_cast<std::size_t>(i)];
+  std::vector<int> inner(static_cast<std::size_t>(outer.back()));
+  std::vector<double> value(inner.size());
+#pragma omp parallel if (n >= kParallelRows)
+  {
+    std::vector<Index> mark(static_cast<std::size_t>(m), -1);
+    std::vector<double> acc(static_cast<std::size_t>(m), 0.0);
+#pragma omp for schedule(static)
+    for (Index i = 0; i < n; ++i) {
+      int* cols = inner.data() + outer[static_cast<std::size_t>(i)];
+      int count = 0;
+      for (int e = ao[i]; e < ao[i + 1]; ++e)
+        for (int f = bo[ai[e]]; f < bo[ai[e] + 1]; ++f) {
+          const auto j = static_cast<std::size_t>(bi[f]);
+          if (mark[j] != i) {
+            mark[j] = i;
+            cols[count++] = bi[f];
+            acc[j] = av[e] * bv[f];
+          } else {
+            acc[j] += av[e] * bv[f];
+          }
+        }
+      std::sort(cols, cols + count);
+      double* vals = value.data() + outer[static_cast<std::size_t>(i)];
+      for (int q = 0; q < count; ++q) vals[q] = acc[static_cast<std::size_t>(cols[q])];
+    }
+  }
+  return RowMat(
+      Eigen::Map<const RowMat>(n, m, outer.back(), outer.data(), inner.data(), value.data()));
 }
 
 // λ_max(D⁻¹A) by power iteration from a fixed start (a lower bound, close after a few steps).
 double largest_eigenvalue(const RowMat& a, const Eigen::VectorXd& inv_diag) {
-  const Eigen::Index n = a.rows();
-  Eigen::MatrixXd q(n, 1);
-  for (Eigen::Index i = 0; i < n; ++i) q(i, 0) = 1.0 + 0.37 * static_cast<double>(i % 11);
+  const Index n = a.rows();
+  Block q(n, 1);
+  for (Index i = 0; i < n; ++i) q(i, 0) = 1.0 + 0.37 * static_cast<double>(i % 11);
   q /= q.norm();
   double lambda = 1.0;
   for (int it = 0; it < 15; ++it) {
-    Eigen::MatrixXd z = inv_diag.asDiagonal() * times(a, q);
+    Block z = inv_diag.asDiagonal() * times(a, q);
     const double norm = z.norm();
     if (!(norm > 0.0)) break;
     lambda = norm;
@@ -48,7 +185,6 @@ double largest_eigenvalue(const RowMat& a, const Eigen::VectorXd& inv_diag) {
   }
   return lambda;
 }
-
 // Aggregates of the strongly connected unknowns: (1) an unknown whose strong neighbours are all
 // free becomes the root of an aggregate with them; (2) a free unknown joins the aggregate of
 // its strongest neighbour from (1); (3) what is left forms aggregates with its free neighbours.
@@ -98,15 +234,27 @@ std::vector<int> aggregates(const RowMat& a, const Eigen::VectorXd& diag, double
   return agg;
 }
 
-Eigen::MatrixXd cycle(const AmgHierarchy& h, std::size_t l, const Eigen::MatrixXd& b) {
-  if (l + 1 == h.levels.size()) return h.coarsest.solve(b);
+Block cycle(const AmgHierarchy& h, std::size_t l, const Block& b) {
+  if (l + 1 == h.levels.size()) {  // column by column: each column's bits whatever the block
+    Block x(b.rows(), b.cols());
+    for (Index c = 0; c < b.cols(); ++c) x.col(c) = h.coarsest.solve(Eigen::VectorXd(b.col(c)));
+    return x;
+  }
   const AmgLevel& L = h.levels[l];
-  const auto d = L.inv_diag.asDiagonal();
-  Eigen::MatrixXd x = L.omega * (d * b);
-  for (int s = 1; s < h.sweeps; ++s) x += L.omega * (d * (b - times(L.a, x)));
-  x += times(L.p, cycle(h, l + 1, times(L.r, b - times(L.a, x))));
-  for (int s = 0; s < h.sweeps; ++s) x += L.omega * (d * (b - times(L.a, x)));
+  Block x = (L.omega * L.inv_diag).asDiagonal() * b;
+  for (int s = 1; s < h.sweeps; ++s) x = jacobi(L, x, b);
+  x += times(L.p, cycle(h, l + 1, times(L.r, residual(L.a, x, b))));
+  for (int s = 0; s < h.sweeps; ++s) x = jacobi(L, x, b);
   return x;
+}
+
+// Σ_i a_ic b_ic per column, in row order (a column's sum the same bits in any block).
+Eigen::VectorXd column_dots(const Block& a, const Block& b) {
+  const Index cols = a.cols();
+  Eigen::VectorXd s = Eigen::VectorXd::Zero(cols);
+  for (Index i = 0; i < a.rows(); ++i)
+    for (Index c = 0; c < cols; ++c) s(c) += a(i, c) * b(i, c);
+  return s;
 }
 
 }  // namespace
@@ -136,20 +284,41 @@ AmgHierarchy build_amg(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& 
       h.levels.push_back(std::move(L));
       break;
     }
-    // P = (I − ω D⁻¹A) P_t, P_t the constant on each aggregate; the next level RᵀAP, R = Pᵀ.
+    // P = (I − ω_F D_F⁻¹A_F) P_t, P_t the constant on each aggregate, A_F the filtered matrix
+    // (A's strong connections, the weak ones lumped into the diagonal: VMB's Ã, which keeps P
+    // as local as the aggregates); the next level RᵀAP, R = Pᵀ.
     L.omega = 4.0 / (3.0 * largest_eigenvalue(L.a, L.inv_diag));
+    RowMat smoother = L.a;
+    {
+      const double strength = o.strength;
+      Eigen::VectorXd diag_f = diag;
+      for (Index i = 0; i < smoother.outerSize(); ++i)
+        for (RowMat::InnerIterator it(smoother, i); it; ++it)
+          if (it.col() != i &&
+              std::abs(it.value()) < strength * std::sqrt(diag(i) * diag(it.col()))) {
+            diag_f(i) += it.value();
+            it.valueRef() = 0.0;
+          }
+      for (Index i = 0; i < smoother.outerSize(); ++i)
+        for (RowMat::InnerIterator it(smoother, i); it; ++it)
+          if (it.col() == i) it.valueRef() = diag_f(i);
+      smoother.prune(0.0);
+      const Eigen::VectorXd inv_f = diag_f.cwiseInverse();
+      const double omega_f = 4.0 / (3.0 * largest_eigenvalue(smoother, inv_f));
+      for (Index i = 0; i < smoother.outerSize(); ++i)  // I − ω_F D_F⁻¹A_F
+        for (RowMat::InnerIterator it(smoother, i); it; ++it)
+          it.valueRef() = (it.col() == i ? 1.0 : 0.0) - omega_f * inv_f(i) * it.value();
+    }
     RowMat pt(L.a.rows(), nc);
     std::vector<Eigen::Triplet<double, int>> t;
     t.reserve(agg.size());
     for (std::size_t i = 0; i < agg.size(); ++i) t.emplace_back(static_cast<int>(i), agg[i], 1.0);
     pt.setFromTriplets(t.begin(), t.end());
-    RowMat smooth = L.inv_diag.asDiagonal() * (L.a * pt);
-    smooth *= L.omega;
-    L.p = pt - smooth;
+    L.p = multiply(smoother, pt);
     L.p.prune(0.0);
     L.r = L.p.transpose();
-    a = L.r * (L.a * L.p);
-    a.makeCompressed();
+    a = multiply(L.r, multiply(L.a, L.p));
+    a = 0.5 * (a + RowMat(a.transpose()));  // (symmetric to the last bit: an SPD V-cycle)
     h.levels.push_back(std::move(L));
   }
   h.coarsest.compute(Eigen::MatrixXd(h.levels.back().a));
@@ -159,55 +328,71 @@ AmgHierarchy build_amg(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& 
 }
 
 Eigen::MatrixXd amg_vcycle(const AmgHierarchy& h, const Eigen::MatrixXd& b) {
-  return cycle(h, 0, b);
+  if (h.levels.empty()) throw std::invalid_argument("AMG: empty hierarchy");
+  return cycle(h, 0, Block(b));
 }
 
-Eigen::MatrixXd amg_pcg(const AmgHierarchy& h, const Eigen::MatrixXd& b, double tolerance,
-                        int max_iterations, int& iterations, bool& converged) {
+Eigen::MatrixXd amg_pcg(const AmgHierarchy& h, const Eigen::MatrixXd& b0, double tolerance,
+                        int max_iterations, int& iterations, bool& converged,
+                        std::vector<int>* column_iterations) {
   if (h.levels.empty()) throw std::invalid_argument("AMG: empty hierarchy");
   const RowMat& a = h.levels.front().a;
-  const Eigen::Index cols = b.cols();
-  Eigen::MatrixXd x = Eigen::MatrixXd::Zero(b.rows(), cols);
-  Eigen::MatrixXd r = b;
+  const Index cols = b0.cols();
+  const Block b = b0;
+  Block x = Block::Zero(b.rows(), cols);
+  Block r = b;
   std::vector<char> done(static_cast<std::size_t>(cols), 0);
-  Eigen::VectorXd bnorm = b.colwise().norm().transpose();
-  for (Eigen::Index c = 0; c < cols; ++c) done[static_cast<std::size_t>(c)] = bnorm(c) == 0.0;
+  const Eigen::VectorXd bnorm = column_dots(b, b).cwiseSqrt();
+  for (Index c = 0; c < cols; ++c) done[static_cast<std::size_t>(c)] = bnorm(c) == 0.0;
   iterations = 0;
   converged = true;
+  std::vector<int> its(static_cast<std::size_t>(cols), 0);
+  auto finish = [&] {
+    if (column_iterations) *column_iterations = its;
+    return Eigen::MatrixXd(x);
+  };
   auto all_done = [&] {
     return std::all_of(done.begin(), done.end(), [](char d) { return d != 0; });
   };
-  if (all_done()) return x;
-  Eigen::MatrixXd z = amg_vcycle(h, r);
-  Eigen::MatrixXd p = z;
-  Eigen::VectorXd rz = (r.array() * z.array()).colwise().sum().transpose();
+  if (all_done()) return finish();
+  Block z = cycle(h, 0, r);
+  Block p = z;
+  Eigen::VectorXd rz = column_dots(r, z);
+  Eigen::VectorXd alpha(cols), beta(cols);
   for (int it = 1; it <= max_iterations; ++it) {
-    const Eigen::MatrixXd ap = times(a, p);
+    const Block ap = times(a, p);
     iterations = it;
-    for (Eigen::Index c = 0; c < cols; ++c) {
+    const Eigen::VectorXd pap = column_dots(p, ap);
+    for (Index c = 0; c < cols; ++c) {
+      alpha(c) = 0.0;
       if (done[static_cast<std::size_t>(c)]) continue;
-      const double pap = p.col(c).dot(ap.col(c));
-      if (!(pap > 0.0) || !(rz(c) > 0.0)) {  // (breakdown: no further progress possible)
+      its[static_cast<std::size_t>(c)] = it;
+      if (!(pap(c) > 0.0) || !(rz(c) > 0.0)) {  // (breakdown: no further progress possible)
         done[static_cast<std::size_t>(c)] = 1;
         converged = false;
         continue;
       }
-      const double alpha = rz(c) / pap;
-      x.col(c) += alpha * p.col(c);
-      r.col(c) -= alpha * ap.col(c);
-      if (r.col(c).norm() <= tolerance * bnorm(c)) done[static_cast<std::size_t>(c)] = 1;
+      alpha(c) = rz(c) / pap(c);
     }
-    if (all_done()) return x;
-    z = amg_vcycle(h, r);
-    for (Eigen::Index c = 0; c < cols; ++c) {
+    x += p * alpha.asDiagonal();
+    r -= ap * alpha.asDiagonal();
+    const Eigen::VectorXd rnorm = column_dots(r, r).cwiseSqrt();
+    for (Index c = 0; c < cols; ++c)
+      if (!done[static_cast<std::size_t>(c)] && rnorm(c) <= tolerance * bnorm(c))
+        done[static_cast<std::size_t>(c)] = 1;
+    if (all_done()) return finish();
+    z = cycle(h, 0, r);
+    const Eigen::VectorXd rz_new = column_dots(r, z);
+    for (Index c = 0; c < cols; ++c) {
+      beta(c) = 0.0;
       if (done[static_cast<std::size_t>(c)]) continue;
-      const double rz_new = r.col(c).dot(z.col(c));
-      p.col(c) = z.col(c) + (rz_new / rz(c)) * p.col(c);
-      rz(c) = rz_new;
+      beta(c) = rz_new(c) / rz(c);
+      rz(c) = rz_new(c);
     }
+    p = z + p * beta.asDiagonal();
   }
   converged = false;
-  return x;
+  return finish();
 }
 
 }  // namespace gs::analysis

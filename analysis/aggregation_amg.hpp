@@ -14,7 +14,7 @@
 namespace gs::analysis {
 
 struct AmgOptions {
-  double strength = 0.08;  // i, j strongly connected when |a_ij| >= strength·sqrt(a_ii a_jj)
+  double strength = 0.02;  // i, j strongly connected when |a_ij| >= strength·sqrt(a_ii a_jj)
   int coarsest = 400;      // a level this small (unknowns) is solved directly (dense Cholesky)
   int sweeps = 1;          // damped Jacobi sweeps before and after the coarse correction
   int max_levels = 12;
@@ -45,11 +45,13 @@ AmgHierarchy build_amg(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& 
 Eigen::MatrixXd amg_vcycle(const AmgHierarchy& h, const Eigen::MatrixXd& b);
 
 /// Conjugate gradients on A x = b (A: the matrix the hierarchy was built from) for every column
-/// of b at once (each column its own step lengths), preconditioned by amg_vcycle, from x = 0,
-/// until every column's relative residual ‖b − A x‖ ≤ tolerance ‖b‖ or max_iterations. Returns
-/// x; `iterations` is the number of iterations run, `converged` whether every column reached
-/// the tolerance.
+/// of b at once (each column its own step lengths, frozen once it converged), preconditioned by
+/// amg_vcycle, from x = 0, until every column's relative residual ‖b − A x‖ ≤ tolerance ‖b‖ or
+/// max_iterations. Returns x (each column the same bits as if solved alone); `iterations` is
+/// the number of iterations run, `converged` whether every column reached the tolerance,
+/// `column_iterations` (if given) the iterations each column took.
 Eigen::MatrixXd amg_pcg(const AmgHierarchy& h, const Eigen::MatrixXd& b, double tolerance,
-                        int max_iterations, int& iterations, bool& converged);
+                        int max_iterations, int& iterations, bool& converged,
+                        std::vector<int>* column_iterations = nullptr);
 
 }  // namespace gs::analysis

@@ -5,16 +5,25 @@
 #include <CGAL/Delaunay_triangulation_3.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Regular_triangulation_3.h>
+#include <CGAL/Spatial_sort_traits_adapter_2.h>
+#include <CGAL/Spatial_sort_traits_adapter_3.h>
 #include <CGAL/Triangulation_vertex_base_with_info_2.h>
 #include <CGAL/Triangulation_vertex_base_with_info_3.h>
+#include <CGAL/hilbert_sort.h>
+#include <CGAL/property_map.h>
 
 #include <algorithm>
 #include <cmath>
 #include <iterator>
 #include <map>
+#include <numeric>
 #include <stdexcept>
 #include <string>
 #include <utility>
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 
 namespace gs::analysis {
 namespace {
@@ -188,34 +197,82 @@ double triangle_quality(const std::array<Eigen::Vector2d, 3>& x, double area) {
   return lrms2 > 0.0 ? 4.0 * std::sqrt(3.0) * area / (3.0 * lrms2) : 0.0;
 }
 
+std::vector<std::int32_t> hilbert_order(const std::vector<Eigen::Vector3d>& points, int dim) {
+  std::vector<std::size_t> order(points.size());
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  if (dim == 2) {
+    std::vector<K::Point_2> p;
+    p.reserve(points.size());
+    for (const auto& x : points) p.emplace_back(x.x(), x.y());
+    using Traits =
+        CGAL::Spatial_sort_traits_adapter_2<K, CGAL::Pointer_property_map<K::Point_2>::type>;
+    CGAL::hilbert_sort(order.begin(), order.end(), Traits(CGAL::make_property_map(p)));
+  } else {
+    std::vector<K::Point_3> p;
+    p.reserve(points.size());
+    for (const auto& x : points) p.emplace_back(x.x(), x.y(), x.z());
+    using Traits =
+        CGAL::Spatial_sort_traits_adapter_3<K, CGAL::Pointer_property_map<K::Point_3>::type>;
+    CGAL::hilbert_sort(order.begin(), order.end(), Traits(CGAL::make_property_map(p)));
+  }
+  return std::vector<std::int32_t>(order.begin(), order.end());
+}
+
 VertexRings vertex_rings(int dim, const std::vector<std::array<std::int32_t, 4>>& simplices,
                          std::size_t n_points) {
   const int nv = dim + 1;
-  // Each simplex lists its nv (nv - 1) directed edges; sort and make unique per vertex.
-  std::vector<std::int64_t> count(n_points + 1, 0);
+  // The simplices at each vertex (counting sort), then each vertex's ring from them on the
+  // threads: the other vertices, deduplicated with a marker, sorted.
+  std::vector<std::int64_t> offset(n_points + 1, 0);
   for (const auto& s : simplices)
     for (int a = 0; a < nv; ++a)
-      count[static_cast<std::size_t>(s[static_cast<std::size_t>(a)]) + 1] += nv - 1;
-  for (std::size_t i = 0; i < n_points; ++i) count[i + 1] += count[i];
-  std::vector<std::int32_t> all(static_cast<std::size_t>(count[n_points]));
-  std::vector<std::int64_t> fill(count.begin(), count.end() - 1);
-  for (const auto& s : simplices)
-    for (int a = 0; a < nv; ++a)
-      for (int b = 0; b < nv; ++b) {
-        if (a == b) continue;
-        const auto i = static_cast<std::size_t>(s[static_cast<std::size_t>(a)]);
-        all[static_cast<std::size_t>(fill[i]++)] = s[static_cast<std::size_t>(b)];
-      }
+      ++offset[static_cast<std::size_t>(s[static_cast<std::size_t>(a)]) + 1];
+  for (std::size_t i = 0; i < n_points; ++i) offset[i + 1] += offset[i];
+  std::vector<std::int32_t> at(static_cast<std::size_t>(offset[n_points]));
+  {
+    std::vector<std::int64_t> fill(offset.begin(), offset.end() - 1);
+    for (std::size_t k = 0; k < simplices.size(); ++k)
+      for (int a = 0; a < nv; ++a)
+        at[static_cast<std::size_t>(
+            fill[static_cast<std::size_t>(simplices[k][static_cast<std::size_t>(a)])]++)] =
+            static_cast<std::int32_t>(k);
+  }
+  const auto n = static_cast<std::ptrdiff_t>(n_points);
+  int threads = 1;
+#ifdef _OPENMP
+  threads = omp_get_max_threads();
+#endif
+  std::vector<std::vector<std::int32_t>> part(static_cast<std::size_t>(threads));
   VertexRings r;
   r.offset.assign(n_points + 1, 0);
-  r.index.reserve(all.size() / 4);
-  for (std::size_t i = 0; i < n_points; ++i) {
-    const auto b = all.begin() + count[i], e = all.begin() + count[i + 1];
-    std::sort(b, e);
-    const auto last = std::unique(b, e);
-    r.index.insert(r.index.end(), b, last);
-    r.offset[i + 1] = static_cast<std::int64_t>(r.index.size());
+#pragma omp parallel num_threads(threads)
+  {
+    int t = 0;
+#ifdef _OPENMP
+    t = omp_get_thread_num();
+#endif
+    const std::ptrdiff_t lo = n * t / threads, hi = n * (t + 1) / threads;
+    auto& out = part[static_cast<std::size_t>(t)];
+    std::vector<std::ptrdiff_t> mark(n_points, -1);
+    for (std::ptrdiff_t i = lo; i < hi; ++i) {
+      const auto begin = out.size();
+      for (auto e = offset[static_cast<std::size_t>(i)];
+           e < offset[static_cast<std::size_t>(i) + 1]; ++e) {
+        const auto& s = simplices[static_cast<std::size_t>(at[static_cast<std::size_t>(e)])];
+        for (int b = 0; b < nv; ++b) {
+          const std::int32_t j = s[static_cast<std::size_t>(b)];
+          if (j == i || mark[static_cast<std::size_t>(j)] == i) continue;
+          mark[static_cast<std::size_t>(j)] = i;
+          out.push_back(j);
+        }
+      }
+      std::sort(out.begin() + static_cast<std::ptrdiff_t>(begin), out.end());
+      r.offset[static_cast<std::size_t>(i) + 1] = static_cast<std::int64_t>(out.size() - begin);
+    }
   }
+  for (std::size_t i = 0; i < n_points; ++i) r.offset[i + 1] += r.offset[i];
+  r.index.reserve(static_cast<std::size_t>(r.offset[n_points]));
+  for (const auto& p : part) r.index.insert(r.index.end(), p.begin(), p.end());
   return r;
 }
 

@@ -49,6 +49,11 @@ double tetrahedron_quality(const std::array<Eigen::Vector3d, 4>& x, double volum
 /// q = 4 sqrt(3) A / (3 l_rms^2) of a triangle of area A: 1 equilateral, -> 0 flat.
 double triangle_quality(const std::array<Eigen::Vector2d, 3>& x, double area);
 
+/// The point indices in Hilbert-curve order (CGAL's hilbert_sort; 2D: of the (x, y)
+/// coordinates): consecutive indices are spatial neighbours, so numbering a mesh's unknowns in
+/// this order keeps sparse-matrix rows and the vectors they touch close in memory.
+std::vector<std::int32_t> hilbert_order(const std::vector<Eigen::Vector3d>& points, int dim);
+
 /// Vertex 1-rings of a mesh of `dim`-simplices (the Delaunay edges) in compressed rows: the
 /// neighbours of vertex i are index[offset[i] .. offset[i+1]), sorted ascending. `n_points` >=
 /// every vertex index + 1.

@@ -68,28 +68,69 @@ std::vector<int> unknown_index(const HhdMesh& m, const P1Geometry& g, int& count
     for (int a = 0; a < vertices_of(m); ++a)
       used[static_cast<std::size_t>(m.simplices[k][static_cast<std::size_t>(a)])] = 1;
   }
+  // Numbered along a Hilbert curve: the rows of K (and of every vector over the unknowns) that
+  // a simplex touches are then close together in memory, which the solvers' products need.
   std::vector<int> idx(m.points.size(), -1);
   count = 0;
-  for (std::size_t i = 0; i < m.points.size(); ++i)
-    if (used[i] && !m.dirichlet[i]) idx[i] = count++;
+  for (const auto i : hilbert_order(m.points, m.dim))
+    if (used[static_cast<std::size_t>(i)] && !m.dirichlet[static_cast<std::size_t>(i)])
+      idx[static_cast<std::size_t>(i)] = count++;
   return idx;
+}
+
+// The simplices of positive measure around each unknown, in simplex order: unknown i's are
+// (simplex[e], its vertex[e]) for e in [offset[i], offset[i + 1]). Row-wise loops over it give
+// each row's sums in simplex order, whatever the number of threads.
+struct Incidence {
+  std::vector<std::int64_t> offset;
+  std::vector<std::int32_t> simplex;
+  std::vector<std::int8_t> vertex;
+};
+
+Incidence incidence(const HhdMesh& m, const P1Geometry& g, const std::vector<int>& idx, int n) {
+  Incidence inc;
+  inc.offset.assign(static_cast<std::size_t>(n) + 1, 0);
+  const int nv = vertices_of(m);
+  for (std::size_t k = 0; k < m.simplices.size(); ++k) {
+    if (!(g.measure[k] > 0.0)) continue;
+    for (int a = 0; a < nv; ++a) {
+      const int i = idx[static_cast<std::size_t>(m.simplices[k][static_cast<std::size_t>(a)])];
+      if (i >= 0) ++inc.offset[static_cast<std::size_t>(i) + 1];
+    }
+  }
+  for (std::size_t i = 0; i < static_cast<std::size_t>(n); ++i) inc.offset[i + 1] += inc.offset[i];
+  inc.simplex.resize(static_cast<std::size_t>(inc.offset.back()));
+  inc.vertex.resize(inc.simplex.size());
+  std::vector<std::int64_t> fill(inc.offset.begin(), inc.offset.end() - 1);
+  for (std::size_t k = 0; k < m.simplices.size(); ++k) {
+    if (!(g.measure[k] > 0.0)) continue;
+    for (int a = 0; a < nv; ++a) {
+      const int i = idx[static_cast<std::size_t>(m.simplices[k][static_cast<std::size_t>(a)])];
+      if (i < 0) continue;
+      const auto e = static_cast<std::size_t>(fill[static_cast<std::size_t>(i)]++);
+      inc.simplex[e] = static_cast<std::int32_t>(k);
+      inc.vertex[e] = static_cast<std::int8_t>(a);
+    }
+  }
+  return inc;
 }
 
 // Right-hand sides over the unknowns. bu: Σ_k |T_k| ∇φ_i·ξ_k (eq 17). b18: Σ_k |T_k| ∇φ_i × ξ_k
 // (eq 18 as written; 1 column in 2D, its z component, 3 columns in 3D).
-void right_hand_sides(const HhdMesh& m, const P1Geometry& g, const std::vector<int>& idx, int n,
+void right_hand_sides(const HhdMesh& m, const P1Geometry& g, const Incidence& inc, int n,
                       const std::vector<Eigen::Vector3d>& field, Eigen::VectorXd& bu,
                       Eigen::MatrixXd& b18) {
   const int nv = m.dim == 3 ? 3 : 1;
   bu = Eigen::VectorXd::Zero(n);
   b18 = Eigen::MatrixXd::Zero(n, nv);
-  for (std::size_t k = 0; k < m.simplices.size(); ++k) {
-    const double w = g.measure[k];
-    if (!(w > 0.0)) continue;
-    for (int a = 0; a < vertices_of(m); ++a) {
-      const int i = idx[static_cast<std::size_t>(m.simplices[k][static_cast<std::size_t>(a)])];
-      if (i < 0) continue;
-      const Eigen::Vector3d& gi = g.gradient[k][static_cast<std::size_t>(a)];
+#pragma omp parallel for schedule(static)
+  for (int i = 0; i < n; ++i) {
+    const auto ii = static_cast<std::size_t>(i);
+    for (auto e = inc.offset[ii]; e < inc.offset[ii + 1]; ++e) {
+      const auto k = static_cast<std::size_t>(inc.simplex[static_cast<std::size_t>(e)]);
+      const double w = g.measure[k];
+      const Eigen::Vector3d& gi =
+          g.gradient[k][static_cast<std::size_t>(inc.vertex[static_cast<std::size_t>(e)])];
       bu(i) += w * gi.dot(field[k]);
       if (nv == 3) {
         b18.row(i) += w * gi.cross(field[k]).transpose();
@@ -101,29 +142,75 @@ void right_hand_sides(const HhdMesh& m, const P1Geometry& g, const std::vector<i
 }
 
 // P1 stiffness K_ij = Σ_k |T_k| (∇φ_i)_k·(∇φ_j)_k over the unknowns, full symmetric storage
-// (compressed, inner indices sorted).
-SpMat stiffness(const HhdMesh& m, const P1Geometry& g, const std::vector<int>& idx, int n) {
+// (compressed, inner indices sorted), assembled row by row on the threads: each entry summed in
+// simplex order (exactly symmetric).
+SpMat stiffness(const HhdMesh& m, const P1Geometry& g, const std::vector<int>& idx,
+                const Incidence& inc, int n) {
   const int nvert = vertices_of(m);
-  std::vector<Eigen::Triplet<double, int>> t;
-  t.reserve(m.simplices.size() * static_cast<std::size_t>(nvert * nvert));
-  for (std::size_t k = 0; k < m.simplices.size(); ++k) {
-    const double w = g.measure[k];
-    if (!(w > 0.0)) continue;
-    for (int a = 0; a < nvert; ++a) {
-      const int i = idx[static_cast<std::size_t>(m.simplices[k][static_cast<std::size_t>(a)])];
-      if (i < 0) continue;
-      for (int b = 0; b < nvert; ++b) {
-        const int j = idx[static_cast<std::size_t>(m.simplices[k][static_cast<std::size_t>(b)])];
-        if (j < 0) continue;
-        t.emplace_back(i, j,
-                       w * g.gradient[k][static_cast<std::size_t>(a)].dot(
-                               g.gradient[k][static_cast<std::size_t>(b)]));
+  int threads = 1;
+#ifdef _OPENMP
+  threads = omp_get_max_threads();
+#endif
+  std::vector<std::vector<int>> cols(static_cast<std::size_t>(threads));
+  std::vector<std::vector<double>> vals(static_cast<std::size_t>(threads));
+  std::vector<int> outer(static_cast<std::size_t>(n) + 1, 0);
+#pragma omp parallel num_threads(threads)
+  {
+    int t = 0;
+#ifdef _OPENMP
+    t = omp_get_thread_num();
+#endif
+    const int lo = static_cast<int>(static_cast<std::int64_t>(n) * t / threads);
+    const int hi = static_cast<int>(static_cast<std::int64_t>(n) * (t + 1) / threads);
+    auto& c = cols[static_cast<std::size_t>(t)];
+    auto& v = vals[static_cast<std::size_t>(t)];
+    std::vector<int> mark(static_cast<std::size_t>(n), -1), pos(static_cast<std::size_t>(n), 0);
+    std::vector<std::pair<int, double>> row;
+    for (int i = lo; i < hi; ++i) {
+      const auto ii = static_cast<std::size_t>(i);
+      row.clear();
+      for (auto e = inc.offset[ii]; e < inc.offset[ii + 1]; ++e) {
+        const auto k = static_cast<std::size_t>(inc.simplex[static_cast<std::size_t>(e)]);
+        const double w = g.measure[k];
+        const Eigen::Vector3d& ga =
+            g.gradient[k][static_cast<std::size_t>(inc.vertex[static_cast<std::size_t>(e)])];
+        for (int b = 0; b < nvert; ++b) {
+          const int j = idx[static_cast<std::size_t>(m.simplices[k][static_cast<std::size_t>(b)])];
+          if (j < 0) continue;
+          const double value = w * ga.dot(g.gradient[k][static_cast<std::size_t>(b)]);
+          auto& mk = mark[static_cast<std::size_t>(j)];
+          if (mk != i) {
+            mk = i;
+            pos[static_cast<std::size_t>(j)] = static_cast<int>(row.size());
+            row.emplace_back(j, value);
+          } else {
+            row[static_cast<std::size_t>(pos[static_cast<std::size_t>(j)])].second += value;
+          }
+        }
       }
+      std::sort(row.begin(), row.end(),
+                [](const auto& x, const auto& y) { return x.first < y.first; });
+      for (const auto& [j, value] : row) {
+        c.push_back(j);
+        v.push_back(value);
+      }
+      outer[ii + 1] = static_cast<int>(row.size());
     }
   }
-  SpMat k(n, n);
-  k.setFromTriplets(t.begin(), t.end());
-  return k;
+  for (std::size_t i = 0; i < static_cast<std::size_t>(n); ++i) outer[i + 1] += outer[i];
+  std::vector<int> inner;
+  std::vector<double> value;
+  inner.reserve(static_cast<std::size_t>(outer.back()));
+  value.reserve(static_cast<std::size_t>(outer.back()));
+  for (int t = 0; t < threads; ++t) {
+    inner.insert(inner.end(), cols[static_cast<std::size_t>(t)].begin(),
+                 cols[static_cast<std::size_t>(t)].end());
+    value.insert(value.end(), vals[static_cast<std::size_t>(t)].begin(),
+                 vals[static_cast<std::size_t>(t)].end());
+  }
+  // Symmetric: the rows are the columns.
+  return SpMat(
+      Eigen::Map<const SpMat>(n, n, outer.back(), outer.data(), inner.data(), value.data()));
 }
 
 // Eq 18 as written in 3D: block (i, j) = Σ_k |T_k| (∇φ_j ∇φ_iᵀ − (∇φ_i·∇φ_j) I), i.e. the
@@ -433,7 +520,10 @@ std::vector<Eigen::Vector3d> simplex_mean(const HhdMesh& m,
   }
   const int nv = vertices_of(m);
   std::vector<Eigen::Vector3d> xi(m.simplices.size(), Eigen::Vector3d::Zero());
-  for (std::size_t k = 0; k < m.simplices.size(); ++k) {
+  const auto ns = static_cast<std::ptrdiff_t>(m.simplices.size());
+#pragma omp parallel for schedule(static)
+  for (std::ptrdiff_t kk = 0; kk < ns; ++kk) {
+    const auto k = static_cast<std::size_t>(kk);
     for (int a = 0; a < nv; ++a)
       xi[k] += nodal[static_cast<std::size_t>(m.simplices[k][static_cast<std::size_t>(a)])];
     xi[k] /= nv;
@@ -445,18 +535,25 @@ std::vector<Eigen::Vector3d> simplex_mean(const HhdMesh& m,
 std::vector<Eigen::Vector3d> p1_gradient(const HhdMesh& m, const P1Geometry& g,
                                          const Eigen::VectorXd& u) {
   std::vector<Eigen::Vector3d> out(m.simplices.size(), Eigen::Vector3d::Zero());
-  for (std::size_t k = 0; k < m.simplices.size(); ++k)
+  const auto ns = static_cast<std::ptrdiff_t>(m.simplices.size());
+#pragma omp parallel for schedule(static)
+  for (std::ptrdiff_t kk = 0; kk < ns; ++kk) {
+    const auto k = static_cast<std::size_t>(kk);
     for (int a = 0; a < vertices_of(m); ++a)
       out[k] += u(m.simplices[k][static_cast<std::size_t>(a)]) *
                 g.gradient[k][static_cast<std::size_t>(a)];
+  }
   return out;
 }
 
 std::vector<Eigen::Vector3d> p1_curl(const HhdMesh& m, const P1Geometry& g,
                                      const Eigen::MatrixXd& v) {
   std::vector<Eigen::Vector3d> out(m.simplices.size(), Eigen::Vector3d::Zero());
-  for (std::size_t k = 0; k < m.simplices.size(); ++k)
+  const auto ns = static_cast<std::ptrdiff_t>(m.simplices.size());
+#pragma omp parallel for schedule(static)
+  for (std::ptrdiff_t kk = 0; kk < ns; ++kk)
     for (int a = 0; a < vertices_of(m); ++a) {
+      const auto k = static_cast<std::size_t>(kk);
       const auto i = m.simplices[k][static_cast<std::size_t>(a)];
       const Eigen::Vector3d& gr = g.gradient[k][static_cast<std::size_t>(a)];
       if (m.dim == 3) {
@@ -471,8 +568,11 @@ std::vector<Eigen::Vector3d> p1_curl(const HhdMesh& m, const P1Geometry& g,
 std::vector<double> p1_divergence(const HhdMesh& m, const P1Geometry& g, const Eigen::MatrixXd& v) {
   std::vector<double> out(m.simplices.size(), 0.0);
   if (m.dim != 3) return out;
-  for (std::size_t k = 0; k < m.simplices.size(); ++k)
+  const auto ns = static_cast<std::ptrdiff_t>(m.simplices.size());
+#pragma omp parallel for schedule(static)
+  for (std::ptrdiff_t kk = 0; kk < ns; ++kk)
     for (std::size_t a = 0; a < 4; ++a) {
+      const auto k = static_cast<std::size_t>(kk);
       const auto i = m.simplices[k][a];
       out[k] += g.gradient[k][a].dot(Eigen::Vector3d(v(i, 0), v(i, 1), v(i, 2)));
     }
@@ -520,8 +620,9 @@ HhdResult helmholtz_hodge(const HhdMesh& m, const std::vector<Eigen::Vector3d>& 
     for (auto& x : r.xi) x.z() = 0.0;
   Eigen::VectorXd bu;
   Eigen::MatrixXd b18;
-  right_hand_sides(m, g, idx, n, r.xi, bu, b18);
-  const SpMat k = stiffness(m, g, idx, n);
+  const Incidence inc = incidence(m, g, idx, n);
+  right_hand_sides(m, g, inc, n, r.xi, bu, b18);
+  const SpMat k = stiffness(m, g, idx, inc, n);
   r.report.seconds_assembly = seconds_since(t0);
 
   // Solutions over the unknowns: column 0 = u, columns 1.. = v.
@@ -554,6 +655,19 @@ HhdResult helmholtz_hodge(const HhdMesh& m, const std::vector<Eigen::Vector3d>& 
     r.report.converged = r.report.converged && converged;
     r.report.seconds_solve += seconds_since(t0);
   };
+  // Path (b) by AMG-preconditioned CG, u and every component of v at once (each column stops at
+  // its own relative residual `tol`).
+  auto amg_path_b = [&](const AmgHierarchy& h, double tol) {
+    t0 = Clock::now();
+    std::vector<int> its;
+    int iterations = 0;
+    bool converged = true;
+    x = amg_pcg(h, rhs, tol, o.max_iterations, iterations, converged, &its);
+    r.report.iterations_u = its[0];
+    r.report.iterations_v = *std::max_element(its.begin() + 1, its.end());
+    r.report.converged = converged;
+    r.report.seconds_solve = seconds_since(t0);
+  };
   switch (solver) {
     case HhdSolver::Projection: {
       Eigen::CholmodDecomposition<SpMat, Eigen::Lower> s;
@@ -570,17 +684,12 @@ HhdResult helmholtz_hodge(const HhdMesh& m, const std::vector<Eigen::Vector3d>& 
       t0 = Clock::now();
       const AmgHierarchy h = build_amg(k);
       r.report.seconds_factor = seconds_since(t0);
-      t0 = Clock::now();
-      bool conv = true;
-      x = amg_pcg(h, rhs, std::min(tolerance, kHhdTolerance), o.max_iterations,
-                  r.report.iterations_u, conv);
-      r.report.converged = conv;
-      r.report.seconds_solve = seconds_since(t0);
+      amg_path_b(h, std::min(tolerance, kHhdTolerance));
       if (o.poll) o.poll();
       if (m.dim == 3) {
+        r.report.iterations_v = 0;
         project([&](const Eigen::MatrixXd& q) { return amg_vcycle(h, q); });
       } else {
-        r.report.iterations_v = r.report.iterations_u;
         r.report.tolerance = std::min(tolerance, kHhdTolerance);  // (no projection iterations)
       }
       break;
@@ -597,30 +706,12 @@ HhdResult helmholtz_hodge(const HhdMesh& m, const std::vector<Eigen::Vector3d>& 
       break;
     }
     case HhdSolver::Cg: {
-      // One CG per right-hand side, the right-hand sides spread over the threads: no barrier
-      // inside the iterations (a parallel SpMV stalls badly on a loaded 2-core machine), and
-      // each column is computed the same way whatever the thread count.
+      // Path (b) by conjugate gradients, every column at once, preconditioned with one V-cycle
+      // of smoothed-aggregation AMG (its setup reported as the factor).
       t0 = Clock::now();
-      r.report.seconds_factor = 0.0;
-      const int cols = 1 + nv;
-      std::vector<int> its(static_cast<std::size_t>(cols), 0);
-      std::vector<char> ok(static_cast<std::size_t>(cols), 1);
-#pragma omp parallel for schedule(dynamic, 1)
-      for (int c = 0; c < cols; ++c) {
-        Eigen::ConjugateGradient<SpMat, Eigen::Lower> s;
-        s.setTolerance(tolerance);
-        s.setMaxIterations(o.max_iterations);
-        s.compute(k);
-        bool conv = true;
-        x.col(c) = iterate(s, rhs.col(c), its[static_cast<std::size_t>(c)], conv);
-        ok[static_cast<std::size_t>(c)] = conv ? 1 : 0;
-      }
-      r.report.iterations_u = its[0];
-      for (int c = 1; c < cols; ++c) {
-        r.report.iterations_v = std::max(r.report.iterations_v, its[static_cast<std::size_t>(c)]);
-      }
-      r.report.converged = std::all_of(ok.begin(), ok.end(), [](char b) { return b != 0; });
-      r.report.seconds_solve = seconds_since(t0);
+      const AmgHierarchy h = build_amg(k);
+      r.report.seconds_factor = seconds_since(t0);
+      amg_path_b(h, tolerance);
       break;
     }
     case HhdSolver::BiCgStab: {
@@ -688,8 +779,8 @@ HhdResult helmholtz_hodge(const HhdMesh& m, const std::vector<Eigen::Vector3d>& 
   }
   Eigen::VectorXd res17, unused;
   Eigen::MatrixXd res18, unused18;
-  right_hand_sides(m, g, idx, n, du, res17, unused18);
-  right_hand_sides(m, g, idx, n, dv, unused, res18);
+  right_hand_sides(m, g, inc, n, du, res17, unused18);
+  right_hand_sides(m, g, inc, n, dv, unused, res18);
   const auto relative = [](double num, double den) { return den > 0.0 ? num / den : num; };
   r.report.residual_eq17 = relative(res17.norm(), bu.norm());
   r.report.residual_eq18 = relative(res18.norm(), b18.norm());

@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/SparseCholesky>
+#include <algorithm>
+#include <cmath>
 #include <random>
 #include <stdexcept>
 
@@ -85,6 +87,46 @@ TEST(AggregationAmg, VcycleIsSymmetricPositiveDefinite) {
   xy << x, y;
   const Eigen::MatrixXd both = amg_vcycle(h, xy);
   EXPECT_EQ(Eigen::MatrixXd(both.col(1)), amg_vcycle(h, y));
+}
+
+TEST(AggregationAmg, GalerkinCoarseMatricesAndColumnsSolvedAsAlone) {
+  const SpMat a = grid_laplacian(20, 1e2);
+  const AmgHierarchy h = build_amg(a);
+  ASSERT_GE(h.levels.size(), 3u);
+  // Every coarse matrix is RAP of the level above (the hand-written sparse products against
+  // Eigen's), symmetric, and R = Pᵀ.
+  for (std::size_t l = 0; l + 1 < h.levels.size(); ++l) {
+    const auto& L = h.levels[l];
+    using RowMat = Eigen::SparseMatrix<double, Eigen::RowMajor, int>;
+    const RowMat rap = L.r * (L.a * L.p);
+    const RowMat next = h.levels[l + 1].a;
+    EXPECT_LT((rap - next).norm(), 1e-13 * next.norm()) << "level " << l;
+    EXPECT_EQ((RowMat(next.transpose()) - next).norm(), 0.0) << "level " << l;
+    EXPECT_EQ((RowMat(L.p.transpose()) - L.r).norm(), 0.0) << "level " << l;
+  }
+  // Three columns converging at different iterations (one scaled, one from a smooth solution):
+  // each column gets the bits and the iteration count of its own solve.
+  Eigen::MatrixXd b = random_columns(a.rows(), 3, 11);
+  b.col(1) *= 1e-8;
+  Eigen::VectorXd smooth(a.rows());
+  for (Eigen::Index i = 0; i < a.rows(); ++i) smooth(i) = std::sin(0.001 * static_cast<double>(i));
+  b.col(2) = a * smooth;
+  int its = 0;
+  bool ok = false;
+  std::vector<int> column_its;
+  const Eigen::MatrixXd x = amg_pcg(h, b, 1e-10, 200, its, ok, &column_its);
+  ASSERT_TRUE(ok);
+  ASSERT_EQ(column_its.size(), 3u);
+  EXPECT_EQ(its, *std::max_element(column_its.begin(), column_its.end()));
+  for (int c = 0; c < 3; ++c) {
+    int its1 = 0;
+    bool ok1 = false;
+    const Eigen::MatrixXd x1 = amg_pcg(h, b.col(c), 1e-10, 200, its1, ok1);
+    EXPECT_TRUE(ok1);
+    EXPECT_EQ(its1, column_its[static_cast<std::size_t>(c)]) << "column " << c;
+    EXPECT_EQ(Eigen::VectorXd(x.col(c)), Eigen::VectorXd(x1.col(0))) << "column " << c;
+    EXPECT_LE((b.col(c) - a * x.col(c)).norm(), 1e-10 * b.col(c).norm());
+  }
 }
 
 TEST(AggregationAmg, SmallMatrixIsSolvedDirectly) {

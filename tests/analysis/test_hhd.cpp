@@ -1,6 +1,7 @@
 // Tests of analysis/hhd (seed 000 eq 9–18) against exact answers: discrete potentials recovered
 // to round-off, convergence rates on analytic fields, orthogonality identities.
 #include <gtest/gtest.h>
+#include <omp.h>
 
 #include <Eigen/Geometry>
 #include <cmath>
@@ -220,6 +221,38 @@ TEST(Hhd, ProjectionAmgIsTheSameProjection) {
   EXPECT_TRUE(a2.report.converged);
   EXPECT_LT((a2.u - c2.u).norm(), 1e-8 * c2.u.norm());
   EXPECT_LT((a2.v - c2.v).norm(), 1e-8 * c2.v.norm());
+}
+
+TEST(Hhd, CgIsPathBAndTheSameBitsForAnyThreadCount) {
+  // Path (b) by AMG-preconditioned CG: the factor's answer to its tolerance, and (rows summed in
+  // a fixed order, the unknowns numbered along a Hilbert curve) the same bits with 1 and 2
+  // threads, assembly and post-processing included.
+  const auto m = test::random_cube_mesh(3000, 4);
+  std::vector<Eigen::Vector3d> nodal;
+  for (const auto& p : m.points) nodal.push_back(test::vortex_source_translation(p));
+  const auto xi = simplex_mean(m, nodal);
+  HhdOptions o;
+  o.solver = HhdSolver::Cholmod;
+  const auto c = helmholtz_hodge(m, xi, o);
+  o.solver = HhdSolver::Cg;
+  const int threads = omp_get_max_threads();
+  omp_set_num_threads(1);
+  const auto one = helmholtz_hodge(m, xi, o);
+  omp_set_num_threads(2);
+  const auto two = helmholtz_hodge(m, xi, o);
+  omp_set_num_threads(threads);
+  EXPECT_EQ(one.report.solver, "cg");
+  EXPECT_TRUE(one.report.converged);
+  EXPECT_LE(one.report.residual_eq17, kHhdTolerance);
+  EXPECT_GT(one.report.iterations_u, 0);
+  EXPECT_LT(one.report.iterations_v, 100);  // (the V-cycle works: Jacobi-CG needed ~10×)
+  EXPECT_LT((one.u - c.u).norm(), 1e-8 * c.u.norm());
+  EXPECT_LT((one.v - c.v).norm(), 1e-8 * c.v.norm());
+  EXPECT_EQ(one.u, two.u);
+  EXPECT_EQ(one.v, two.v);
+  EXPECT_EQ(one.harmonic, two.harmonic);
+  EXPECT_EQ(one.norm_harmonic, two.norm_harmonic);
+  EXPECT_EQ(one.report.residual_eq18, two.report.residual_eq18);
 }
 
 // L2 errors (centroid values, measure-weighted RMS) of the parts and RMS nodal errors of the
