@@ -22,44 +22,55 @@ using Index = Eigen::Index;
 
 // Rows below this are not worth waking the threads for.
 constexpr Index kParallelRows = 8192;
+// Rows go to the threads in chunks of this many; sums over rows are taken per chunk, then over
+// the chunks in order: the same bits for any number of threads and any block width.
+constexpr Index kChunk = 2048;
+
+Index chunks(Index n) {
+  return (n + kChunk - 1) / kChunk;
+}
+
+// f(begin, end, chunk) for every chunk of [0, n), chunks on the threads.
+template <class F>
+void for_chunks(Index n, F&& f) {
+  const Index nc = chunks(n);
+#pragma omp parallel for schedule(static) if (n >= kParallelRows)
+  for (Index k = 0; k < nc; ++k) f(k * kChunk, std::min(n, (k + 1) * kChunk), k);
+}
 
 // For every row i of A: sums s_c = Σ_e a_ie x_(j_e, c) over the row in storage order, then
-// row(i, s). C columns known at compile time (C = 0: x.cols() at run time).
+// row(i, s, chunk). C columns known at compile time (C = 0: x.cols() at run time).
 template <int C, class Row>
 void for_rows_fixed(const RowMat& a, const Block& x, Row&& row) {
-  const Index n = a.rows();
   const int* outer = a.outerIndexPtr();
   const int* inner = a.innerIndexPtr();
   const double* val = a.valuePtr();
   const double* xd = x.data();
-  if constexpr (C > 0) {
-#pragma omp parallel for schedule(static) if (n >= kParallelRows)
-    for (Index i = 0; i < n; ++i) {
-      std::array<double, C> s{};  // (a fresh local per row: the sums stay in registers)
-      for (int e = outer[i]; e < outer[i + 1]; ++e) {
-        const double v = val[e];
-        const double* xr = xd + static_cast<Index>(inner[e]) * C;
-        for (int c = 0; c < C; ++c) s[static_cast<std::size_t>(c)] += v * xr[c];
+  const Index cols = C > 0 ? C : x.cols();
+  for_chunks(a.rows(), [&](Index begin, Index end, Index chunk) {
+    if constexpr (C > 0) {
+      for (Index i = begin; i < end; ++i) {
+        std::array<double, C> s{};  // (a fresh local per row: the sums stay in registers)
+        for (int e = outer[i]; e < outer[i + 1]; ++e) {
+          const double v = val[e];
+          const double* xr = xd + static_cast<Index>(inner[e]) * C;
+          for (int c = 0; c < C; ++c) s[static_cast<std::size_t>(c)] += v * xr[c];
+        }
+        row(i, s.data(), chunk);
       }
-      row(i, s.data());
-    }
-  } else {
-    const Index cols = x.cols();
-#pragma omp parallel if (n >= kParallelRows)
-    {
+    } else {
       std::vector<double> s(static_cast<std::size_t>(cols));
-#pragma omp for schedule(static)
-      for (Index i = 0; i < n; ++i) {
+      for (Index i = begin; i < end; ++i) {
         std::fill(s.begin(), s.end(), 0.0);
         for (int e = outer[i]; e < outer[i + 1]; ++e) {
           const double v = val[e];
           const double* xr = xd + static_cast<Index>(inner[e]) * cols;
           for (Index c = 0; c < cols; ++c) s[static_cast<std::size_t>(c)] += v * xr[c];
         }
-        row(i, s.data());
+        row(i, s.data(), chunk);
       }
     }
-  }
+  });
 }
 
 template <class Row>
@@ -78,35 +89,54 @@ void for_rows(const RowMat& a, const Block& x, Row&& row) {
   }
 }
 
-// A·X.
-Block times(const RowMat& a, const Block& x) {
+// Per-chunk partial sums of `cols` columns, added over the chunks in order.
+struct ChunkSums {
+  Index cols;
+  Eigen::MatrixXd part;  // cols × chunks
+  ChunkSums(Index n, Index c) : cols(c), part(Eigen::MatrixXd::Zero(c, chunks(n))) {}
+  double* at(Index chunk) { return part.col(chunk).data(); }
+  Eigen::VectorXd total() const {
+    Eigen::VectorXd t = Eigen::VectorXd::Zero(cols);
+    for (Index k = 0; k < part.cols(); ++k) t += part.col(k);
+    return t;
+  }
+};
+
+// Σ_i a_ic b_ic per column.
+Eigen::VectorXd column_dots(const Block& a, const Block& b) {
+  const Index cols = a.cols();
+  ChunkSums sums(a.rows(), cols);
+  for_chunks(a.rows(), [&](Index begin, Index end, Index chunk) {
+    double* s = sums.at(chunk);
+    for (Index i = begin; i < end; ++i)
+      for (Index c = 0; c < cols; ++c) s[c] += a(i, c) * b(i, c);
+  });
+  return sums.total();
+}
+
+// Y = A·X.
+void times(const RowMat& a, const Block& x, Block& y) {
   const Index cols = x.cols();
-  Block y(a.rows(), cols);
-  for_rows(a, x, [&](Index i, const double* s) {
+  y.resize(a.rows(), cols);
+  for_rows(a, x, [&](Index i, const double* s, Index) {
     for (Index c = 0; c < cols; ++c) y(i, c) = s[c];
   });
+}
+
+Block times(const RowMat& a, const Block& x) {
+  Block y;
+  times(a, x, y);
   return y;
 }
 
-// B − A·X.
-Block residual(const RowMat& a, const Block& x, const Block& b) {
+// One damped Jacobi sweep: Y = X + ω D⁻¹ (B − A·X).
+void jacobi(const AmgLevel& L, const Block& x, const Block& b, Block& y) {
   const Index cols = x.cols();
-  Block y(a.rows(), cols);
-  for_rows(a, x, [&](Index i, const double* s) {
-    for (Index c = 0; c < cols; ++c) y(i, c) = b(i, c) - s[c];
-  });
-  return y;
-}
-
-// One damped Jacobi sweep: X + ω D⁻¹ (B − A·X).
-Block jacobi(const AmgLevel& L, const Block& x, const Block& b) {
-  const Index cols = x.cols();
-  Block y(L.a.rows(), cols);
-  for_rows(L.a, x, [&](Index i, const double* s) {
+  y.resize(L.a.rows(), cols);
+  for_rows(L.a, x, [&](Index i, const double* s, Index) {
     const double w = L.omega * L.inv_diag(i);
     for (Index c = 0; c < cols; ++c) y(i, c) = x(i, c) + w * (b(i, c) - s[c]);
   });
-  return y;
 }
 
 // A·B of two sparse matrices (Gustavson: row by row with a dense accumulator), rows on the
@@ -234,27 +264,47 @@ std::vector<int> aggregates(const RowMat& a, const Eigen::VectorXd& diag, double
   return agg;
 }
 
-Block cycle(const AmgHierarchy& h, std::size_t l, const Block& b) {
+// Per level: the solution, the right-hand side and a scratch block of the V-cycle.
+struct Workspace {
+  std::vector<Block> x, b, t;
+  explicit Workspace(std::size_t levels) : x(levels), b(levels), t(levels) {}
+};
+
+// One V-cycle from zero on level l: w.x[l] ≈ A_l⁻¹ w.b[l] (w.b[l] unchanged).
+void cycle(const AmgHierarchy& h, std::size_t l, Workspace& w) {
+  Block& x = w.x[l];
+  const Block& b = w.b[l];
+  const Index cols = b.cols();
+  x.resize(b.rows(), cols);
   if (l + 1 == h.levels.size()) {  // column by column: each column's bits whatever the block
-    Block x(b.rows(), b.cols());
-    for (Index c = 0; c < b.cols(); ++c) x.col(c) = h.coarsest.solve(Eigen::VectorXd(b.col(c)));
-    return x;
+    for (Index c = 0; c < cols; ++c) x.col(c) = h.coarsest.solve(Eigen::VectorXd(b.col(c)));
+    return;
   }
   const AmgLevel& L = h.levels[l];
-  Block x = (L.omega * L.inv_diag).asDiagonal() * b;
-  for (int s = 1; s < h.sweeps; ++s) x = jacobi(L, x, b);
-  x += times(L.p, cycle(h, l + 1, times(L.r, residual(L.a, x, b))));
-  for (int s = 0; s < h.sweeps; ++s) x = jacobi(L, x, b);
-  return x;
-}
-
-// Σ_i a_ic b_ic per column, in row order (a column's sum the same bits in any block).
-Eigen::VectorXd column_dots(const Block& a, const Block& b) {
-  const Index cols = a.cols();
-  Eigen::VectorXd s = Eigen::VectorXd::Zero(cols);
-  for (Index i = 0; i < a.rows(); ++i)
-    for (Index c = 0; c < cols; ++c) s(c) += a(i, c) * b(i, c);
-  return s;
+  Block& t = w.t[l];
+  for_chunks(b.rows(), [&](Index begin, Index end, Index) {
+    for (Index i = begin; i < end; ++i) {
+      const double d = L.omega * L.inv_diag(i);
+      for (Index c = 0; c < cols; ++c) x(i, c) = d * b(i, c);
+    }
+  });
+  for (int s = 1; s < h.sweeps; ++s) {
+    jacobi(L, x, b, t);
+    x.swap(t);
+  }
+  t.resize(b.rows(), cols);  // the residual, restricted
+  for_rows(L.a, x, [&](Index i, const double* s, Index) {
+    for (Index c = 0; c < cols; ++c) t(i, c) = b(i, c) - s[c];
+  });
+  times(L.r, t, w.b[l + 1]);
+  cycle(h, l + 1, w);
+  for_rows(L.p, w.x[l + 1], [&](Index i, const double* s, Index) {
+    for (Index c = 0; c < cols; ++c) x(i, c) += s[c];
+  });
+  for (int s = 0; s < h.sweeps; ++s) {
+    jacobi(L, x, b, t);
+    x.swap(t);
+  }
 }
 
 }  // namespace
@@ -329,7 +379,10 @@ AmgHierarchy build_amg(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& 
 
 Eigen::MatrixXd amg_vcycle(const AmgHierarchy& h, const Eigen::MatrixXd& b) {
   if (h.levels.empty()) throw std::invalid_argument("AMG: empty hierarchy");
-  return cycle(h, 0, Block(b));
+  Workspace w(h.levels.size());
+  w.b[0] = b;
+  cycle(h, 0, w);
+  return Eigen::MatrixXd(w.x[0]);
 }
 
 Eigen::MatrixXd amg_pcg(const AmgHierarchy& h, const Eigen::MatrixXd& b0, double tolerance,
@@ -337,12 +390,14 @@ Eigen::MatrixXd amg_pcg(const AmgHierarchy& h, const Eigen::MatrixXd& b0, double
                         std::vector<int>* column_iterations) {
   if (h.levels.empty()) throw std::invalid_argument("AMG: empty hierarchy");
   const RowMat& a = h.levels.front().a;
-  const Index cols = b0.cols();
-  const Block b = b0;
-  Block x = Block::Zero(b.rows(), cols);
-  Block r = b;
+  const Index n = b0.rows(), cols = b0.cols();
+  Workspace w(h.levels.size());
+  Block& r = w.b[0];        // the residual is the V-cycle's right-hand side,
+  const Block& z = w.x[0];  // and its output the preconditioned residual
+  r = b0;
+  Block x = Block::Zero(n, cols), p, ap(n, cols);
   std::vector<char> done(static_cast<std::size_t>(cols), 0);
-  const Eigen::VectorXd bnorm = column_dots(b, b).cwiseSqrt();
+  const Eigen::VectorXd bnorm = column_dots(r, r).cwiseSqrt();
   for (Index c = 0; c < cols; ++c) done[static_cast<std::size_t>(c)] = bnorm(c) == 0.0;
   iterations = 0;
   converged = true;
@@ -355,33 +410,48 @@ Eigen::MatrixXd amg_pcg(const AmgHierarchy& h, const Eigen::MatrixXd& b0, double
     return std::all_of(done.begin(), done.end(), [](char d) { return d != 0; });
   };
   if (all_done()) return finish();
-  Block z = cycle(h, 0, r);
-  Block p = z;
+  cycle(h, 0, w);
+  p = z;
   Eigen::VectorXd rz = column_dots(r, z);
   Eigen::VectorXd alpha(cols), beta(cols);
   for (int it = 1; it <= max_iterations; ++it) {
-    const Block ap = times(a, p);
     iterations = it;
-    const Eigen::VectorXd pap = column_dots(p, ap);
+    ChunkSums pap(n, cols);  // A·p and pᵀA·p in one pass
+    for_rows(a, p, [&](Index i, const double* s, Index chunk) {
+      double* q = pap.at(chunk);
+      for (Index c = 0; c < cols; ++c) {
+        ap(i, c) = s[c];
+        q[c] += p(i, c) * s[c];
+      }
+    });
+    const Eigen::VectorXd pap_total = pap.total();
     for (Index c = 0; c < cols; ++c) {
       alpha(c) = 0.0;
       if (done[static_cast<std::size_t>(c)]) continue;
       its[static_cast<std::size_t>(c)] = it;
-      if (!(pap(c) > 0.0) || !(rz(c) > 0.0)) {  // (breakdown: no further progress possible)
+      if (!(pap_total(c) > 0.0) || !(rz(c) > 0.0)) {  // (breakdown: no further progress)
         done[static_cast<std::size_t>(c)] = 1;
         converged = false;
         continue;
       }
-      alpha(c) = rz(c) / pap(c);
+      alpha(c) = rz(c) / pap_total(c);
     }
-    x += p * alpha.asDiagonal();
-    r -= ap * alpha.asDiagonal();
-    const Eigen::VectorXd rnorm = column_dots(r, r).cwiseSqrt();
+    ChunkSums rr(n, cols);  // the updates and ‖r‖² in one pass
+    for_chunks(n, [&](Index begin, Index end, Index chunk) {
+      double* q = rr.at(chunk);
+      for (Index i = begin; i < end; ++i)
+        for (Index c = 0; c < cols; ++c) {
+          x(i, c) += alpha(c) * p(i, c);
+          r(i, c) -= alpha(c) * ap(i, c);
+          q[c] += r(i, c) * r(i, c);
+        }
+    });
+    const Eigen::VectorXd rnorm = rr.total().cwiseSqrt();
     for (Index c = 0; c < cols; ++c)
       if (!done[static_cast<std::size_t>(c)] && rnorm(c) <= tolerance * bnorm(c))
         done[static_cast<std::size_t>(c)] = 1;
     if (all_done()) return finish();
-    z = cycle(h, 0, r);
+    cycle(h, 0, w);
     const Eigen::VectorXd rz_new = column_dots(r, z);
     for (Index c = 0; c < cols; ++c) {
       beta(c) = 0.0;
@@ -389,7 +459,10 @@ Eigen::MatrixXd amg_pcg(const AmgHierarchy& h, const Eigen::MatrixXd& b0, double
       beta(c) = rz_new(c) / rz(c);
       rz(c) = rz_new(c);
     }
-    p = z + p * beta.asDiagonal();
+    for_chunks(n, [&](Index begin, Index end, Index) {
+      for (Index i = begin; i < end; ++i)
+        for (Index c = 0; c < cols; ++c) p(i, c) = z(i, c) + beta(c) * p(i, c);
+    });
   }
   converged = false;
   return finish();
