@@ -150,7 +150,7 @@ RowMat multiply(const RowMat& a, const RowMat& b) {
   const int* bi = b.innerIndexPtr();
   const double* bv = b.valuePtr();
   std::vector<int> outer(static_cast<std::size_t>(n) + 1, 0);
-#pragma omp parallel if (n >= kParallelRows)
+#pragma omp parallel if (a.nonZeros() >= kParallelRows)
   {
     std::vector<Index> mark(static_cast<std::size_t>(m), -1);
 #pragma omp for schedule(static)
@@ -171,7 +171,7 @@ RowMat multiply(const RowMat& a, const RowMat& b) {
     outer[static_cast<std::size_t>(i) + 1] += outer[static_cast<std::size_t>(i)];
   std::vector<int> inner(static_cast<std::size_t>(outer.back()));
   std::vector<double> value(inner.size());
-#pragma omp parallel if (n >= kParallelRows)
+#pragma omp parallel if (a.nonZeros() >= kParallelRows)
   {
     std::vector<Index> mark(static_cast<std::size_t>(m), -1);
     std::vector<double> acc(static_cast<std::size_t>(m), 0.0);
