@@ -385,6 +385,14 @@ Eigen::MatrixXd amg_vcycle(const AmgHierarchy& h, const Eigen::MatrixXd& b) {
   return Eigen::MatrixXd(w.x[0]);
 }
 
+void amg_vcycle(const AmgHierarchy& h, const Eigen::Ref<const AmgBlock>& b, AmgBlock& x) {
+  if (h.levels.empty()) throw std::invalid_argument("AMG: empty hierarchy");
+  Workspace w(h.levels.size());
+  w.b[0] = b;
+  cycle(h, 0, w);
+  x.swap(w.x[0]);
+}
+
 Eigen::MatrixXd amg_pcg(const AmgHierarchy& h, const Eigen::MatrixXd& b0, double tolerance,
                         int max_iterations, int& iterations, bool& converged,
                         std::vector<int>* column_iterations) {

@@ -44,6 +44,11 @@ AmgHierarchy build_amg(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& 
 /// approximation of A⁻¹b (the columns share each pass over the matrices).
 Eigen::MatrixXd amg_vcycle(const AmgHierarchy& h, const Eigen::MatrixXd& b);
 
+/// A block of right-hand sides with each unknown's columns side by side (row-major).
+using AmgBlock = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+/// amg_vcycle for a row-major block (no change of layout): x ≈ A⁻¹b, the same bits.
+void amg_vcycle(const AmgHierarchy& h, const Eigen::Ref<const AmgBlock>& b, AmgBlock& x);
+
 /// Conjugate gradients on A x = b (A: the matrix the hierarchy was built from) for every column
 /// of b at once (each column its own step lengths, frozen once it converged), preconditioned by
 /// amg_vcycle, from x = 0, until every column's relative residual ‖b − A x‖ ≤ tolerance ‖b‖ or

@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -264,50 +265,89 @@ SpMat curl_curl_eq18(const HhdMesh& m, const P1Geometry& g, const std::vector<in
   return a;
 }
 
-// A·V with A = CᵀMC (the matrix of eq 18 up to its sign), matrix-free over the tetrahedra: per
-// tetrahedron c_k = |T_k| Σ_a ∇φ_a × v_a, then row i gets c_k × ∇φ_i. V and AV are n×3 over the
-// unknowns. Each thread sums a fixed range of tetrahedra into its own buffer and the buffers are
-// added in thread order, so the result does not depend on the scheduling.
-Eigen::MatrixXd apply_curl_curl(const HhdMesh& m, const P1Geometry& g, const std::vector<int>& idx,
-                                const Eigen::MatrixXd& v) {
+// Vectors over the unknowns with a node's three components side by side.
+using Rows3 = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
+
+// A = CᵀMC (the matrix of eq 18 up to its sign), matrix-free, laid out for its products: the
+// tetrahedra of positive measure in the order of their smallest unknown (the unknowns follow a
+// Hilbert curve, so consecutive tetrahedra read and write nearby rows), each with its four
+// unknowns (−1: a Dirichlet node), |T_k| and its four ∇φ_a.
+struct CurlCurl {
+  std::vector<std::array<int, 4>> node;
+  std::vector<double> measure;
+  // ∇φ_1..3 (9 values); ∇φ_0 = −∇φ_1 − ∇φ_2 − ∇φ_3, summed as p1_geometry sums it (the same
+  // bits): 96 bytes a tetrahedron to stream per product instead of 120.
+  std::vector<std::array<double, 9>> gradient;
+};
+
+CurlCurl curl_curl_operator(const HhdMesh& m, const P1Geometry& g, const std::vector<int>& idx) {
+  std::vector<std::pair<int, std::int32_t>> order;  // (smallest unknown, simplex)
+  order.reserve(m.simplices.size());
+  for (std::size_t k = 0; k < m.simplices.size(); ++k) {
+    if (!(g.measure[k] > 0.0)) continue;
+    int first = std::numeric_limits<int>::max();
+    for (std::size_t a = 0; a < 4; ++a) {
+      const int j = idx[static_cast<std::size_t>(m.simplices[k][a])];
+      if (j >= 0) first = std::min(first, j);
+    }
+    if (first != std::numeric_limits<int>::max())
+      order.emplace_back(first, static_cast<std::int32_t>(k));
+  }
+  std::sort(order.begin(), order.end());
+  CurlCurl op;
+  op.node.resize(order.size());
+  op.measure.resize(order.size());
+  op.gradient.resize(order.size());
+  for (std::size_t e = 0; e < order.size(); ++e) {
+    const auto k = static_cast<std::size_t>(order[e].second);
+    for (std::size_t a = 0; a < 4; ++a)
+      op.node[e][a] = idx[static_cast<std::size_t>(m.simplices[k][a])];
+    op.measure[e] = g.measure[k];
+    for (std::size_t a = 1; a < 4; ++a)
+      for (std::size_t q = 0; q < 3; ++q) op.gradient[e][3 * (a - 1) + q] = g.gradient[k][a][q];
+  }
+  return op;
+}
+
+// A·V: per tetrahedron c_k = |T_k| Σ_a ∇φ_a × v_a, then row i gets c_k × ∇φ_i. Each thread sums
+// a fixed range of tetrahedra into its own buffer and the buffers are added in thread order, so
+// the result does not depend on the scheduling.
+Rows3 apply_curl_curl(const CurlCurl& op, const Rows3& v) {
   const Eigen::Index n = v.rows();
-  const auto ns = static_cast<std::ptrdiff_t>(m.simplices.size());
+  const auto ns = static_cast<std::ptrdiff_t>(op.node.size());
   int threads = 1;
 #ifdef _OPENMP
   threads = omp_get_max_threads();
 #endif
-  std::vector<Eigen::MatrixXd> part(static_cast<std::size_t>(threads));
+  std::vector<Rows3> part(static_cast<std::size_t>(threads));
 #pragma omp parallel num_threads(threads)
   {
     int t = 0;
 #ifdef _OPENMP
     t = omp_get_thread_num();
 #endif
-    Eigen::MatrixXd& out = part[static_cast<std::size_t>(t)];
-    out = Eigen::MatrixXd::Zero(n, 3);
+    Rows3& out = part[static_cast<std::size_t>(t)];
+    out = Rows3::Zero(n, 3);
     const std::ptrdiff_t lo = ns * t / threads, hi = ns * (t + 1) / threads;
     for (std::ptrdiff_t kk = lo; kk < hi; ++kk) {
       const auto k = static_cast<std::size_t>(kk);
-      const double w = g.measure[k];
-      if (!(w > 0.0)) continue;
-      std::array<int, 4> j{};
-      Eigen::Vector3d c = Eigen::Vector3d::Zero();
-      for (std::size_t a = 0; a < 4; ++a) {
-        j[a] = idx[static_cast<std::size_t>(m.simplices[k][a])];
-        if (j[a] >= 0)
-          c += g.gradient[k][a].cross(Eigen::Vector3d(v(j[a], 0), v(j[a], 1), v(j[a], 2)));
+      const auto& j = op.node[k];
+      std::array<Eigen::Vector3d, 4> gr;
+      gr[0] = Eigen::Vector3d::Zero();
+      for (std::size_t a = 1; a < 4; ++a) {
+        gr[a] = Eigen::Vector3d(op.gradient[k].data() + 3 * (a - 1));
+        gr[0] -= gr[a];
       }
-      c *= w;
+      Eigen::Vector3d c = Eigen::Vector3d::Zero();
       for (std::size_t a = 0; a < 4; ++a)
-        if (j[a] >= 0) out.row(j[a]) += c.cross(g.gradient[k][a]).transpose();
+        if (j[a] >= 0) c += gr[a].cross(v.row(j[a]).transpose());
+      c *= op.measure[k];
+      for (std::size_t a = 0; a < 4; ++a)
+        if (j[a] >= 0) out.row(j[a]) += c.cross(gr[a]).transpose();
     }
   }
   for (std::size_t t = 1; t < part.size(); ++t) part[0] += part[t];
-  return part[0];
-}
-
-double frobenius_dot(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
-  return (a.array() * b.array()).sum();
+  return std::move(part[0]);
 }
 
 // The 3×3 diagonal blocks of A, Σ_k |T_k| (|∇φ_i|² I − ∇φ_i ∇φ_iᵀ), inverted (pseudo-inverse
@@ -337,8 +377,9 @@ std::vector<Eigen::Matrix3d> curl_curl_block_inverses(const HhdMesh& m, const P1
   return d;
 }
 
-Eigen::MatrixXd apply_blocks(const std::vector<Eigen::Matrix3d>& d, const Eigen::MatrixXd& r) {
-  Eigen::MatrixXd z(r.rows(), 3);
+Rows3 apply_blocks(const std::vector<Eigen::Matrix3d>& d, const Rows3& r) {
+  Rows3 z(r.rows(), 3);
+#pragma omp parallel for schedule(static)
   for (Eigen::Index i = 0; i < r.rows(); ++i)
     z.row(i) = (d[static_cast<std::size_t>(i)] * r.row(i).transpose()).transpose();
   return z;
@@ -359,59 +400,104 @@ Eigen::MatrixXd apply_blocks(const std::vector<Eigen::Matrix3d>& d, const Eigen:
 // CG minimises ‖C(v − v*)‖_M, the error of ∇×v, over its Krylov space, and its residual is
 // orthogonal to that space, which holds v: ⟨∇×v, h⟩ = vᵀ(CᵀMξ − Av) = 0 at every iterate (to
 // round-off). Stops at ‖CᵀMξ − Av‖ ≤ tolerance ‖CᵀMξ‖ (eq 18's residual) or max_iterations.
+// Σ over [0, n) of f(begin, end) taken per chunk of rows on the threads, then over the chunks
+// in order: the same bits for any number of threads.
+template <class F>
+double chunked_sum(Eigen::Index n, F&& f) {
+  constexpr Eigen::Index chunk = 2048;
+  const Eigen::Index nc = (n + chunk - 1) / chunk;
+  std::vector<double> part(static_cast<std::size_t>(nc), 0.0);
+#pragma omp parallel for schedule(static)
+  for (Eigen::Index k = 0; k < nc; ++k)
+    part[static_cast<std::size_t>(k)] = f(k * chunk, std::min(n, (k + 1) * chunk));
+  double sum = 0.0;
+  for (const double x : part) sum += x;
+  return sum;
+}
+
 template <class SolveK>
 Eigen::MatrixXd projection_pcg(const HhdMesh& m, const P1Geometry& g, const std::vector<int>& idx,
-                               const Eigen::MatrixXd& b, SolveK&& solve_k, double tolerance,
-                               int max_iterations, int& iterations, bool& converged,
-                               const std::function<void()>& poll) {
+                               const Eigen::MatrixXd& b, SolveK&& solve_k, bool additive,
+                               double tolerance, int max_iterations, int& iterations,
+                               bool& converged, const std::function<void()>& poll) {
   const Eigen::Index n = b.rows();
   iterations = 0;
   converged = true;
-  Eigen::MatrixXd v = Eigen::MatrixXd::Zero(n, 3);
+  Rows3 v = Rows3::Zero(n, 3);
   const double bnorm = b.norm();
-  if (bnorm == 0.0) return v;
+  if (bnorm == 0.0) return Eigen::MatrixXd(v);
   const auto d = curl_curl_block_inverses(m, g, idx, static_cast<int>(n));
+  const CurlCurl op = curl_curl_operator(m, g, idx);
+  auto dot = [n](const Rows3& x, const Rows3& y) {
+    return chunked_sum(n, [&](Eigen::Index lo, Eigen::Index hi) {
+      double s = 0.0;
+      for (Eigen::Index i = lo; i < hi; ++i) s += x.row(i).dot(y.row(i));
+      return s;
+    });
+  };
   // λ_max(D⁻¹A) by power iteration from a fixed start (deterministic).
-  Eigen::MatrixXd q = Eigen::MatrixXd::Ones(n, 3);
+  Rows3 q = Rows3::Ones(n, 3);
   for (Eigen::Index i = 0; i < n; ++i)
     q.row(i) *= (i % 7 == 0 ? -1.0 : 1.0) * (1.0 + 0.01 * static_cast<double>(i % 13));
   double lambda = 1.0;
   for (int it = 0; it < 12; ++it) {
-    const Eigen::MatrixXd aq = apply_curl_curl(m, g, idx, q);
-    const Eigen::MatrixXd dq = apply_blocks(d, aq);
-    const double qaq = frobenius_dot(q, aq);
-    const double qdq = frobenius_dot(dq, aq);
+    const Rows3 aq = apply_curl_curl(op, q);
+    const Rows3 dq = apply_blocks(d, aq);
+    const double qaq = dot(q, aq);
+    const double qdq = dot(dq, aq);
     if (qaq > 0.0) lambda = qdq / qaq;  // Rayleigh quotient of D⁻¹A in the A inner product
-    q = dq / dq.norm();
+    q = dq / std::sqrt(dot(dq, dq));
   }
-  const double omega = 1.5 / lambda;
-  auto precondition = [&](const Eigen::MatrixXd& r) {
-    Eigen::MatrixXd z = omega * apply_blocks(d, r);
-    z += solve_k(Eigen::MatrixXd(r - apply_curl_curl(m, g, idx, z)));
-    z += omega * apply_blocks(d, Eigen::MatrixXd(r - apply_curl_curl(m, g, idx, z)));
-    return z;
+  const double omega = (additive ? 0.4 : 1.5) / lambda;
+  // z = P r; returns rᵀz.
+  Rows3 t(n, 3);
+  auto precondition = [&](const Rows3& r, Rows3& z) {
+    if (additive) {
+      const Rows3 k = solve_k(r);
+      return chunked_sum(n, [&](Eigen::Index lo, Eigen::Index hi) {
+        double s = 0.0;
+        for (Eigen::Index i = lo; i < hi; ++i) {
+          z.row(i) = k.row(i) +
+                     omega * (d[static_cast<std::size_t>(i)] * r.row(i).transpose()).transpose();
+          s += r.row(i).dot(z.row(i));
+        }
+        return s;
+      });
+    }
+    z = omega * apply_blocks(d, r);
+    z += solve_k(Rows3(r - apply_curl_curl(op, z)));
+    z += omega * apply_blocks(d, Rows3(r - apply_curl_curl(op, z)));
+    return dot(r, z);
   };
-  Eigen::MatrixXd r = b;
-  Eigen::MatrixXd z = precondition(r);
-  Eigen::MatrixXd p = z;
-  double rz = frobenius_dot(r, z);
+  Rows3 r = b;
+  Rows3 z(n, 3);
+  double rz = precondition(r, z);
+  Rows3 p = z;
   for (int it = 1; it <= max_iterations; ++it) {
-    const Eigen::MatrixXd ap = apply_curl_curl(m, g, idx, p);
-    const double pap = frobenius_dot(p, ap);
+    const Rows3 ap = apply_curl_curl(op, p);
+    const double pap = dot(p, ap);
     if (!(pap > 0.0) || !(rz > 0.0)) break;
     const double alpha = rz / pap;
-    v += alpha * p;
-    r -= alpha * ap;
+    const double rr = chunked_sum(n, [&](Eigen::Index lo, Eigen::Index hi) {
+      double s = 0.0;
+      for (Eigen::Index i = lo; i < hi; ++i) {
+        v.row(i) += alpha * p.row(i);
+        r.row(i) -= alpha * ap.row(i);
+        s += r.row(i).squaredNorm();
+      }
+      return s;
+    });
     iterations = it;
-    if (r.norm() <= tolerance * bnorm) return v;
+    if (std::sqrt(rr) <= tolerance * bnorm) return Eigen::MatrixXd(v);
     if (poll && it % 8 == 0) poll();
-    z = precondition(r);
-    const double rz_new = frobenius_dot(r, z);
-    p = z + (rz_new / rz) * p;
+    const double rz_new = precondition(r, z);
+    const double beta = rz_new / rz;
+#pragma omp parallel for schedule(static)
+    for (Eigen::Index i = 0; i < n; ++i) p.row(i) = z.row(i) + beta * p.row(i);
     rz = rz_new;
   }
   converged = false;
-  return v;
+  return Eigen::MatrixXd(v);
 }
 
 template <class Solver>
@@ -605,7 +691,8 @@ HhdResult helmholtz_hodge(const HhdMesh& m, const std::vector<Eigen::Vector3d>& 
   if (n == 0) throw std::invalid_argument("HHD mesh has no interior node to solve for");
   r.report.unknowns = static_cast<std::size_t>(n);
   HhdSolver solver = o.solver;
-  if (solver == HhdSolver::Auto) solver = m.dim == 3 ? HhdSolver::Projection : HhdSolver::Cholmod;
+  if (solver == HhdSolver::Auto)
+    solver = m.dim == 3 ? HhdSolver::ProjectionAmg : HhdSolver::Cholmod;
   const bool projection = solver == HhdSolver::Projection || solver == HhdSolver::ProjectionAmg;
   const double tolerance = o.tolerance > 0.0 ? o.tolerance
                            : projection      ? kHhdProjectionTolerance
@@ -646,11 +733,11 @@ HhdResult helmholtz_hodge(const HhdMesh& m, const std::vector<Eigen::Vector3d>& 
   };
   // 3D: eq 18's projection from path (b)'s solution in x (kept as v_coulomb), with solve_k
   // (K⁻¹ or an approximation of it, per column) in its preconditioner.
-  auto project = [&](auto&& solve_k) {
+  auto project = [&](auto&& solve_k, bool additive) {
     t0 = Clock::now();
     v_coulomb = x.rightCols(3);
     bool converged = true;
-    x.rightCols(3) = projection_pcg(m, g, idx, Eigen::MatrixXd(-b18), solve_k, tolerance,
+    x.rightCols(3) = projection_pcg(m, g, idx, Eigen::MatrixXd(-b18), solve_k, additive, tolerance,
                                     o.max_iterations, r.report.iterations_v, converged, o.poll);
     r.report.converged = r.report.converged && converged;
     r.report.seconds_solve += seconds_since(t0);
@@ -674,7 +761,7 @@ HhdResult helmholtz_hodge(const HhdMesh& m, const std::vector<Eigen::Vector3d>& 
       direct(s);  // u, and path (b)'s v (eq 18 itself in 2D)
       if (o.poll) o.poll();
       if (m.dim == 3)
-        project([&](const Eigen::MatrixXd& q) { return Eigen::MatrixXd(s.solve(q)); });
+        project([&](const Rows3& q) { return Rows3(s.solve(Eigen::MatrixXd(q))); }, false);
       break;
     }
     case HhdSolver::ProjectionAmg: {
@@ -688,7 +775,13 @@ HhdResult helmholtz_hodge(const HhdMesh& m, const std::vector<Eigen::Vector3d>& 
       if (o.poll) o.poll();
       if (m.dim == 3) {
         r.report.iterations_v = 0;
-        project([&](const Eigen::MatrixXd& q) { return amg_vcycle(h, q); });
+        project(
+            [&](const Rows3& q) {
+              AmgBlock z;
+              amg_vcycle(h, q, z);
+              return Rows3(z);
+            },
+            true);
       } else {
         r.report.tolerance = std::min(tolerance, kHhdTolerance);  // (no projection iterations)
       }

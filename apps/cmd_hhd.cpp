@@ -53,11 +53,11 @@ void add_field_options(CLI::App* s, FieldArgs& a) {
   s->add_option("--d50", a.d50, "d50 in m for the ghost defaults (default: from the frame)");
   s->add_option(
       "--solver", a.solver,
-      "auto (default: projection in 3D, cholmod in 2D) | projection (eq 18's L2 projection: "
-      "PCG preconditioned by the Laplacian factor) | projection-amg (the same projection with an "
-      "AMG V-cycle for the Laplacian: no factor) | cholmod (path b: Laplacian, gauge as a "
-      "penalty) | ldlt (path c) | cg (path b, iterative) | bicgstab (path a: eq 17-18 as "
-      "written, the paper's)");
+      "auto (default: projection-amg in 3D, cholmod in 2D) | projection-amg (eq 18's L2 "
+      "projection: PCG preconditioned by an AMG V-cycle of the Laplacian and block Jacobi) | "
+      "projection (the same with the Laplacian's Cholesky factor) | cholmod (path b: Laplacian, "
+      "gauge as a penalty) | ldlt (path c) | cg (path b, AMG-preconditioned CG) | bicgstab "
+      "(path a: eq 17-18 as written, the paper's)");
   s->add_option("--tolerance", a.tolerance,
                 "iterative solvers: relative residual (projection 1e-7, cg and bicgstab 1e-10)");
   s->add_option("--max-iterations", a.max_iterations, "iterative solvers (10000)");

@@ -498,7 +498,9 @@ TEST(CmdHhd, DemIncrementPartsOrthogonalWithTheDefault) {
     EXPECT_GT(b[0], 1e-3);
     EXPECT_LT(b[1], 1e-8);
     EXPECT_EQ(attr(dir / "p.h5", "converged"), 1.0);
-    EXPECT_EQ(attr(dir / "p.h5", "norm_grad_u"), attr(dir / "b.h5", "norm_grad_u"));
+    // The same u (eq 17): by AMG-preconditioned CG to 1e-10 in the default, by the factor here.
+    EXPECT_NEAR(attr(dir / "p.h5", "norm_grad_u"), attr(dir / "b.h5", "norm_grad_u"),
+                1e-9 * attr(dir / "b.h5", "norm_grad_u"));
   }
   fs::remove_all(dir);
 }

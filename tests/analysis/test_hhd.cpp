@@ -170,7 +170,9 @@ TEST(Hhd, ProjectionIsEq18OnRandomPoints) {
   o.max_iterations = 200000;
   const auto a = helmholtz_hodge(m, xi, o);
   ASSERT_TRUE(a.report.converged);
-  const auto p = helmholtz_hodge(m, xi);  // auto: the projection in 3D
+  HhdOptions op;
+  op.solver = HhdSolver::Projection;  // (with the factor: its v_coulomb is path (b)'s, bit for bit)
+  const auto p = helmholtz_hodge(m, xi, op);
   EXPECT_EQ(p.report.solver, "projection");
   EXPECT_TRUE(p.report.converged);
   EXPECT_EQ(p.report.tolerance, kHhdProjectionTolerance);
@@ -197,10 +199,10 @@ TEST(Hhd, ProjectionAmgIsTheSameProjection) {
   std::vector<Eigen::Vector3d> nodal;
   for (const auto& p : m.points) nodal.push_back(test::vortex_source_translation(p));
   const auto xi = simplex_mean(m, nodal);
-  const auto p = helmholtz_hodge(m, xi);  // auto: the projection with the factor
   HhdOptions o;
-  o.solver = HhdSolver::ProjectionAmg;
-  const auto q = helmholtz_hodge(m, xi, o);
+  o.solver = HhdSolver::Projection;
+  const auto p = helmholtz_hodge(m, xi, o);  // the projection with the factor
+  const auto q = helmholtz_hodge(m, xi);     // auto: projection-amg in 3D
   EXPECT_EQ(q.report.solver, "projection-amg");
   EXPECT_TRUE(q.report.converged);
   EXPECT_LE(q.report.residual_eq18, kHhdProjectionTolerance);
@@ -217,6 +219,7 @@ TEST(Hhd, ProjectionAmgIsTheSameProjection) {
   for (const auto& x : m2.points) nodal2.push_back(f.xi(x));
   const auto xi2 = simplex_mean(m2, nodal2);
   const auto c2 = helmholtz_hodge(m2, xi2);  // auto: cholmod in 2D
+  o.solver = HhdSolver::ProjectionAmg;
   const auto a2 = helmholtz_hodge(m2, xi2, o);
   EXPECT_TRUE(a2.report.converged);
   EXPECT_LT((a2.u - c2.u).norm(), 1e-8 * c2.u.norm());
@@ -376,7 +379,7 @@ TEST(Hhd, BadInputThrows) {
   m = box_mesh(3, 4, 9);
   const std::vector<Eigen::Vector3d> c(m.simplices.size(), Eigen::Vector3d(1, -2, 0.5));
   const auto r = helmholtz_hodge(m, c);
-  EXPECT_EQ(r.report.solver, "projection");  // 3D default
+  EXPECT_EQ(r.report.solver, "projection-amg");  // 3D default
   EXPECT_LT(r.u.lpNorm<Eigen::Infinity>() + r.v.lpNorm<Eigen::Infinity>(), 1e-14);
   EXPECT_NEAR(r.norm_harmonic, r.norm_xi, 1e-14 * r.norm_xi);
 }

@@ -181,7 +181,7 @@ def test_motion_errors_are_the_cli_lines():
 
 
 def test_ctrl_c_interrupts_a_long_hhd():
-    """A 3D decomposition of 20 000 nodes (about 5 s on 2 cores): SIGINT after 0.5 s raises
+    """A 3D decomposition of 20 000 nodes (about 1.2 s on 2 cores): SIGINT after 0.5 s raises
     KeyboardInterrupt from the projection solver's iterations, well before it would end (timed
     against the same decomposition run to its end, so that a loaded machine slows both)."""
     import os
