@@ -1,18 +1,20 @@
 // Speed against error of the Helmholtz–Hodge decomposition (seed 000 eq 9–18) in 3D, every solver
 // path in the same process (path (a) the paper's BiCGSTAB on eq 18 as written; path (b) the
-// Laplacian with the gauge as a penalty, CHOLMOD or CG; path (c) Eigen LDLT; `projection` eq 18
-// by PCG, the default), on two kinds of input:
+// Laplacian with the gauge as a penalty, CHOLMOD or AMG-preconditioned CG; path (c) Eigen LDLT;
+// `projection-amg` eq 18 by PCG with an AMG V-cycle, the default in 3D, and `projection` the same
+// with the Laplacian's Cholesky factor), on two kinds of input:
 //  * lattice: jittered lattices of the unit cube and the analytic field of
 //    tests/analysis/hhd_test_fields.hpp (ξ = ∇U + ∇×V + c, V divergence-free): the L2 error of
 //    each part against the exact decomposition;
 //  * random: N uniformly random points (slivers included) and issue 20's field (a Lamb–Oseen
 //    vortex crossing the hull, a Gaussian source, a translation): |∇×v|, |h|, cos(∇×v, h),
 //    cos(∇u, h), ‖∇·v‖ and the relative difference of ∇×v from path (a)'s where it converged.
-// Then the whole pipeline (mesh, HHD, extrema, tubes) on the 5.6e4-node lattice.
+// Then the whole pipeline (mesh, ξ, HHD, extrema, tubes) on the 5.5e4-node lattice and on 5.6e4
+// random points (issue 23 item 7), with each 3D path.
 //   build/bin/bench_hhd [N ...]      (default 10000 56000 200000)
 // Environment: GS_BENCH_MESH (lattice, random or both: default both), GS_BENCH_PATHS (comma list
-// of auto, projection, cholmod, cg, ldlt, bicgstab; default all), GS_BENCH_LDLT_MAX (largest N
-// for LDLT, default 60000: its AMD ordering fills in far more than CHOLMOD's METIS),
+// of bicgstab, projection, projection-amg, cholmod, cg, ldlt; default all), GS_BENCH_LDLT_MAX
+// (largest N for LDLT, default 60000: its AMD ordering fills in far more than CHOLMOD's METIS),
 // GS_BENCH_BICGSTAB_ITERATIONS (cap of path (a), default 3000; a capped run is reported as not
 // converged with its residual), GS_BENCH_PIPELINE=0 skips the pipeline.
 #include <chrono>
@@ -117,10 +119,10 @@ struct Path {
 const std::vector<Path>& paths() {
   static const std::vector<Path> p = {
       {"bicgstab", "path a  bicgstab (paper)", HhdSolver::BiCgStab},
-      {"projection", "projection (default)", HhdSolver::Projection},
-      {"projection-amg", "projection, AMG", HhdSolver::ProjectionAmg},
+      {"projection", "projection (factor)", HhdSolver::Projection},
+      {"projection-amg", "projection-amg (default)", HhdSolver::ProjectionAmg},
       {"cholmod", "path b  cholmod", HhdSolver::Cholmod},
-      {"cg", "path b' cg (Jacobi)", HhdSolver::Cg},
+      {"cg", "path b' cg (AMG)", HhdSolver::Cg},
       {"ldlt", "path c  ldlt (Eigen)", HhdSolver::Ldlt}};
   return p;
 }
@@ -161,12 +163,12 @@ void all_paths(const HhdMesh& m, const std::vector<Eigen::Vector3d>& xi,
     print_parts(r.r, a && a->r.report.converged ? &a->r : nullptr);
     if (p.solver == HhdSolver::BiCgStab) a = r;
     if (p.solver == HhdSolver::Cg) seconds_b = r.seconds;
-    if (p.solver == HhdSolver::Projection) seconds_proj = r.seconds;
+    if (p.solver == HhdSolver::ProjectionAmg) seconds_proj = r.seconds;
   }
   if (seconds_b > 0.0 && seconds_proj > 0.0) {
-    std::printf("  ratio projection / path b' cg (the former default at this size): %.1f",
+    std::printf("  ratio projection-amg (default) / path b' cg (AMG): %.1f",
                 seconds_proj / seconds_b);
-    if (a) std::printf("   path a / projection: %.1f", a->seconds / seconds_proj);
+    if (a) std::printf("   path a / projection-amg: %.1f", a->seconds / seconds_proj);
     std::printf("\n");
   }
 }
@@ -209,24 +211,34 @@ int main(int argc, char** argv) {
     std::fflush(stdout);
   }
   if (env_long("GS_BENCH_PIPELINE", 1) == 0) return 0;
-  // Whole pipeline on ~5.6e4 nodes: mesh + ξ + HHD + extrema + tubes.
-  const auto m = gs::test::box_mesh(3, 37, 8);
-  std::vector<Eigen::Vector3d> nodal;
-  for (const auto& p : m.points) nodal.push_back(f.xi(p));
-  for (auto solver : {HhdSolver::Projection, HhdSolver::Cholmod, HhdSolver::Cg}) {
-    VortexAnalysisOptions o;
-    o.hhd.solver = solver;
-    const auto t0 = Clock::now();
-    const auto a = analyze_vortices(m.points, nodal, 3, o);
-    const double total = since(t0);
-    const auto& r = a.hhd.report;
-    const auto c = count_extrema(a.extrema, true);
-    std::printf(
-        "pipeline %zu nodes, %s: total %.3f s = Delaunay %.3f + assembly %.3f + factor %.3f + "
-        "solve %.3f + detection %.3f (+ rest); %zu extrema (%zu significant), %zu tubes\n",
-        m.points.size(), r.solver.c_str(), total, a.seconds_delaunay, r.seconds_assembly,
-        r.seconds_factor, r.seconds_solve, a.seconds_detection, a.extrema.size(),
-        c[0] + c[1] + c[2] + c[3], a.tubes.size());
+  // Whole pipeline on ~5.6e4 nodes: mesh + ξ + HHD + extrema + tubes, timed from the points.
+  const gs::test::AnalyticField& field = f;
+  for (const bool lattice : {true, false}) {
+    const auto m = lattice ? gs::test::box_mesh(3, 37, 8) : gs::test::random_cube_mesh(56000, 1);
+    std::vector<Eigen::Vector3d> nodal;
+    for (const auto& p : m.points)
+      nodal.push_back(lattice ? field.xi(p) : gs::test::vortex_source_translation(p));
+    for (auto solver :
+         {HhdSolver::ProjectionAmg, HhdSolver::Projection, HhdSolver::Cholmod, HhdSolver::Cg}) {
+      VortexAnalysisOptions o;
+      o.hhd.solver = solver;
+      const auto t0 = Clock::now();
+      const auto a = analyze_vortices(m.points, nodal, 3, o);
+      const double total = since(t0);
+      const auto& r = a.hhd.report;
+      const auto c = count_extrema(a.extrema, true);
+      std::printf(
+          "pipeline %s %zu nodes, %s: total %.3f s = Delaunay %.3f + assembly %.3f + factor "
+          "%.3f + solve %.3f + detection %.3f (+ rest %.3f); %zu extrema (%zu significant), %zu "
+          "tubes\n",
+          lattice ? "lattice" : "random", m.points.size(), r.solver.c_str(), total,
+          a.seconds_delaunay, r.seconds_assembly, r.seconds_factor, r.seconds_solve,
+          a.seconds_detection,
+          total - a.seconds_delaunay - r.seconds_assembly - r.seconds_factor - r.seconds_solve -
+              a.seconds_detection,
+          a.extrema.size(), c[0] + c[1] + c[2] + c[3], a.tubes.size());
+      std::fflush(stdout);
+    }
   }
   return 0;
 }
