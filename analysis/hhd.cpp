@@ -116,11 +116,12 @@ Incidence incidence(const HhdMesh& m, const P1Geometry& g, const std::vector<int
   return inc;
 }
 
-// Right-hand sides over the unknowns. bu: Σ_k |T_k| ∇φ_i·ξ_k (eq 17). b18: Σ_k |T_k| ∇φ_i × ξ_k
-// (eq 18 as written; 1 column in 2D, its z component, 3 columns in 3D).
-void right_hand_sides(const HhdMesh& m, const P1Geometry& g, const Incidence& inc, int n,
-                      const std::vector<Eigen::Vector3d>& field, Eigen::VectorXd& bu,
-                      Eigen::MatrixXd& b18) {
+// Right-hand sides over the unknowns. bu: Σ_k |T_k| ∇φ_i·fu(k) (eq 17 with fu = ξ). b18:
+// Σ_k |T_k| ∇φ_i × fv(k) (eq 18 as written with fv = ξ; 1 column in 2D, its z component, 3
+// columns in 3D). Rows on the threads, each summed in simplex order.
+template <class Fu, class Fv>
+void right_hand_sides(const HhdMesh& m, const P1Geometry& g, const Incidence& inc, int n, Fu&& fu,
+                      Fv&& fv, Eigen::VectorXd& bu, Eigen::MatrixXd& b18) {
   const int nv = m.dim == 3 ? 3 : 1;
   bu = Eigen::VectorXd::Zero(n);
   b18 = Eigen::MatrixXd::Zero(n, nv);
@@ -132,11 +133,12 @@ void right_hand_sides(const HhdMesh& m, const P1Geometry& g, const Incidence& in
       const double w = g.measure[k];
       const Eigen::Vector3d& gi =
           g.gradient[k][static_cast<std::size_t>(inc.vertex[static_cast<std::size_t>(e)])];
-      bu(i) += w * gi.dot(field[k]);
+      const Eigen::Vector3d a = fu(k), b = fv(k);
+      bu(i) += w * gi.dot(a);
       if (nv == 3) {
-        b18.row(i) += w * gi.cross(field[k]).transpose();
+        b18.row(i) += w * gi.cross(b).transpose();
       } else {
-        b18(i, 0) += w * cross_z(gi, field[k]);
+        b18(i, 0) += w * cross_z(gi, b);
       }
     }
   }
@@ -329,21 +331,51 @@ Rows3 apply_curl_curl(const CurlCurl& op, const Rows3& v) {
     Rows3& out = part[static_cast<std::size_t>(t)];
     out = Rows3::Zero(n, 3);
     const std::ptrdiff_t lo = ns * t / threads, hi = ns * (t + 1) / threads;
+    static constexpr double zero[3] = {0.0, 0.0, 0.0};
+    const double* vd = v.data();
+    double* od = out.data();
     for (std::ptrdiff_t kk = lo; kk < hi; ++kk) {
       const auto k = static_cast<std::size_t>(kk);
       const auto& j = op.node[k];
-      std::array<Eigen::Vector3d, 4> gr;
-      gr[0] = Eigen::Vector3d::Zero();
+      const double* g = op.gradient[k].data();  // ∇φ_1, ∇φ_2, ∇φ_3
+      // Σ_a ∇φ_a × v_a = Σ_{a≥1} ∇φ_a × (v_a − v_0), since ∇φ_0 = −Σ_{a≥1} ∇φ_a.
+      const double* v0 = j[0] >= 0 ? vd + 3 * j[0] : zero;
+      double c[3] = {0.0, 0.0, 0.0};
       for (std::size_t a = 1; a < 4; ++a) {
-        gr[a] = Eigen::Vector3d(op.gradient[k].data() + 3 * (a - 1));
-        gr[0] -= gr[a];
+        const double* va = j[a] >= 0 ? vd + 3 * j[a] : zero;
+        const double* ga = g + 3 * (a - 1);
+        const double d0 = va[0] - v0[0], d1 = va[1] - v0[1], d2 = va[2] - v0[2];
+        c[0] += ga[1] * d2 - ga[2] * d1;
+        c[1] += ga[2] * d0 - ga[0] * d2;
+        c[2] += ga[0] * d1 - ga[1] * d0;
       }
-      Eigen::Vector3d c = Eigen::Vector3d::Zero();
-      for (std::size_t a = 0; a < 4; ++a)
-        if (j[a] >= 0) c += gr[a].cross(v.row(j[a]).transpose());
-      c *= op.measure[k];
-      for (std::size_t a = 0; a < 4; ++a)
-        if (j[a] >= 0) out.row(j[a]) += c.cross(gr[a]).transpose();
+      const double w = op.measure[k];
+      c[0] *= w;
+      c[1] *= w;
+      c[2] *= w;
+      // Row a gets c × ∇φ_a; row 0 minus their sum.
+      double s[3] = {0.0, 0.0, 0.0};
+      for (std::size_t a = 1; a < 4; ++a) {
+        const double* ga = g + 3 * (a - 1);
+        const double e0 = c[1] * ga[2] - c[2] * ga[1];
+        const double e1 = c[2] * ga[0] - c[0] * ga[2];
+        const double e2 = c[0] * ga[1] - c[1] * ga[0];
+        s[0] += e0;
+        s[1] += e1;
+        s[2] += e2;
+        if (j[a] >= 0) {
+          double* o = od + 3 * j[a];
+          o[0] += e0;
+          o[1] += e1;
+          o[2] += e2;
+        }
+      }
+      if (j[0] >= 0) {
+        double* o = od + 3 * j[0];
+        o[0] -= s[0];
+        o[1] -= s[1];
+        o[2] -= s[2];
+      }
     }
   }
   for (std::size_t t = 1; t < part.size(); ++t) part[0] += part[t];
@@ -400,19 +432,26 @@ Rows3 apply_blocks(const std::vector<Eigen::Matrix3d>& d, const Rows3& r) {
 // CG minimises ‖C(v − v*)‖_M, the error of ∇×v, over its Krylov space, and its residual is
 // orthogonal to that space, which holds v: ⟨∇×v, h⟩ = vᵀ(CᵀMξ − Av) = 0 at every iterate (to
 // round-off). Stops at ‖CᵀMξ − Av‖ ≤ tolerance ‖CᵀMξ‖ (eq 18's residual) or max_iterations.
-// Σ over [0, n) of f(begin, end) taken per chunk of rows on the threads, then over the chunks
-// in order: the same bits for any number of threads.
-template <class F>
-double chunked_sum(Eigen::Index n, F&& f) {
+// Σ over [0, n) of f(begin, end) (N sums) taken per chunk of rows on the threads, then over the
+// chunks in order: the same bits for any number of threads.
+template <std::size_t N, class F>
+std::array<double, N> chunked_sums(Eigen::Index n, F&& f) {
   constexpr Eigen::Index chunk = 2048;
   const Eigen::Index nc = (n + chunk - 1) / chunk;
-  std::vector<double> part(static_cast<std::size_t>(nc), 0.0);
+  std::vector<std::array<double, N>> part(static_cast<std::size_t>(nc));
 #pragma omp parallel for schedule(static)
   for (Eigen::Index k = 0; k < nc; ++k)
     part[static_cast<std::size_t>(k)] = f(k * chunk, std::min(n, (k + 1) * chunk));
-  double sum = 0.0;
-  for (const double x : part) sum += x;
+  std::array<double, N> sum{};
+  for (const auto& x : part)
+    for (std::size_t q = 0; q < N; ++q) sum[q] += x[q];
   return sum;
+}
+
+template <class F>
+double chunked_sum(Eigen::Index n, F&& f) {
+  return chunked_sums<1>(
+      n, [&](Eigen::Index lo, Eigen::Index hi) { return std::array<double, 1>{f(lo, hi)}; })[0];
 }
 
 template <class SolveK>
@@ -507,13 +546,6 @@ Eigen::VectorXd iterate(Solver& s, const Eigen::VectorXd& b, int& iterations, bo
   iterations = std::max(iterations, static_cast<int>(s.iterations()));
   if (s.info() != Eigen::Success) converged = false;
   return x;
-}
-
-double dot(const std::vector<double>& w, const std::vector<Eigen::Vector3d>& a,
-           const std::vector<Eigen::Vector3d>& b) {
-  double s = 0.0;
-  for (std::size_t k = 0; k < w.size(); ++k) s += w[k] * a[k].dot(b[k]);
-  return s;
 }
 
 }  // namespace
@@ -708,7 +740,10 @@ HhdResult helmholtz_hodge(const HhdMesh& m, const std::vector<Eigen::Vector3d>& 
   Eigen::VectorXd bu;
   Eigen::MatrixXd b18;
   const Incidence inc = incidence(m, g, idx, n);
-  right_hand_sides(m, g, inc, n, r.xi, bu, b18);
+  {
+    const auto field = [&](std::size_t k) { return r.xi[k]; };
+    right_hand_sides(m, g, inc, n, field, field, bu, b18);
+  }
   const SpMat k = stiffness(m, g, idx, inc, n);
   r.report.seconds_assembly = seconds_since(t0);
 
@@ -849,31 +884,45 @@ HhdResult helmholtz_hodge(const HhdMesh& m, const std::vector<Eigen::Vector3d>& 
   r.measure = g.measure;
   r.grad_u = p1_gradient(m, g, r.u);
   r.curl_v = p1_curl(m, g, r.v);
-  r.harmonic.resize(r.xi.size());
-  for (std::size_t s = 0; s < r.xi.size(); ++s) r.harmonic[s] = r.xi[s] - r.grad_u[s] - r.curl_v[s];
-  r.norm_xi = std::sqrt(dot(r.measure, r.xi, r.xi));
-  r.norm_grad_u = std::sqrt(dot(r.measure, r.grad_u, r.grad_u));
-  r.norm_curl_v = std::sqrt(dot(r.measure, r.curl_v, r.curl_v));
-  r.norm_harmonic = std::sqrt(dot(r.measure, r.harmonic, r.harmonic));
-  r.dot_grad_curl = dot(r.measure, r.grad_u, r.curl_v);
-  r.dot_grad_harmonic = dot(r.measure, r.grad_u, r.harmonic);
-  r.dot_curl_harmonic = dot(r.measure, r.curl_v, r.harmonic);
   const auto div = p1_divergence(m, g, r.v);
-  double d2 = 0.0;
-  for (std::size_t s = 0; s < div.size(); ++s) d2 += r.measure[s] * div[s] * div[s];
-  r.norm_div_v = std::sqrt(d2);
+  // h, and the norms and inner products in one pass (chunked: the same bits on any threads).
+  r.harmonic.resize(r.xi.size());
+  const auto sums = chunked_sums<8>(
+      static_cast<Eigen::Index>(r.xi.size()), [&](Eigen::Index lo, Eigen::Index hi) {
+        std::array<double, 8> q{};
+        for (auto kk = lo; kk < hi; ++kk) {
+          const auto k = static_cast<std::size_t>(kk);
+          const double w = r.measure[k];
+          const Eigen::Vector3d &xi_k = r.xi[k], &gu = r.grad_u[k], &cv = r.curl_v[k];
+          const Eigen::Vector3d h = xi_k - gu - cv;
+          r.harmonic[k] = h;
+          q[0] += w * xi_k.dot(xi_k);
+          q[1] += w * gu.dot(gu);
+          q[2] += w * cv.dot(cv);
+          q[3] += w * h.dot(h);
+          q[4] += w * gu.dot(cv);
+          q[5] += w * gu.dot(h);
+          q[6] += w * cv.dot(h);
+          q[7] += w * div[k] * div[k];
+        }
+        return q;
+      });
+  r.norm_xi = std::sqrt(sums[0]);
+  r.norm_grad_u = std::sqrt(sums[1]);
+  r.norm_curl_v = std::sqrt(sums[2]);
+  r.norm_harmonic = std::sqrt(sums[3]);
+  r.dot_grad_curl = sums[4];
+  r.dot_grad_harmonic = sums[5];
+  r.dot_curl_harmonic = sums[6];
+  r.norm_div_v = std::sqrt(sums[7]);
 
   // Residuals of eq 17 and eq 18 as written, matrix-free: Σ_k |T_k| ∇φ_i·(∇u − ξ)_k and
   // Σ_k |T_k| ∇φ_i × (∇×v − ξ)_k.
-  std::vector<Eigen::Vector3d> du(r.xi.size()), dv(r.xi.size());
-  for (std::size_t s = 0; s < r.xi.size(); ++s) {
-    du[s] = r.grad_u[s] - r.xi[s];
-    dv[s] = r.curl_v[s] - r.xi[s];
-  }
-  Eigen::VectorXd res17, unused;
-  Eigen::MatrixXd res18, unused18;
-  right_hand_sides(m, g, inc, n, du, res17, unused18);
-  right_hand_sides(m, g, inc, n, dv, unused, res18);
+  Eigen::VectorXd res17;
+  Eigen::MatrixXd res18;
+  right_hand_sides(
+      m, g, inc, n, [&](std::size_t k) { return Eigen::Vector3d(r.grad_u[k] - r.xi[k]); },
+      [&](std::size_t k) { return Eigen::Vector3d(r.curl_v[k] - r.xi[k]); }, res17, res18);
   const auto relative = [](double num, double den) { return den > 0.0 ? num / den : num; };
   r.report.residual_eq17 = relative(res17.norm(), bu.norm());
   r.report.residual_eq18 = relative(res18.norm(), b18.norm());
