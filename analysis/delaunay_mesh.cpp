@@ -3,6 +3,7 @@
 
 #include <CGAL/Delaunay_triangulation_2.h>
 #include <CGAL/Delaunay_triangulation_3.h>
+#include <CGAL/Delaunay_triangulation_cell_base_3.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Regular_triangulation_3.h>
 #include <CGAL/Spatial_sort_traits_adapter_2.h>
@@ -21,6 +22,11 @@
 #include <string>
 #include <utility>
 
+#include <Eigen/Geometry>
+#ifdef CGAL_LINKED_WITH_TBB
+#include <tbb/task_arena.h>
+#endif
+
 #ifdef _OPENMP
 #include <omp.h>
 #endif
@@ -32,6 +38,15 @@ using K = CGAL::Exact_predicates_inexact_constructions_kernel;
 using Vb3 = CGAL::Triangulation_vertex_base_with_info_3<std::int32_t, K>;
 using Tds3 = CGAL::Triangulation_data_structure_3<Vb3>;
 using Delaunay3 = CGAL::Delaunay_triangulation_3<K, Tds3>;
+#ifdef CGAL_LINKED_WITH_TBB
+// The same triangulation built by threads (CGAL's concurrent insertion, TBB): the tetrahedra are
+// unique (CGAL inserts with symbolic perturbation), only their order in memory varies.
+using PTds3 = CGAL::Triangulation_data_structure_3<Vb3, CGAL::Delaunay_triangulation_cell_base_3<K>,
+                                                   CGAL::Parallel_tag>;
+using PDelaunay3 = CGAL::Delaunay_triangulation_3<K, PTds3>;
+// Below this many points the threads cost more than they save.
+constexpr std::size_t kParallelDelaunay = 20000;
+#endif
 using RVb =
     CGAL::Triangulation_vertex_base_with_info_3<std::int32_t, K,
                                                 CGAL::Regular_triangulation_vertex_base_3<K>>;
@@ -70,17 +85,41 @@ void check_input(const std::vector<Vec>& points, std::size_t min_points, const c
   }
 }
 
-}  // namespace
-
-DelaunayMesh delaunay_mesh(const std::vector<Eigen::Vector3d>& points) {
-  check_input(points, 4, "tetrahedra");
-  std::vector<std::pair<K::Point_3, std::int32_t>> pts;
-  pts.reserve(points.size());
-  for (std::size_t i = 0; i < points.size(); ++i) {
-    pts.emplace_back(K::Point_3(points[i].x(), points[i].y(), points[i].z()),
-                     static_cast<std::int32_t>(i));
+// Tetrahedra in a canonical form and order, whatever order the triangulation holds them in:
+// each rotated by an even permutation (orientation kept) so that its smallest vertex comes first
+// and the smallest of the other three second; then sorted (counting sort on the first vertex,
+// insertion sort within).
+void canonical_order(std::vector<std::array<std::int32_t, 4>>& t, std::size_t n_points) {
+  for (auto& s : t) {
+    const auto first = static_cast<std::size_t>(std::min_element(s.begin(), s.end()) - s.begin());
+    if (first != 0) {  // two transpositions: (0 first) and the two other places
+      std::size_t o[2], q = 0;
+      for (std::size_t a = 1; a < 4; ++a)
+        if (a != first) o[q++] = a;
+      std::swap(s[0], s[first]);
+      std::swap(s[o[0]], s[o[1]]);
+    }
+    while (s[1] > s[2] || s[1] > s[3]) {  // 3-cycle of the last three
+      const std::int32_t x = s[1];
+      s[1] = s[2];
+      s[2] = s[3];
+      s[3] = x;
+    }
   }
-  const Delaunay3 dt(pts.begin(), pts.end());  // spatially sorted insertion
+  std::vector<std::size_t> start(n_points + 1, 0);
+  for (const auto& s : t) ++start[static_cast<std::size_t>(s[0]) + 1];
+  for (std::size_t i = 0; i < n_points; ++i) start[i + 1] += start[i];
+  std::vector<std::array<std::int32_t, 4>> sorted(t.size());
+  std::vector<std::size_t> fill(start.begin(), start.end() - 1);
+  for (const auto& s : t) sorted[fill[static_cast<std::size_t>(s[0])]++] = s;
+  for (std::size_t i = 0; i < n_points; ++i)
+    std::sort(sorted.begin() + static_cast<std::ptrdiff_t>(start[i]),
+              sorted.begin() + static_cast<std::ptrdiff_t>(start[i + 1]));
+  t.swap(sorted);
+}
+
+template <class Triangulation>
+DelaunayMesh mesh_of(const Triangulation& dt, const std::vector<Eigen::Vector3d>& points) {
   if (dt.number_of_vertices() != points.size()) throw_duplicate(points);
   if (dt.dimension() < 3) {
     throw std::invalid_argument("all particle centres are coplanar (dimension " +
@@ -93,11 +132,46 @@ DelaunayMesh delaunay_mesh(const std::vector<Eigen::Vector3d>& points) {
     m.simplices.push_back(
         {c->vertex(0)->info(), c->vertex(1)->info(), c->vertex(2)->info(), c->vertex(3)->info()});
   }
+  canonical_order(m.simplices, points.size());
   m.on_hull.assign(points.size(), 0);
-  std::vector<Delaunay3::Vertex_handle> hull;
+  std::vector<typename Triangulation::Vertex_handle> hull;
   dt.finite_adjacent_vertices(dt.infinite_vertex(), std::back_inserter(hull));
   for (const auto& v : hull) m.on_hull[static_cast<std::size_t>(v->info())] = 1;
   return m;
+}
+
+}  // namespace
+
+DelaunayMesh delaunay_mesh(const std::vector<Eigen::Vector3d>& points) {
+  check_input(points, 4, "tetrahedra");
+  std::vector<std::pair<K::Point_3, std::int32_t>> pts;
+  pts.reserve(points.size());
+  Eigen::AlignedBox3d box;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    pts.emplace_back(K::Point_3(points[i].x(), points[i].y(), points[i].z()),
+                     static_cast<std::int32_t>(i));
+    box.extend(points[i]);
+  }
+#ifdef CGAL_LINKED_WITH_TBB
+  int threads = 1;
+#ifdef _OPENMP
+  threads = omp_get_max_threads();
+#endif
+  if (threads > 1 && points.size() >= kParallelDelaunay) {
+    // As many threads as the OpenMP parts use (OMP_NUM_THREADS, a scene's `threads`).
+    tbb::task_arena arena(threads);
+    return arena.execute([&] {
+      PDelaunay3::Lock_data_structure lock(
+          CGAL::Bbox_3(box.min().x(), box.min().y(), box.min().z(), box.max().x(), box.max().y(),
+                       box.max().z()),
+          50);
+      const PDelaunay3 dt(pts.begin(), pts.end(), K(), &lock);  // spatially sorted insertion
+      return mesh_of(dt, points);
+    });
+  }
+#endif
+  const Delaunay3 dt(pts.begin(), pts.end());  // spatially sorted insertion
+  return mesh_of(dt, points);
 }
 
 DelaunayMesh delaunay_mesh(const std::vector<Eigen::Vector2d>& points) {

@@ -271,6 +271,45 @@ TEST(DelaunayMesh, VertexRingsAreTheEdgesOfTheSimplices) {
   }
 }
 
+TEST(DelaunayMesh, SameMeshForAnyThreadCountAndOrientedTetrahedra) {
+  // Above 20 000 points CGAL inserts on the threads (TBB): the same tetrahedra in the same
+  // canonical order as one thread, for random points and for an exact lattice (cospherical
+  // points everywhere: CGAL's symbolic perturbation decides, whatever the insertion order).
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::vector<Eigen::Vector3d> random, lattice;
+  for (int i = 0; i < 25000; ++i) random.emplace_back(u(rng), u(rng), u(rng));
+  for (int z = 0; z < 30; ++z)
+    for (int y = 0; y < 30; ++y)
+      for (int x = 0; x < 30; ++x) lattice.emplace_back(x, y, z);
+  const int threads = omp_get_max_threads();
+  for (const auto* p : {&random, &lattice}) {
+    omp_set_num_threads(1);
+    const DelaunayMesh one = delaunay_mesh(*p);
+    omp_set_num_threads(2);
+    const DelaunayMesh two = delaunay_mesh(*p);
+    omp_set_num_threads(threads);
+    EXPECT_EQ(one.simplices, two.simplices);
+    EXPECT_EQ(one.on_hull, two.on_hull);
+    double volume = 0.0;
+    for (const auto& s : one.simplices) {
+      const Eigen::Vector3d &a = (*p)[static_cast<std::size_t>(s[0])],
+                            &b = (*p)[static_cast<std::size_t>(s[1])],
+                            &c = (*p)[static_cast<std::size_t>(s[2])],
+                            &d = (*p)[static_cast<std::size_t>(s[3])];
+      const double v = (b - a).dot((c - a).cross(d - a)) / 6.0;
+      EXPECT_GE(v, 0.0);  // (positively oriented; lattice tetrahedra may be flat)
+      volume += v;
+      EXPECT_LT(s[0], std::min({s[1], s[2], s[3]}));  // the canonical form
+      EXPECT_LT(s[1], std::min(s[2], s[3]));
+    }
+    if (p == &lattice) {
+      EXPECT_NEAR(volume, 29.0 * 29.0 * 29.0, 1e-6);  // the hull's volume
+    }
+    EXPECT_TRUE(std::is_sorted(one.simplices.begin(), one.simplices.end()));
+  }
+}
+
 TEST(DelaunayMesh, HilbertOrderIsAPermutationThatKeepsNeighboursClose) {
   std::mt19937 rng(8);
   std::uniform_real_distribution<double> u(0.0, 1.0);
