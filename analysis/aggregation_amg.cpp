@@ -13,6 +13,10 @@
 #include <stdexcept>
 #include <string>
 
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
 namespace gs::analysis {
 namespace {
 
@@ -140,7 +144,8 @@ void jacobi(const AmgLevel& L, const Block& x, const Block& b, Block& y) {
 }
 
 // A·B of two sparse matrices (Gustavson: row by row with a dense accumulator), rows on the
-// threads; each entry summed in A's row order, then B's, for any number of threads.
+// threads in contiguous ranges; each entry summed in A's row order, then B's, for any number of
+// threads.
 RowMat multiply(const RowMat& a, const RowMat& b) {
   const Index n = a.rows(), m = b.cols();
   const int* ao = a.outerIndexPtr();
@@ -149,54 +154,114 @@ RowMat multiply(const RowMat& a, const RowMat& b) {
   const int* bo = b.outerIndexPtr();
   const int* bi = b.innerIndexPtr();
   const double* bv = b.valuePtr();
+  int threads = 1;
+#ifdef _OPENMP
+  if (a.nonZeros() >= kParallelRows) threads = omp_get_max_threads();
+#endif
+  std::vector<std::vector<int>> cols(static_cast<std::size_t>(threads));
+  std::vector<std::vector<double>> vals(static_cast<std::size_t>(threads));
   std::vector<int> outer(static_cast<std::size_t>(n) + 1, 0);
-#pragma omp parallel if (a.nonZeros() >= kParallelRows)
+#pragma omp parallel num_threads(threads)
   {
-    std::vector<Index> mark(static_cast<std::size_t>(m), -1);
-#pragma omp for schedule(static)
-    for (Index i = 0; i < n; ++i) {
-      int count = 0;
-      for (int e = ao[i]; e < ao[i + 1]; ++e)
-        for (int f = bo[ai[e]]; f < bo[ai[e] + 1]; ++f) {
-          auto& mk = mark[static_cast<std::size_t>(bi[f])];
-          if (mk != i) {
-            mk = i;
-            ++count;
-          }
-        }
-      outer[static_cast<std::size_t>(i) + 1] = count;
-    }
-  }
-  for (Index i = 0; i < n; ++i)
-    outer[static_cast<std::size_t>(i) + 1] += outer[static_cast<std::size_t>(i)];
-  std::vector<int> inner(static_cast<std::size_t>(outer.back()));
-  std::vector<double> value(inner.size());
-#pragma omp parallel if (a.nonZeros() >= kParallelRows)
-  {
+    int t = 0;
+#ifdef _OPENMP
+    t = omp_get_thread_num();
+#endif
+    const Index lo = n * t / threads, hi = n * (t + 1) / threads;
+    auto& c = cols[static_cast<std::size_t>(t)];
+    auto& v = vals[static_cast<std::size_t>(t)];
     std::vector<Index> mark(static_cast<std::size_t>(m), -1);
     std::vector<double> acc(static_cast<std::size_t>(m), 0.0);
-#pragma omp for schedule(static)
-    for (Index i = 0; i < n; ++i) {
-      int* cols = inner.data() + outer[static_cast<std::size_t>(i)];
-      int count = 0;
+    const auto guess = static_cast<std::size_t>((ao[hi] - ao[lo]) *
+                                                (b.rows() > 0 ? b.nonZeros() / b.rows() + 1 : 1));
+    c.reserve(guess);
+    v.reserve(guess);
+    for (Index i = lo; i < hi; ++i) {
+      const std::size_t start = c.size();
       for (int e = ao[i]; e < ao[i + 1]; ++e)
         for (int f = bo[ai[e]]; f < bo[ai[e] + 1]; ++f) {
           const auto j = static_cast<std::size_t>(bi[f]);
           if (mark[j] != i) {
             mark[j] = i;
-            cols[count++] = bi[f];
+            c.push_back(bi[f]);
             acc[j] = av[e] * bv[f];
           } else {
             acc[j] += av[e] * bv[f];
           }
         }
-      std::sort(cols, cols + count);
-      double* vals = value.data() + outer[static_cast<std::size_t>(i)];
-      for (int q = 0; q < count; ++q) vals[q] = acc[static_cast<std::size_t>(cols[q])];
+      std::sort(c.begin() + static_cast<std::ptrdiff_t>(start), c.end());
+      for (std::size_t q = start; q < c.size(); ++q)
+        v.push_back(acc[static_cast<std::size_t>(c[q])]);
+      outer[static_cast<std::size_t>(i) + 1] = static_cast<int>(c.size() - start);
     }
+  }
+  for (Index i = 0; i < n; ++i)
+    outer[static_cast<std::size_t>(i) + 1] += outer[static_cast<std::size_t>(i)];
+  std::vector<int> inner;
+  std::vector<double> value;
+  inner.reserve(static_cast<std::size_t>(outer.back()));
+  value.reserve(static_cast<std::size_t>(outer.back()));
+  for (int t = 0; t < threads; ++t) {
+    inner.insert(inner.end(), cols[static_cast<std::size_t>(t)].begin(),
+                 cols[static_cast<std::size_t>(t)].end());
+    value.insert(value.end(), vals[static_cast<std::size_t>(t)].begin(),
+                 vals[static_cast<std::size_t>(t)].end());
   }
   return RowMat(
       Eigen::Map<const RowMat>(n, m, outer.back(), outer.data(), inner.data(), value.data()));
+}
+
+// Per stored entry of A: 1 when it is a strong connection, |a_ij| ≥ θ √(a_ii a_jj), i ≠ j.
+std::vector<char> strong_entries(const RowMat& a, const Eigen::VectorXd& diag, double theta) {
+  const Eigen::VectorXd scale = diag.cwiseSqrt().cwiseInverse();
+  const int* outer = a.outerIndexPtr();
+  const int* inner = a.innerIndexPtr();
+  const double* val = a.valuePtr();
+  std::vector<char> strong(static_cast<std::size_t>(a.nonZeros()), 0);
+#pragma omp parallel for schedule(static) if (a.nonZeros() >= kParallelRows)
+  for (Index i = 0; i < a.rows(); ++i)
+    for (int e = outer[i]; e < outer[i + 1]; ++e)
+      strong[static_cast<std::size_t>(e)] =
+          inner[e] != i && std::abs(val[e]) * scale(i) * scale(inner[e]) >= theta;
+  return strong;
+}
+
+// The filtered matrix A_F: A's strong connections and its diagonal, the weak connections of a
+// row lumped into its diagonal (VMB's Ã).
+RowMat filtered(const RowMat& a, const std::vector<char>& strong) {
+  const Index n = a.rows();
+  const int* outer = a.outerIndexPtr();
+  const int* inner = a.innerIndexPtr();
+  const double* val = a.valuePtr();
+  std::vector<int> fo(static_cast<std::size_t>(n) + 1, 0);
+#pragma omp parallel for schedule(static) if (a.nonZeros() >= kParallelRows)
+  for (Index i = 0; i < n; ++i) {
+    int c = 0;
+    for (int e = outer[i]; e < outer[i + 1]; ++e)
+      c += (strong[static_cast<std::size_t>(e)] || inner[e] == i) ? 1 : 0;
+    fo[static_cast<std::size_t>(i) + 1] = c;
+  }
+  for (Index i = 0; i < n; ++i)
+    fo[static_cast<std::size_t>(i) + 1] += fo[static_cast<std::size_t>(i)];
+  std::vector<int> fi(static_cast<std::size_t>(fo.back()));
+  std::vector<double> fv(fi.size());
+#pragma omp parallel for schedule(static) if (a.nonZeros() >= kParallelRows)
+  for (Index i = 0; i < n; ++i) {
+    double lumped = 0.0;
+    for (int e = outer[i]; e < outer[i + 1]; ++e)
+      if (inner[e] != i && !strong[static_cast<std::size_t>(e)]) lumped += val[e];
+    int q = fo[static_cast<std::size_t>(i)];
+    for (int e = outer[i]; e < outer[i + 1]; ++e) {
+      if (inner[e] == i) {
+        fi[static_cast<std::size_t>(q)] = inner[e];
+        fv[static_cast<std::size_t>(q++)] = val[e] + lumped;
+      } else if (strong[static_cast<std::size_t>(e)]) {
+        fi[static_cast<std::size_t>(q)] = inner[e];
+        fv[static_cast<std::size_t>(q++)] = val[e];
+      }
+    }
+  }
+  return RowMat(Eigen::Map<const RowMat>(n, a.cols(), fo.back(), fo.data(), fi.data(), fv.data()));
 }
 
 // λ_max(D⁻¹A) by power iteration from a fixed start (a lower bound, close after a few steps).
@@ -206,7 +271,7 @@ double largest_eigenvalue(const RowMat& a, const Eigen::VectorXd& inv_diag) {
   for (Index i = 0; i < n; ++i) q(i, 0) = 1.0 + 0.37 * static_cast<double>(i % 11);
   q /= q.norm();
   double lambda = 1.0;
-  for (int it = 0; it < 15; ++it) {
+  for (int it = 0; it < 10; ++it) {
     Block z = inv_diag.asDiagonal() * times(a, q);
     const double norm = z.norm();
     if (!(norm > 0.0)) break;
@@ -218,16 +283,12 @@ double largest_eigenvalue(const RowMat& a, const Eigen::VectorXd& inv_diag) {
 // Aggregates of the strongly connected unknowns: (1) an unknown whose strong neighbours are all
 // free becomes the root of an aggregate with them; (2) a free unknown joins the aggregate of
 // its strongest neighbour from (1); (3) what is left forms aggregates with its free neighbours.
-std::vector<int> aggregates(const RowMat& a, const Eigen::VectorXd& diag, double strength,
-                            int& count) {
+std::vector<int> aggregates(const RowMat& a, const std::vector<char>& is_strong, int& count) {
   const Eigen::Index n = a.rows();
   const int* outer = a.outerIndexPtr();
   const int* inner = a.innerIndexPtr();
   const double* val = a.valuePtr();
-  auto strong = [&](Eigen::Index i, int e) {
-    const int j = inner[e];
-    return j != i && std::abs(val[e]) >= strength * std::sqrt(diag(i) * diag(j));
-  };
+  auto strong = [&](Eigen::Index, int e) { return is_strong[static_cast<std::size_t>(e)] != 0; };
   std::vector<int> agg(static_cast<std::size_t>(n), -1);
   count = 0;
   for (Eigen::Index i = 0; i < n; ++i) {
@@ -328,32 +389,21 @@ AmgHierarchy build_amg(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& 
     L.inv_diag = diag.cwiseInverse();
     int nc = 0;
     std::vector<int> agg;
-    if (L.a.rows() > o.coarsest && static_cast<int>(h.levels.size()) + 1 < o.max_levels)
-      agg = aggregates(L.a, diag, o.strength, nc);
+    std::vector<char> strong;
+    if (L.a.rows() > o.coarsest && static_cast<int>(h.levels.size()) + 1 < o.max_levels) {
+      strong = strong_entries(L.a, diag, o.strength);
+      agg = aggregates(L.a, strong, nc);
+    }
     if (agg.empty() || nc >= L.a.rows()) {  // (the coarsest level: small, or no coarsening)
       h.levels.push_back(std::move(L));
       break;
     }
     // P = (I − ω_F D_F⁻¹A_F) P_t, P_t the constant on each aggregate, A_F the filtered matrix
-    // (A's strong connections, the weak ones lumped into the diagonal: VMB's Ã, which keeps P
-    // as local as the aggregates); the next level RᵀAP, R = Pᵀ.
+    // (which keeps P as local as the aggregates); the next level RᵀAP, R = Pᵀ.
     L.omega = 4.0 / (3.0 * largest_eigenvalue(L.a, L.inv_diag));
-    RowMat smoother = L.a;
+    RowMat smoother = filtered(L.a, strong);
     {
-      const double strength = o.strength;
-      Eigen::VectorXd diag_f = diag;
-      for (Index i = 0; i < smoother.outerSize(); ++i)
-        for (RowMat::InnerIterator it(smoother, i); it; ++it)
-          if (it.col() != i &&
-              std::abs(it.value()) < strength * std::sqrt(diag(i) * diag(it.col()))) {
-            diag_f(i) += it.value();
-            it.valueRef() = 0.0;
-          }
-      for (Index i = 0; i < smoother.outerSize(); ++i)
-        for (RowMat::InnerIterator it(smoother, i); it; ++it)
-          if (it.col() == i) it.valueRef() = diag_f(i);
-      smoother.prune(0.0);
-      const Eigen::VectorXd inv_f = diag_f.cwiseInverse();
+      const Eigen::VectorXd inv_f = smoother.diagonal().cwiseInverse();
       const double omega_f = 4.0 / (3.0 * largest_eigenvalue(smoother, inv_f));
       for (Index i = 0; i < smoother.outerSize(); ++i)  // I − ω_F D_F⁻¹A_F
         for (RowMat::InnerIterator it(smoother, i); it; ++it)
