@@ -10,7 +10,8 @@
 //    vortex crossing the hull, a Gaussian source, a translation): |∇×v|, |h|, cos(∇×v, h),
 //    cos(∇u, h), ‖∇·v‖ and the relative difference of ∇×v from path (a)'s where it converged.
 // Then the whole pipeline (mesh, ξ, HHD, extrema, tubes) on the 5.5e4-node lattice and on 5.6e4
-// random points (issue 23 item 7), with each 3D path.
+// random points (issue 23 item 7), with each 3D path but bicgstab and ldlt (GS_BENCH_PATHS
+// applies).
 //   build/bin/bench_hhd [N ...]      (default 10000 56000 200000)
 // Environment: GS_BENCH_MESH (lattice, random or both: default both), GS_BENCH_PATHS (comma list
 // of bicgstab, projection, projection-amg, cholmod, cg, ldlt; default all), GS_BENCH_LDLT_MAX
@@ -218,8 +219,9 @@ int main(int argc, char** argv) {
     std::vector<Eigen::Vector3d> nodal;
     for (const auto& p : m.points)
       nodal.push_back(lattice ? field.xi(p) : gs::test::vortex_source_translation(p));
-    for (auto solver :
-         {HhdSolver::ProjectionAmg, HhdSolver::Projection, HhdSolver::Cholmod, HhdSolver::Cg}) {
+    for (const auto& path : paths()) {
+      const HhdSolver solver = path.solver;
+      if (solver == HhdSolver::BiCgStab || solver == HhdSolver::Ldlt || !wanted(path.key)) continue;
       VortexAnalysisOptions o;
       o.hhd.solver = solver;
       const auto t0 = Clock::now();
