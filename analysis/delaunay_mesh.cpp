@@ -164,7 +164,7 @@ DelaunayMesh delaunay_mesh(const std::vector<Eigen::Vector3d>& points) {
       PDelaunay3::Lock_data_structure lock(
           CGAL::Bbox_3(box.min().x(), box.min().y(), box.min().z(), box.max().x(), box.max().y(),
                        box.max().z()),
-          50);
+          20);  // (a 20³ grid of locks: 5 % faster than 50³ at 5.6e4 points, 2 threads)
       const PDelaunay3 dt(pts.begin(), pts.end(), K(), &lock);  // spatially sorted insertion
       return mesh_of(dt, points);
     });
