@@ -42,7 +42,7 @@ enum class HhdSolver {
   Projection,  // eq 18 as the paper defines it, solved as a projection (3D: PCG on CᵀMC with the
                // Laplacian factor and block Jacobi, symmetric multiplicative; 2D: path (b))
   ProjectionAmg,  // the same projection with one aggregation-AMG V-cycle in place of the
-                  // Laplacian factor (added to the block Jacobi: no factor, 2.5–3.7× faster, half
+                  // Laplacian factor (added to the block Jacobi: no factor, 1.9–3.1× faster, half
                   // the memory), and u, path (b)'s v by AMG-preconditioned CG
   Cholmod,   // path (b): Laplacian, CHOLMOD Cholesky (supernodal/simplicial as CHOLMOD picks)
   Ldlt,      // path (c): Laplacian, Eigen SimplicialLDLT (AMD ordering)
