@@ -24,8 +24,8 @@ using RowMat = Eigen::SparseMatrix<double, Eigen::RowMajor, int>;
 using Block = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 using Index = Eigen::Index;
 
-// Rows below this are not worth waking the threads for.
-constexpr Index kParallelRows = 8192;
+// Rows (or, for the sparse products, entries) below this are not worth waking the threads for.
+constexpr Index kParallelWork = 8192;
 // Rows go to the threads in chunks of this many; sums over rows are taken per chunk, then over
 // the chunks in order: the same bits for any number of threads and any block width.
 constexpr Index kChunk = 2048;
@@ -38,7 +38,7 @@ Index chunks(Index n) {
 template <class F>
 void for_chunks(Index n, F&& f) {
   const Index nc = chunks(n);
-#pragma omp parallel for schedule(static) if (n >= kParallelRows)
+#pragma omp parallel for schedule(static) if (n >= kParallelWork)
   for (Index k = 0; k < nc; ++k) f(k * kChunk, std::min(n, (k + 1) * kChunk), k);
 }
 
@@ -156,7 +156,7 @@ RowMat multiply(const RowMat& a, const RowMat& b) {
   const double* bv = b.valuePtr();
   int threads = 1;
 #ifdef _OPENMP
-  if (a.nonZeros() >= kParallelRows) threads = omp_get_max_threads();
+  if (a.nonZeros() >= kParallelWork) threads = omp_get_max_threads();
 #endif
   std::vector<std::vector<int>> cols(static_cast<std::size_t>(threads));
   std::vector<std::vector<double>> vals(static_cast<std::size_t>(threads));
@@ -218,7 +218,7 @@ std::vector<char> strong_entries(const RowMat& a, const Eigen::VectorXd& diag, d
   const int* inner = a.innerIndexPtr();
   const double* val = a.valuePtr();
   std::vector<char> strong(static_cast<std::size_t>(a.nonZeros()), 0);
-#pragma omp parallel for schedule(static) if (a.nonZeros() >= kParallelRows)
+#pragma omp parallel for schedule(static) if (a.nonZeros() >= kParallelWork)
   for (Index i = 0; i < a.rows(); ++i)
     for (int e = outer[i]; e < outer[i + 1]; ++e)
       strong[static_cast<std::size_t>(e)] =
@@ -234,7 +234,7 @@ RowMat filtered(const RowMat& a, const std::vector<char>& strong) {
   const int* inner = a.innerIndexPtr();
   const double* val = a.valuePtr();
   std::vector<int> fo(static_cast<std::size_t>(n) + 1, 0);
-#pragma omp parallel for schedule(static) if (a.nonZeros() >= kParallelRows)
+#pragma omp parallel for schedule(static) if (a.nonZeros() >= kParallelWork)
   for (Index i = 0; i < n; ++i) {
     int c = 0;
     for (int e = outer[i]; e < outer[i + 1]; ++e)
@@ -245,7 +245,7 @@ RowMat filtered(const RowMat& a, const std::vector<char>& strong) {
     fo[static_cast<std::size_t>(i) + 1] += fo[static_cast<std::size_t>(i)];
   std::vector<int> fi(static_cast<std::size_t>(fo.back()));
   std::vector<double> fv(fi.size());
-#pragma omp parallel for schedule(static) if (a.nonZeros() >= kParallelRows)
+#pragma omp parallel for schedule(static) if (a.nonZeros() >= kParallelWork)
   for (Index i = 0; i < n; ++i) {
     double lumped = 0.0;
     for (int e = outer[i]; e < outer[i + 1]; ++e)
@@ -326,10 +326,15 @@ std::vector<int> aggregates(const RowMat& a, const std::vector<char>& is_strong,
 }
 
 // Per level: the solution, the right-hand side and a scratch block of the V-cycle.
-struct Workspace {
-  std::vector<Block> x, b, t;
-  explicit Workspace(std::size_t levels) : x(levels), b(levels), t(levels) {}
-};
+using Workspace = AmgWorkspace;
+
+Workspace workspace(const AmgHierarchy& h) {
+  Workspace w;
+  w.x.resize(h.levels.size());
+  w.b.resize(h.levels.size());
+  w.t.resize(h.levels.size());
+  return w;
+}
 
 // One V-cycle from zero on level l: w.x[l] ≈ A_l⁻¹ w.b[l] (w.b[l] unchanged).
 void cycle(const AmgHierarchy& h, std::size_t l, Workspace& w) {
@@ -429,18 +434,19 @@ AmgHierarchy build_amg(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& 
 
 Eigen::MatrixXd amg_vcycle(const AmgHierarchy& h, const Eigen::MatrixXd& b) {
   if (h.levels.empty()) throw std::invalid_argument("AMG: empty hierarchy");
-  Workspace w(h.levels.size());
+  Workspace w = workspace(h);
   w.b[0] = b;
   cycle(h, 0, w);
   return Eigen::MatrixXd(w.x[0]);
 }
 
-void amg_vcycle(const AmgHierarchy& h, const Eigen::Ref<const AmgBlock>& b, AmgBlock& x) {
+void amg_vcycle(const AmgHierarchy& h, const Eigen::Ref<const AmgBlock>& b, AmgBlock& x,
+                AmgWorkspace& w) {
   if (h.levels.empty()) throw std::invalid_argument("AMG: empty hierarchy");
-  Workspace w(h.levels.size());
+  if (w.x.size() != h.levels.size()) w = workspace(h);
   w.b[0] = b;
   cycle(h, 0, w);
-  x.swap(w.x[0]);
+  x = w.x[0];
 }
 
 Eigen::MatrixXd amg_pcg(const AmgHierarchy& h, const Eigen::MatrixXd& b0, double tolerance,
@@ -449,7 +455,7 @@ Eigen::MatrixXd amg_pcg(const AmgHierarchy& h, const Eigen::MatrixXd& b0, double
   if (h.levels.empty()) throw std::invalid_argument("AMG: empty hierarchy");
   const RowMat& a = h.levels.front().a;
   const Index n = b0.rows(), cols = b0.cols();
-  Workspace w(h.levels.size());
+  Workspace w = workspace(h);
   Block& r = w.b[0];        // the residual is the V-cycle's right-hand side,
   const Block& z = w.x[0];  // and its output the preconditioned residual
   r = b0;

@@ -46,8 +46,15 @@ Eigen::MatrixXd amg_vcycle(const AmgHierarchy& h, const Eigen::MatrixXd& b);
 
 /// A block of right-hand sides with each unknown's columns side by side (row-major).
 using AmgBlock = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
-/// amg_vcycle for a row-major block (no change of layout): x ≈ A⁻¹b, the same bits.
-void amg_vcycle(const AmgHierarchy& h, const Eigen::Ref<const AmgBlock>& b, AmgBlock& x);
+/// The V-cycle's blocks on every level (solution, right-hand side, scratch): kept by a caller
+/// that cycles many times, so that they are allocated once.
+struct AmgWorkspace {
+  std::vector<AmgBlock> x, b, t;
+};
+/// amg_vcycle for a row-major block (no change of layout): x ≈ A⁻¹b, the same bits; `w` holds
+/// the blocks between calls.
+void amg_vcycle(const AmgHierarchy& h, const Eigen::Ref<const AmgBlock>& b, AmgBlock& x,
+                AmgWorkspace& w);
 
 /// Conjugate gradients on A x = b (A: the matrix the hierarchy was built from) for every column
 /// of b at once (each column its own step lengths, frozen once it converged), preconditioned by

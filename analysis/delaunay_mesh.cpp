@@ -88,7 +88,7 @@ void check_input(const std::vector<Vec>& points, std::size_t min_points, const c
 // Tetrahedra in a canonical form and order, whatever order the triangulation holds them in:
 // each rotated by an even permutation (orientation kept) so that its smallest vertex comes first
 // and the smallest of the other three second; then sorted (counting sort on the first vertex,
-// insertion sort within).
+// a sort of the few sharing it).
 void canonical_order(std::vector<std::array<std::int32_t, 4>>& t, std::size_t n_points) {
   for (auto& s : t) {
     const auto first = static_cast<std::size_t>(std::min_element(s.begin(), s.end()) - s.begin());

@@ -273,7 +273,7 @@ using Rows3 = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
 // A = CᵀMC (the matrix of eq 18 up to its sign), matrix-free, laid out for its products: the
 // tetrahedra of positive measure in the order of their smallest unknown (the unknowns follow a
 // Hilbert curve, so consecutive tetrahedra read and write nearby rows), each with its four
-// unknowns (−1: a Dirichlet node), |T_k| and its four ∇φ_a.
+// unknowns (−1: a Dirichlet node), |T_k| and ∇φ_1..3.
 struct CurlCurl {
   std::vector<std::array<int, 4>> node;
   std::vector<double> measure;
@@ -311,25 +311,26 @@ CurlCurl curl_curl_operator(const HhdMesh& m, const P1Geometry& g, const std::ve
   return op;
 }
 
-// A·V: per tetrahedron c_k = |T_k| Σ_a ∇φ_a × v_a, then row i gets c_k × ∇φ_i. Each thread sums
-// a fixed range of tetrahedra into its own buffer and the buffers are added in thread order, so
-// the result does not depend on the scheduling.
-Rows3 apply_curl_curl(const CurlCurl& op, const Rows3& v) {
+// out = A·V: per tetrahedron c_k = |T_k| Σ_a ∇φ_a × v_a, then row i gets c_k × ∇φ_i. Each thread
+// sums a fixed range of tetrahedra into its own buffer (`part`, kept by the caller between
+// products: at 10⁶ nodes fresh buffers cost more in page faults than the product) and the
+// buffers are added in thread order, so the result does not depend on the scheduling.
+void apply_curl_curl(const CurlCurl& op, const Rows3& v, Rows3& result, std::vector<Rows3>& part) {
   const Eigen::Index n = v.rows();
   const auto ns = static_cast<std::ptrdiff_t>(op.node.size());
   int threads = 1;
 #ifdef _OPENMP
   threads = omp_get_max_threads();
 #endif
-  std::vector<Rows3> part(static_cast<std::size_t>(threads));
+  part.resize(static_cast<std::size_t>(threads));
 #pragma omp parallel num_threads(threads)
   {
     int t = 0;
 #ifdef _OPENMP
     t = omp_get_thread_num();
 #endif
-    Rows3& out = part[static_cast<std::size_t>(t)];
-    out = Rows3::Zero(n, 3);
+    Rows3& out = t == 0 ? result : part[static_cast<std::size_t>(t)];
+    out.setZero(n, 3);
     const std::ptrdiff_t lo = ns * t / threads, hi = ns * (t + 1) / threads;
     static constexpr double zero[3] = {0.0, 0.0, 0.0};
     const double* vd = v.data();
@@ -378,8 +379,7 @@ Rows3 apply_curl_curl(const CurlCurl& op, const Rows3& v) {
       }
     }
   }
-  for (std::size_t t = 1; t < part.size(); ++t) part[0] += part[t];
-  return std::move(part[0]);
+  for (std::size_t t = 1; t < part.size(); ++t) result += part[t];
 }
 
 // The 3×3 diagonal blocks of A, Σ_k |T_k| (|∇φ_i|² I − ∇φ_i ∇φ_iᵀ), inverted (pseudo-inverse
@@ -417,21 +417,6 @@ Rows3 apply_blocks(const std::vector<Eigen::Matrix3d>& d, const Rows3& r) {
   return z;
 }
 
-// Eq 18 in 3D as the projection it is: v minimises ‖∇×v − ξ‖ over P1 fields vanishing on the
-// hull, i.e. A v = CᵀMξ with A = CᵀMC (SPD on Delaunay meshes, but conditioned like h⁻⁴ and much
-// worse with slivers). Conjugate gradients, from v = 0, on A with a symmetric two-part
-// preconditioner:
-//  * the vector Laplacian K⊗I (`solve_k`, the factor path (b) computes): K⊗I = CᵀMC + DᵀMD, so
-//    (K⊗I)⁻¹A = I − (K⊗I)⁻¹DᵀMD is the identity on divergence-free fields; and
-//  * damped block Jacobi on A's 3×3 node blocks before and after it (symmetric multiplicative),
-//    for the modes K⊗I gets wrong: a sliver tetrahedron stiffens K in every direction, A only
-//    tangentially to the sliver. Damping ω = 1.5/λ_max(D⁻¹A) (power iteration, a lower bound of
-//    λ_max): ω λ_max < 2 keeps the preconditioner SPD. On 10 000 random points it cuts the
-//    iterations from 1 527 (Laplacian alone) to 118; a per-sliver 12×12 block or a deflation of
-//    low-order polynomial divergence modes did not reduce them further (docs/hhd.md).
-// CG minimises ‖C(v − v*)‖_M, the error of ∇×v, over its Krylov space, and its residual is
-// orthogonal to that space, which holds v: ⟨∇×v, h⟩ = vᵀ(CᵀMξ − Av) = 0 at every iterate (to
-// round-off). Stops at ‖CᵀMξ − Av‖ ≤ tolerance ‖CᵀMξ‖ (eq 18's residual) or max_iterations.
 // Σ over [0, n) of f(begin, end) (N sums) taken per chunk of rows on the threads, then over the
 // chunks in order: the same bits for any number of threads.
 template <std::size_t N, class F>
@@ -454,6 +439,24 @@ double chunked_sum(Eigen::Index n, F&& f) {
       n, [&](Eigen::Index lo, Eigen::Index hi) { return std::array<double, 1>{f(lo, hi)}; })[0];
 }
 
+// Eq 18 in 3D as the projection it is: v minimises ‖∇×v − ξ‖ over P1 fields vanishing on the
+// hull, i.e. A v = CᵀMξ with A = CᵀMC (SPD on Delaunay meshes, but conditioned like h⁻⁴ and much
+// worse with slivers). Conjugate gradients, from v = 0, on A with a symmetric two-part
+// preconditioner:
+//  * the vector Laplacian K⊗I (`solve_k`, the factor path (b) computes): K⊗I = CᵀMC + DᵀMD, so
+//    (K⊗I)⁻¹A = I − (K⊗I)⁻¹DᵀMD is the identity on divergence-free fields; and
+//  * damped block Jacobi on A's 3×3 node blocks before and after it (symmetric multiplicative),
+//    for the modes K⊗I gets wrong: a sliver tetrahedron stiffens K in every direction, A only
+//    tangentially to the sliver. Damping ω = 1.5/λ_max(D⁻¹A) (power iteration, a lower bound of
+//    λ_max): ω λ_max < 2 keeps the preconditioner SPD. On 10 000 random points it cuts the
+//    iterations from 1 527 (Laplacian alone) to 118; a per-sliver 12×12 block or a deflation of
+//    low-order polynomial divergence modes did not reduce them further (docs/hhd.md).
+// `additive` (for an approximate solve_k such as one AMG V-cycle): z = solve_k(r) + ω D⁻¹r with
+// ω = 0.4/λ_max instead, SPD for any ω > 0 and with no product with A inside: ~1.7× the
+// iterations, each a third of the products (faster once solve_k is cheap; docs/hhd.md).
+// CG minimises ‖C(v − v*)‖_M, the error of ∇×v, over its Krylov space, and its residual is
+// orthogonal to that space, which holds v: ⟨∇×v, h⟩ = vᵀ(CᵀMξ − Av) = 0 at every iterate (to
+// round-off). Stops at ‖CᵀMξ − Av‖ ≤ tolerance ‖CᵀMξ‖ (eq 18's residual) or max_iterations.
 template <class SolveK>
 Eigen::MatrixXd projection_pcg(const HhdMesh& m, const P1Geometry& g, const std::vector<int>& idx,
                                const Eigen::MatrixXd& b, SolveK&& solve_k, bool additive,
@@ -474,25 +477,36 @@ Eigen::MatrixXd projection_pcg(const HhdMesh& m, const P1Geometry& g, const std:
       return s;
     });
   };
+  // The vectors of the iterations, allocated once.
+  Rows3 r = b, z(n, 3), p(n, 3), ap(n, 3), k(n, 3), t(n, 3);
+  std::vector<Rows3> part;
   // λ_max(D⁻¹A) by power iteration from a fixed start (deterministic).
   Rows3 q = Rows3::Ones(n, 3);
   for (Eigen::Index i = 0; i < n; ++i)
     q.row(i) *= (i % 7 == 0 ? -1.0 : 1.0) * (1.0 + 0.01 * static_cast<double>(i % 13));
   double lambda = 1.0;
   for (int it = 0; it < 12; ++it) {
-    const Rows3 aq = apply_curl_curl(op, q);
-    const Rows3 dq = apply_blocks(d, aq);
-    const double qaq = dot(q, aq);
-    const double qdq = dot(dq, aq);
+    apply_curl_curl(op, q, ap, part);
+    const Rows3 dq = apply_blocks(d, ap);
+    const double qaq = dot(q, ap);
+    const double qdq = dot(dq, ap);
     if (qaq > 0.0) lambda = qdq / qaq;  // Rayleigh quotient of D⁻¹A in the A inner product
     q = dq / std::sqrt(dot(dq, dq));
   }
   const double omega = (additive ? 0.4 : 1.5) / lambda;
+  // z = ω D⁻¹x (+ z if `add`), the blocks on the threads.
+  auto jacobi = [&](const Rows3& x, bool add) {
+#pragma omp parallel for schedule(static)
+    for (Eigen::Index i = 0; i < n; ++i) {
+      const Eigen::RowVector3d y =
+          omega * (d[static_cast<std::size_t>(i)] * x.row(i).transpose()).transpose();
+      z.row(i) = add ? Eigen::RowVector3d(z.row(i) + y) : y;
+    }
+  };
   // z = P r; returns rᵀz.
-  Rows3 t(n, 3);
-  auto precondition = [&](const Rows3& r, Rows3& z) {
+  auto precondition = [&]() {
     if (additive) {
-      const Rows3 k = solve_k(r);
+      solve_k(r, k);
       return chunked_sum(n, [&](Eigen::Index lo, Eigen::Index hi) {
         double s = 0.0;
         for (Eigen::Index i = lo; i < hi; ++i) {
@@ -503,17 +517,20 @@ Eigen::MatrixXd projection_pcg(const HhdMesh& m, const P1Geometry& g, const std:
         return s;
       });
     }
-    z = omega * apply_blocks(d, r);
-    z += solve_k(Rows3(r - apply_curl_curl(op, z)));
-    z += omega * apply_blocks(d, Rows3(r - apply_curl_curl(op, z)));
+    jacobi(r, false);
+    apply_curl_curl(op, z, ap, part);
+    t = r - ap;
+    solve_k(t, k);
+    z += k;
+    apply_curl_curl(op, z, ap, part);
+    t = r - ap;
+    jacobi(t, true);
     return dot(r, z);
   };
-  Rows3 r = b;
-  Rows3 z(n, 3);
-  double rz = precondition(r, z);
-  Rows3 p = z;
+  double rz = precondition();
+  p = z;
   for (int it = 1; it <= max_iterations; ++it) {
-    const Rows3 ap = apply_curl_curl(op, p);
+    apply_curl_curl(op, p, ap, part);
     const double pap = dot(p, ap);
     if (!(pap > 0.0) || !(rz > 0.0)) break;
     const double alpha = rz / pap;
@@ -529,7 +546,7 @@ Eigen::MatrixXd projection_pcg(const HhdMesh& m, const P1Geometry& g, const std:
     iterations = it;
     if (std::sqrt(rr) <= tolerance * bnorm) return Eigen::MatrixXd(v);
     if (poll && it % 8 == 0) poll();
-    const double rz_new = precondition(r, z);
+    const double rz_new = precondition();
     const double beta = rz_new / rz;
 #pragma omp parallel for schedule(static)
     for (Eigen::Index i = 0; i < n; ++i) p.row(i) = z.row(i) + beta * p.row(i);
@@ -796,7 +813,7 @@ HhdResult helmholtz_hodge(const HhdMesh& m, const std::vector<Eigen::Vector3d>& 
       direct(s);  // u, and path (b)'s v (eq 18 itself in 2D)
       if (o.poll) o.poll();
       if (m.dim == 3)
-        project([&](const Rows3& q) { return Rows3(s.solve(Eigen::MatrixXd(q))); }, false);
+        project([&](const Rows3& q, Rows3& out) { out = s.solve(Eigen::MatrixXd(q)); }, false);
       break;
     }
     case HhdSolver::ProjectionAmg: {
@@ -810,11 +827,12 @@ HhdResult helmholtz_hodge(const HhdMesh& m, const std::vector<Eigen::Vector3d>& 
       if (o.poll) o.poll();
       if (m.dim == 3) {
         r.report.iterations_v = 0;
+        AmgWorkspace w;
+        AmgBlock z;
         project(
-            [&](const Rows3& q) {
-              AmgBlock z;
-              amg_vcycle(h, q, z);
-              return Rows3(z);
+            [&](const Rows3& q, Rows3& out) {
+              amg_vcycle(h, q, z, w);
+              out = z;
             },
             true);
       } else {
