@@ -6,6 +6,7 @@
 // pass over a matrix serves all of them; rows go to the threads, and each row's sums are taken in
 // the matrix's order whatever the number of threads or columns (the same bits).
 #include "aggregation_amg.hpp"
+#include "thread_rows.hpp"
 
 #include <algorithm>
 #include <array>
@@ -195,20 +196,7 @@ RowMat multiply(const RowMat& a, const RowMat& b) {
       outer[static_cast<std::size_t>(i) + 1] = static_cast<int>(c.size() - start);
     }
   }
-  for (Index i = 0; i < n; ++i)
-    outer[static_cast<std::size_t>(i) + 1] += outer[static_cast<std::size_t>(i)];
-  std::vector<int> inner;
-  std::vector<double> value;
-  inner.reserve(static_cast<std::size_t>(outer.back()));
-  value.reserve(static_cast<std::size_t>(outer.back()));
-  for (int t = 0; t < threads; ++t) {
-    inner.insert(inner.end(), cols[static_cast<std::size_t>(t)].begin(),
-                 cols[static_cast<std::size_t>(t)].end());
-    value.insert(value.end(), vals[static_cast<std::size_t>(t)].begin(),
-                 vals[static_cast<std::size_t>(t)].end());
-  }
-  return RowMat(
-      Eigen::Map<const RowMat>(n, m, outer.back(), outer.data(), inner.data(), value.data()));
+  return join_thread_rows<RowMat>(n, m, outer, cols, vals);
 }
 
 // Per stored entry of A: 1 when it is a strong connection, |a_ij| ≥ θ √(a_ii a_jj), i ≠ j.

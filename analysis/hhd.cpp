@@ -17,6 +17,7 @@
 
 #include "aggregation_amg.hpp"
 #include "delaunay_mesh.hpp"
+#include "thread_rows.hpp"
 
 #ifdef _OPENMP
 #include <omp.h>
@@ -200,20 +201,7 @@ SpMat stiffness(const HhdMesh& m, const P1Geometry& g, const std::vector<int>& i
       outer[ii + 1] = static_cast<int>(row.size());
     }
   }
-  for (std::size_t i = 0; i < static_cast<std::size_t>(n); ++i) outer[i + 1] += outer[i];
-  std::vector<int> inner;
-  std::vector<double> value;
-  inner.reserve(static_cast<std::size_t>(outer.back()));
-  value.reserve(static_cast<std::size_t>(outer.back()));
-  for (int t = 0; t < threads; ++t) {
-    inner.insert(inner.end(), cols[static_cast<std::size_t>(t)].begin(),
-                 cols[static_cast<std::size_t>(t)].end());
-    value.insert(value.end(), vals[static_cast<std::size_t>(t)].begin(),
-                 vals[static_cast<std::size_t>(t)].end());
-  }
-  // Symmetric: the rows are the columns.
-  return SpMat(
-      Eigen::Map<const SpMat>(n, n, outer.back(), outer.data(), inner.data(), value.data()));
+  return join_thread_rows<SpMat>(n, n, outer, cols, vals);  // (symmetric: rows = columns)
 }
 
 // Eq 18 as written in 3D: block (i, j) = Σ_k |T_k| (∇φ_j ∇φ_iᵀ − (∇φ_i·∇φ_j) I), i.e. the

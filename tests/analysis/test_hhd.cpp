@@ -147,6 +147,19 @@ double cosine(double dot, double x, double y) {
   return std::abs(dot) / (x * y);
 }
 
+// Issue 20's field (a vortex crossing the hull, a source, a translation) on n random points.
+struct RandomCase {
+  HhdMesh m;
+  std::vector<Eigen::Vector3d> xi;
+};
+RandomCase issue20_case(std::size_t n, unsigned seed) {
+  RandomCase c{test::random_cube_mesh(n, seed), {}};
+  std::vector<Eigen::Vector3d> nodal;
+  for (const auto& p : c.m.points) nodal.push_back(test::vortex_source_translation(p));
+  c.xi = simplex_mean(c.m, nodal);
+  return c;
+}
+
 // The parts of eq 18's decomposition orthogonal to round-off (issue 20: cos ≤ 1e-8).
 void expect_orthogonal_parts(const HhdResult& r) {
   EXPECT_LT(cosine(r.dot_curl_harmonic, r.norm_curl_v, r.norm_harmonic), 1e-8);
@@ -160,10 +173,7 @@ TEST(Hhd, ProjectionIsEq18OnRandomPoints) {
   // (BiCGSTAB on eq 18 as written, converged far) is the reference. The projection must give its
   // ∇×v to 1e-6 and parts orthogonal to round-off; path (b) must not (else this test could not
   // tell them apart).
-  const auto m = test::random_cube_mesh(2500, 21);
-  std::vector<Eigen::Vector3d> nodal;
-  for (const auto& p : m.points) nodal.push_back(test::vortex_source_translation(p));
-  const auto xi = simplex_mean(m, nodal);
+  const auto [m, xi] = issue20_case(2500, 21);
   HhdOptions o;
   o.solver = HhdSolver::BiCgStab;
   o.tolerance = 1e-13;
@@ -195,10 +205,7 @@ TEST(Hhd, ProjectionIsEq18OnRandomPoints) {
 TEST(Hhd, ProjectionAmgIsTheSameProjection) {
   // The projection with the AMG V-cycle in place of the Laplacian factor, and u and path (b)'s
   // v by AMG-preconditioned CG: the same decomposition to the solvers' tolerances.
-  const auto m = test::random_cube_mesh(2500, 21);
-  std::vector<Eigen::Vector3d> nodal;
-  for (const auto& p : m.points) nodal.push_back(test::vortex_source_translation(p));
-  const auto xi = simplex_mean(m, nodal);
+  const auto [m, xi] = issue20_case(2500, 21);
   HhdOptions o;
   o.solver = HhdSolver::Projection;
   const auto p = helmholtz_hodge(m, xi, o);  // the projection with the factor
@@ -230,10 +237,7 @@ TEST(Hhd, CgIsPathBAndTheSameBitsForAnyThreadCount) {
   // Path (b) by AMG-preconditioned CG: the factor's answer to its tolerance, and (rows summed in
   // a fixed order, the unknowns numbered along a Hilbert curve) the same bits with 1 and 2
   // threads, assembly and post-processing included.
-  const auto m = test::random_cube_mesh(3000, 4);
-  std::vector<Eigen::Vector3d> nodal;
-  for (const auto& p : m.points) nodal.push_back(test::vortex_source_translation(p));
-  const auto xi = simplex_mean(m, nodal);
+  const auto [m, xi] = issue20_case(3000, 4);
   HhdOptions o;
   o.solver = HhdSolver::Cholmod;
   const auto c = helmholtz_hodge(m, xi, o);

@@ -1,0 +1,31 @@
+// Sparse matrices assembled row by row on threads: each thread builds a contiguous range of rows
+// into its own column and value lists; this joins them into one compressed matrix.
+#pragma once
+
+#include <Eigen/Sparse>
+#include <cstddef>
+#include <vector>
+
+namespace gs::analysis {
+
+/// `outer[i + 1]` holds the number of entries of row i (outer[0] = 0); `inner[t]` and `value[t]`
+/// the entries of thread t's rows, in row order, threads in row order. Returns the compressed
+/// matrix with these rows (for a column-major `Sparse`, of a symmetric matrix: rows = columns).
+template <class Sparse>
+Sparse join_thread_rows(Eigen::Index rows, Eigen::Index cols, std::vector<int>& outer,
+                        const std::vector<std::vector<int>>& inner,
+                        const std::vector<std::vector<double>>& value) {
+  for (std::size_t i = 0; i + 1 < outer.size(); ++i) outer[i + 1] += outer[i];
+  std::vector<int> all_inner;
+  std::vector<double> all_value;
+  all_inner.reserve(static_cast<std::size_t>(outer.back()));
+  all_value.reserve(static_cast<std::size_t>(outer.back()));
+  for (std::size_t t = 0; t < inner.size(); ++t) {
+    all_inner.insert(all_inner.end(), inner[t].begin(), inner[t].end());
+    all_value.insert(all_value.end(), value[t].begin(), value[t].end());
+  }
+  return Sparse(Eigen::Map<const Sparse>(rows, cols, outer.back(), outer.data(), all_inner.data(),
+                                         all_value.data()));
+}
+
+}  // namespace gs::analysis
