@@ -159,44 +159,35 @@ RowMat multiply(const RowMat& a, const RowMat& b) {
 #ifdef _OPENMP
   if (a.nonZeros() >= kParallelWork) threads = omp_get_max_threads();
 #endif
-  std::vector<std::vector<int>> cols(static_cast<std::size_t>(threads));
-  std::vector<std::vector<double>> vals(static_cast<std::size_t>(threads));
-  std::vector<int> outer(static_cast<std::size_t>(n) + 1, 0);
-#pragma omp parallel num_threads(threads)
-  {
-    int t = 0;
-#ifdef _OPENMP
-    t = omp_get_thread_num();
-#endif
-    const Index lo = n * t / threads, hi = n * (t + 1) / threads;
-    auto& c = cols[static_cast<std::size_t>(t)];
-    auto& v = vals[static_cast<std::size_t>(t)];
-    std::vector<Index> mark(static_cast<std::size_t>(m), -1);
-    std::vector<double> acc(static_cast<std::size_t>(m), 0.0);
-    const auto guess = static_cast<std::size_t>((ao[hi] - ao[lo]) *
-                                                (b.rows() > 0 ? b.nonZeros() / b.rows() + 1 : 1));
-    c.reserve(guess);
-    v.reserve(guess);
-    for (Index i = lo; i < hi; ++i) {
-      const std::size_t start = c.size();
-      for (int e = ao[i]; e < ao[i + 1]; ++e)
-        for (int f = bo[ai[e]]; f < bo[ai[e] + 1]; ++f) {
-          const auto j = static_cast<std::size_t>(bi[f]);
-          if (mark[j] != i) {
-            mark[j] = i;
-            c.push_back(bi[f]);
-            acc[j] = av[e] * bv[f];
-          } else {
-            acc[j] += av[e] * bv[f];
-          }
+  return assemble_rows<RowMat>(
+      n, m, threads,
+      [&](Index lo, Index hi, std::vector<int>& c, std::vector<double>& v,
+          std::vector<int>& outer) {
+        std::vector<Index> mark(static_cast<std::size_t>(m), -1);
+        std::vector<double> acc(static_cast<std::size_t>(m), 0.0);
+        const auto guess = static_cast<std::size_t>(
+            (ao[hi] - ao[lo]) * (b.rows() > 0 ? b.nonZeros() / b.rows() + 1 : 1));
+        c.reserve(guess);
+        v.reserve(guess);
+        for (Index i = lo; i < hi; ++i) {
+          const std::size_t start = c.size();
+          for (int e = ao[i]; e < ao[i + 1]; ++e)
+            for (int f = bo[ai[e]]; f < bo[ai[e] + 1]; ++f) {
+              const auto j = static_cast<std::size_t>(bi[f]);
+              if (mark[j] != i) {
+                mark[j] = i;
+                c.push_back(bi[f]);
+                acc[j] = av[e] * bv[f];
+              } else {
+                acc[j] += av[e] * bv[f];
+              }
+            }
+          std::sort(c.begin() + static_cast<std::ptrdiff_t>(start), c.end());
+          for (std::size_t q = start; q < c.size(); ++q)
+            v.push_back(acc[static_cast<std::size_t>(c[q])]);
+          outer[static_cast<std::size_t>(i) + 1] = static_cast<int>(c.size() - start);
         }
-      std::sort(c.begin() + static_cast<std::ptrdiff_t>(start), c.end());
-      for (std::size_t q = start; q < c.size(); ++q)
-        v.push_back(acc[static_cast<std::size_t>(c[q])]);
-      outer[static_cast<std::size_t>(i) + 1] = static_cast<int>(c.size() - start);
-    }
-  }
-  return join_thread_rows<RowMat>(n, m, outer, cols, vals);
+      });
 }
 
 // Per stored entry of A: 1 when it is a strong connection, |a_ij| ≥ θ √(a_ii a_jj), i ≠ j.

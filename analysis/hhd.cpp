@@ -155,53 +155,45 @@ SpMat stiffness(const HhdMesh& m, const P1Geometry& g, const std::vector<int>& i
 #ifdef _OPENMP
   threads = omp_get_max_threads();
 #endif
-  std::vector<std::vector<int>> cols(static_cast<std::size_t>(threads));
-  std::vector<std::vector<double>> vals(static_cast<std::size_t>(threads));
-  std::vector<int> outer(static_cast<std::size_t>(n) + 1, 0);
-#pragma omp parallel num_threads(threads)
-  {
-    int t = 0;
-#ifdef _OPENMP
-    t = omp_get_thread_num();
-#endif
-    const int lo = static_cast<int>(static_cast<std::int64_t>(n) * t / threads);
-    const int hi = static_cast<int>(static_cast<std::int64_t>(n) * (t + 1) / threads);
-    auto& c = cols[static_cast<std::size_t>(t)];
-    auto& v = vals[static_cast<std::size_t>(t)];
-    std::vector<int> mark(static_cast<std::size_t>(n), -1), pos(static_cast<std::size_t>(n), 0);
-    std::vector<std::pair<int, double>> row;
-    for (int i = lo; i < hi; ++i) {
-      const auto ii = static_cast<std::size_t>(i);
-      row.clear();
-      for (auto e = inc.offset[ii]; e < inc.offset[ii + 1]; ++e) {
-        const auto k = static_cast<std::size_t>(inc.simplex[static_cast<std::size_t>(e)]);
-        const double w = g.measure[k];
-        const Eigen::Vector3d& ga =
-            g.gradient[k][static_cast<std::size_t>(inc.vertex[static_cast<std::size_t>(e)])];
-        for (int b = 0; b < nvert; ++b) {
-          const int j = idx[static_cast<std::size_t>(m.simplices[k][static_cast<std::size_t>(b)])];
-          if (j < 0) continue;
-          const double value = w * ga.dot(g.gradient[k][static_cast<std::size_t>(b)]);
-          auto& mk = mark[static_cast<std::size_t>(j)];
-          if (mk != i) {
-            mk = i;
-            pos[static_cast<std::size_t>(j)] = static_cast<int>(row.size());
-            row.emplace_back(j, value);
-          } else {
-            row[static_cast<std::size_t>(pos[static_cast<std::size_t>(j)])].second += value;
+  // Symmetric: the rows are the columns.
+  return assemble_rows<SpMat>(
+      n, n, threads,
+      [&](Eigen::Index lo, Eigen::Index hi, std::vector<int>& c, std::vector<double>& v,
+          std::vector<int>& outer) {
+        std::vector<int> mark(static_cast<std::size_t>(n), -1), pos(static_cast<std::size_t>(n), 0);
+        std::vector<std::pair<int, double>> row;
+        for (int i = static_cast<int>(lo); i < static_cast<int>(hi); ++i) {
+          const auto ii = static_cast<std::size_t>(i);
+          row.clear();
+          for (auto e = inc.offset[ii]; e < inc.offset[ii + 1]; ++e) {
+            const auto k = static_cast<std::size_t>(inc.simplex[static_cast<std::size_t>(e)]);
+            const double w = g.measure[k];
+            const Eigen::Vector3d& ga =
+                g.gradient[k][static_cast<std::size_t>(inc.vertex[static_cast<std::size_t>(e)])];
+            for (int b = 0; b < nvert; ++b) {
+              const int j =
+                  idx[static_cast<std::size_t>(m.simplices[k][static_cast<std::size_t>(b)])];
+              if (j < 0) continue;
+              const double value = w * ga.dot(g.gradient[k][static_cast<std::size_t>(b)]);
+              auto& mk = mark[static_cast<std::size_t>(j)];
+              if (mk != i) {
+                mk = i;
+                pos[static_cast<std::size_t>(j)] = static_cast<int>(row.size());
+                row.emplace_back(j, value);
+              } else {
+                row[static_cast<std::size_t>(pos[static_cast<std::size_t>(j)])].second += value;
+              }
+            }
           }
+          std::sort(row.begin(), row.end(),
+                    [](const auto& x, const auto& y) { return x.first < y.first; });
+          for (const auto& [j, value] : row) {
+            c.push_back(j);
+            v.push_back(value);
+          }
+          outer[ii + 1] = static_cast<int>(row.size());
         }
-      }
-      std::sort(row.begin(), row.end(),
-                [](const auto& x, const auto& y) { return x.first < y.first; });
-      for (const auto& [j, value] : row) {
-        c.push_back(j);
-        v.push_back(value);
-      }
-      outer[ii + 1] = static_cast<int>(row.size());
-    }
-  }
-  return join_thread_rows<SpMat>(n, n, outer, cols, vals);  // (symmetric: rows = columns)
+      });
 }
 
 // Eq 18 as written in 3D: block (i, j) = Σ_k |T_k| (∇φ_j ∇φ_iᵀ − (∇φ_i·∇φ_j) I), i.e. the

@@ -6,6 +6,10 @@
 #include <cstddef>
 #include <vector>
 
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
 namespace gs::analysis {
 
 /// `outer[i + 1]` holds the number of entries of row i (outer[0] = 0); `inner[t]` and `value[t]`
@@ -26,6 +30,26 @@ Sparse join_thread_rows(Eigen::Index rows, Eigen::Index cols, std::vector<int>& 
   }
   return Sparse(Eigen::Map<const Sparse>(rows, cols, outer.back(), outer.data(), all_inner.data(),
                                          all_value.data()));
+}
+
+/// Rows [0, rows) built on `threads` threads in contiguous ranges: build(lo, hi, inner, value,
+/// outer) appends the entries of rows lo..hi−1 (columns ascending) to that thread's lists and
+/// sets outer[i + 1] to row i's count. Returns the joined compressed matrix.
+template <class Sparse, class Build>
+Sparse assemble_rows(Eigen::Index rows, Eigen::Index cols, int threads, Build&& build) {
+  std::vector<std::vector<int>> inner(static_cast<std::size_t>(threads));
+  std::vector<std::vector<double>> value(static_cast<std::size_t>(threads));
+  std::vector<int> outer(static_cast<std::size_t>(rows) + 1, 0);
+#pragma omp parallel num_threads(threads)
+  {
+    int t = 0;
+#ifdef _OPENMP
+    t = omp_get_thread_num();
+#endif
+    build(rows * t / threads, rows * (t + 1) / threads, inner[static_cast<std::size_t>(t)],
+          value[static_cast<std::size_t>(t)], outer);
+  }
+  return join_thread_rows<Sparse>(rows, cols, outer, inner, value);
 }
 
 }  // namespace gs::analysis
