@@ -25,23 +25,8 @@ using RowMat = Eigen::SparseMatrix<double, Eigen::RowMajor, int>;
 using Block = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 using Index = Eigen::Index;
 
-// Rows (or, for the sparse products, entries) below this are not worth waking the threads for.
+// Matrix entries below this are not worth waking the threads for (the sparse products).
 constexpr Index kParallelWork = 8192;
-// Rows go to the threads in chunks of this many; sums over rows are taken per chunk, then over
-// the chunks in order: the same bits for any number of threads and any block width.
-constexpr Index kChunk = 2048;
-
-Index chunks(Index n) {
-  return (n + kChunk - 1) / kChunk;
-}
-
-// f(begin, end, chunk) for every chunk of [0, n), chunks on the threads.
-template <class F>
-void for_chunks(Index n, F&& f) {
-  const Index nc = chunks(n);
-#pragma omp parallel for schedule(static) if (n >= kParallelWork)
-  for (Index k = 0; k < nc; ++k) f(k * kChunk, std::min(n, (k + 1) * kChunk), k);
-}
 
 // For every row i of A: sums s_c = Σ_e a_ie x_(j_e, c) over the row in storage order, then
 // row(i, s, chunk). C columns known at compile time (C = 0: x.cols() at run time).
@@ -52,7 +37,7 @@ void for_rows_fixed(const RowMat& a, const Block& x, Row&& row) {
   const double* val = a.valuePtr();
   const double* xd = x.data();
   const Index cols = C > 0 ? C : x.cols();
-  for_chunks(a.rows(), [&](Index begin, Index end, Index chunk) {
+  for_row_chunks(a.rows(), [&](Index begin, Index end, Index chunk) {
     if constexpr (C > 0) {
       for (Index i = begin; i < end; ++i) {
         std::array<double, C> s{};  // (a fresh local per row: the sums stay in registers)
@@ -98,7 +83,7 @@ void for_rows(const RowMat& a, const Block& x, Row&& row) {
 struct ChunkSums {
   Index cols;
   Eigen::MatrixXd part;  // cols × chunks
-  ChunkSums(Index n, Index c) : cols(c), part(Eigen::MatrixXd::Zero(c, chunks(n))) {}
+  ChunkSums(Index n, Index c) : cols(c), part(Eigen::MatrixXd::Zero(c, row_chunks(n))) {}
   double* at(Index chunk) { return part.col(chunk).data(); }
   Eigen::VectorXd total() const {
     Eigen::VectorXd t = Eigen::VectorXd::Zero(cols);
@@ -111,7 +96,7 @@ struct ChunkSums {
 Eigen::VectorXd column_dots(const Block& a, const Block& b) {
   const Index cols = a.cols();
   ChunkSums sums(a.rows(), cols);
-  for_chunks(a.rows(), [&](Index begin, Index end, Index chunk) {
+  for_row_chunks(a.rows(), [&](Index begin, Index end, Index chunk) {
     double* s = sums.at(chunk);
     for (Index i = begin; i < end; ++i)
       for (Index c = 0; c < cols; ++c) s[c] += a(i, c) * b(i, c);
@@ -267,18 +252,18 @@ std::vector<int> aggregates(const RowMat& a, const std::vector<char>& is_strong,
   const int* outer = a.outerIndexPtr();
   const int* inner = a.innerIndexPtr();
   const double* val = a.valuePtr();
-  auto strong = [&](Eigen::Index, int e) { return is_strong[static_cast<std::size_t>(e)] != 0; };
+  auto strong = [&](int e) { return is_strong[static_cast<std::size_t>(e)] != 0; };
   std::vector<int> agg(static_cast<std::size_t>(n), -1);
   count = 0;
   for (Eigen::Index i = 0; i < n; ++i) {
     if (agg[static_cast<std::size_t>(i)] >= 0) continue;
     bool free = true;
     for (int e = outer[i]; e < outer[i + 1] && free; ++e)
-      if (strong(i, e) && agg[static_cast<std::size_t>(inner[e])] >= 0) free = false;
+      if (strong(e) && agg[static_cast<std::size_t>(inner[e])] >= 0) free = false;
     if (!free) continue;
     agg[static_cast<std::size_t>(i)] = count;
     for (int e = outer[i]; e < outer[i + 1]; ++e)
-      if (strong(i, e)) agg[static_cast<std::size_t>(inner[e])] = count;
+      if (strong(e)) agg[static_cast<std::size_t>(inner[e])] = count;
     ++count;
   }
   const std::vector<int> first = agg;
@@ -287,7 +272,7 @@ std::vector<int> aggregates(const RowMat& a, const std::vector<char>& is_strong,
     double best = 0.0;
     for (int e = outer[i]; e < outer[i + 1]; ++e) {
       const int g = first[static_cast<std::size_t>(inner[e])];
-      if (strong(i, e) && g >= 0 && std::abs(val[e]) > best) {
+      if (strong(e) && g >= 0 && std::abs(val[e]) > best) {
         best = std::abs(val[e]);
         agg[static_cast<std::size_t>(i)] = g;
       }
@@ -297,7 +282,7 @@ std::vector<int> aggregates(const RowMat& a, const std::vector<char>& is_strong,
     if (agg[static_cast<std::size_t>(i)] >= 0) continue;
     agg[static_cast<std::size_t>(i)] = count;
     for (int e = outer[i]; e < outer[i + 1]; ++e)
-      if (strong(i, e) && agg[static_cast<std::size_t>(inner[e])] < 0)
+      if (strong(e) && agg[static_cast<std::size_t>(inner[e])] < 0)
         agg[static_cast<std::size_t>(inner[e])] = count;
     ++count;
   }
@@ -305,10 +290,8 @@ std::vector<int> aggregates(const RowMat& a, const std::vector<char>& is_strong,
 }
 
 // Per level: the solution, the right-hand side and a scratch block of the V-cycle.
-using Workspace = AmgWorkspace;
-
-Workspace workspace(const AmgHierarchy& h) {
-  Workspace w;
+AmgWorkspace workspace(const AmgHierarchy& h) {
+  AmgWorkspace w;
   w.x.resize(h.levels.size());
   w.b.resize(h.levels.size());
   w.t.resize(h.levels.size());
@@ -316,7 +299,7 @@ Workspace workspace(const AmgHierarchy& h) {
 }
 
 // One V-cycle from zero on level l: w.x[l] ≈ A_l⁻¹ w.b[l] (w.b[l] unchanged).
-void cycle(const AmgHierarchy& h, std::size_t l, Workspace& w) {
+void cycle(const AmgHierarchy& h, std::size_t l, AmgWorkspace& w) {
   Block& x = w.x[l];
   const Block& b = w.b[l];
   const Index cols = b.cols();
@@ -327,7 +310,7 @@ void cycle(const AmgHierarchy& h, std::size_t l, Workspace& w) {
   }
   const AmgLevel& L = h.levels[l];
   Block& t = w.t[l];
-  for_chunks(b.rows(), [&](Index begin, Index end, Index) {
+  for_row_chunks(b.rows(), [&](Index begin, Index end, Index) {
     for (Index i = begin; i < end; ++i) {
       const double d = L.omega * L.inv_diag(i);
       for (Index c = 0; c < cols; ++c) x(i, c) = d * b(i, c);
@@ -412,11 +395,10 @@ AmgHierarchy build_amg(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& 
 }
 
 Eigen::MatrixXd amg_vcycle(const AmgHierarchy& h, const Eigen::MatrixXd& b) {
-  if (h.levels.empty()) throw std::invalid_argument("AMG: empty hierarchy");
-  Workspace w = workspace(h);
-  w.b[0] = b;
-  cycle(h, 0, w);
-  return Eigen::MatrixXd(w.x[0]);
+  AmgWorkspace w;
+  AmgBlock x;
+  amg_vcycle(h, AmgBlock(b), x, w);
+  return Eigen::MatrixXd(x);
 }
 
 void amg_vcycle(const AmgHierarchy& h, const Eigen::Ref<const AmgBlock>& b, AmgBlock& x,
@@ -434,7 +416,7 @@ Eigen::MatrixXd amg_pcg(const AmgHierarchy& h, const Eigen::MatrixXd& b0, double
   if (h.levels.empty()) throw std::invalid_argument("AMG: empty hierarchy");
   const RowMat& a = h.levels.front().a;
   const Index n = b0.rows(), cols = b0.cols();
-  Workspace w = workspace(h);
+  AmgWorkspace w = workspace(h);
   Block& r = w.b[0];        // the residual is the V-cycle's right-hand side,
   const Block& z = w.x[0];  // and its output the preconditioned residual
   r = b0;
@@ -480,7 +462,7 @@ Eigen::MatrixXd amg_pcg(const AmgHierarchy& h, const Eigen::MatrixXd& b0, double
       alpha(c) = rz(c) / pap_total(c);
     }
     ChunkSums rr(n, cols);  // the updates and ‖r‖² in one pass
-    for_chunks(n, [&](Index begin, Index end, Index chunk) {
+    for_row_chunks(n, [&](Index begin, Index end, Index chunk) {
       double* q = rr.at(chunk);
       for (Index i = begin; i < end; ++i)
         for (Index c = 0; c < cols; ++c) {
@@ -502,7 +484,7 @@ Eigen::MatrixXd amg_pcg(const AmgHierarchy& h, const Eigen::MatrixXd& b0, double
       beta(c) = rz_new(c) / rz(c);
       rz(c) = rz_new(c);
     }
-    for_chunks(n, [&](Index begin, Index end, Index) {
+    for_row_chunks(n, [&](Index begin, Index end, Index) {
       for (Index i = begin; i < end; ++i)
         for (Index c = 0; c < cols; ++c) p(i, c) = z(i, c) + beta(c) * p(i, c);
     });

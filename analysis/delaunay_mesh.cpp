@@ -292,25 +292,35 @@ std::vector<std::int32_t> hilbert_order(const std::vector<Eigen::Vector3d>& poin
   return std::vector<std::int32_t>(order.begin(), order.end());
 }
 
+VertexSimplices vertex_simplices(int dim, const std::vector<std::array<std::int32_t, 4>>& simplices,
+                                 std::size_t n_points) {
+  const int nv = dim + 1;
+  VertexSimplices v;  // (a counting sort by vertex)
+  v.offset.assign(n_points + 1, 0);
+  for (const auto& s : simplices)
+    for (int a = 0; a < nv; ++a)
+      ++v.offset[static_cast<std::size_t>(s[static_cast<std::size_t>(a)]) + 1];
+  for (std::size_t i = 0; i < n_points; ++i) v.offset[i + 1] += v.offset[i];
+  v.simplex.resize(static_cast<std::size_t>(v.offset[n_points]));
+  v.vertex.resize(v.simplex.size());
+  std::vector<std::int64_t> fill(v.offset.begin(), v.offset.end() - 1);
+  for (std::size_t k = 0; k < simplices.size(); ++k)
+    for (int a = 0; a < nv; ++a) {
+      const auto e = static_cast<std::size_t>(
+          fill[static_cast<std::size_t>(simplices[k][static_cast<std::size_t>(a)])]++);
+      v.simplex[e] = static_cast<std::int32_t>(k);
+      v.vertex[e] = static_cast<std::int8_t>(a);
+    }
+  return v;
+}
+
 VertexRings vertex_rings(int dim, const std::vector<std::array<std::int32_t, 4>>& simplices,
                          std::size_t n_points) {
   const int nv = dim + 1;
-  // The simplices at each vertex (counting sort), then each vertex's ring from them on the
-  // threads: the other vertices, deduplicated with a marker, sorted.
-  std::vector<std::int64_t> offset(n_points + 1, 0);
-  for (const auto& s : simplices)
-    for (int a = 0; a < nv; ++a)
-      ++offset[static_cast<std::size_t>(s[static_cast<std::size_t>(a)]) + 1];
-  for (std::size_t i = 0; i < n_points; ++i) offset[i + 1] += offset[i];
-  std::vector<std::int32_t> at(static_cast<std::size_t>(offset[n_points]));
-  {
-    std::vector<std::int64_t> fill(offset.begin(), offset.end() - 1);
-    for (std::size_t k = 0; k < simplices.size(); ++k)
-      for (int a = 0; a < nv; ++a)
-        at[static_cast<std::size_t>(
-            fill[static_cast<std::size_t>(simplices[k][static_cast<std::size_t>(a)])]++)] =
-            static_cast<std::int32_t>(k);
-  }
+  // The simplices at each vertex, then each vertex's ring from them on the threads: the other
+  // vertices, deduplicated with a marker, sorted.
+  const VertexSimplices at = vertex_simplices(dim, simplices, n_points);
+  const std::vector<std::int64_t>& offset = at.offset;
   const auto n = static_cast<std::ptrdiff_t>(n_points);
   int threads = 1;
 #ifdef _OPENMP
@@ -332,7 +342,8 @@ VertexRings vertex_rings(int dim, const std::vector<std::array<std::int32_t, 4>>
       const auto begin = out.size();
       for (auto e = offset[static_cast<std::size_t>(i)];
            e < offset[static_cast<std::size_t>(i) + 1]; ++e) {
-        const auto& s = simplices[static_cast<std::size_t>(at[static_cast<std::size_t>(e)])];
+        const auto& s =
+            simplices[static_cast<std::size_t>(at.simplex[static_cast<std::size_t>(e)])];
         for (int b = 0; b < nv; ++b) {
           const std::int32_t j = s[static_cast<std::size_t>(b)];
           if (j == i || mark[static_cast<std::size_t>(j)] == i) continue;

@@ -54,6 +54,17 @@ double triangle_quality(const std::array<Eigen::Vector2d, 3>& x, double area);
 /// this order keeps sparse-matrix rows and the vectors they touch close in memory.
 std::vector<std::int32_t> hilbert_order(const std::vector<Eigen::Vector3d>& points, int dim);
 
+/// The simplices at each vertex of a mesh of `dim`-simplices, in simplex order: vertex i's are
+/// simplex[e] (where it is vertex[e], 0..dim) for e in [offset[i], offset[i+1]). `n_points` >=
+/// every vertex index + 1.
+struct VertexSimplices {
+  std::vector<std::int64_t> offset;
+  std::vector<std::int32_t> simplex;
+  std::vector<std::int8_t> vertex;
+};
+VertexSimplices vertex_simplices(int dim, const std::vector<std::array<std::int32_t, 4>>& simplices,
+                                 std::size_t n_points);
+
 /// Vertex 1-rings of a mesh of `dim`-simplices (the Delaunay edges) in compressed rows: the
 /// neighbours of vertex i are index[offset[i] .. offset[i+1]), sorted ascending. `n_points` >=
 /// every vertex index + 1.

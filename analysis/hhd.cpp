@@ -80,41 +80,32 @@ std::vector<int> unknown_index(const HhdMesh& m, const P1Geometry& g, int& count
   return idx;
 }
 
-// The simplices of positive measure around each unknown, in simplex order: unknown i's are
-// (simplex[e], its vertex[e]) for e in [offset[i], offset[i + 1]). Row-wise loops over it give
-// each row's sums in simplex order, whatever the number of threads.
+// The simplices around each unknown: those of its node point[i] (delaunay_mesh's
+// vertex_simplices), in simplex order; the loops over them skip the ones of zero measure.
+// Row-wise loops give each row's sums in simplex order, whatever the number of threads.
 struct Incidence {
-  std::vector<std::int64_t> offset;
-  std::vector<std::int32_t> simplex;
-  std::vector<std::int8_t> vertex;
+  VertexSimplices at;
+  std::vector<int> point;
 };
 
-Incidence incidence(const HhdMesh& m, const P1Geometry& g, const std::vector<int>& idx, int n) {
-  Incidence inc;
-  inc.offset.assign(static_cast<std::size_t>(n) + 1, 0);
-  const int nv = vertices_of(m);
-  for (std::size_t k = 0; k < m.simplices.size(); ++k) {
-    if (!(g.measure[k] > 0.0)) continue;
-    for (int a = 0; a < nv; ++a) {
-      const int i = idx[static_cast<std::size_t>(m.simplices[k][static_cast<std::size_t>(a)])];
-      if (i >= 0) ++inc.offset[static_cast<std::size_t>(i) + 1];
-    }
-  }
-  for (std::size_t i = 0; i < static_cast<std::size_t>(n); ++i) inc.offset[i + 1] += inc.offset[i];
-  inc.simplex.resize(static_cast<std::size_t>(inc.offset.back()));
-  inc.vertex.resize(inc.simplex.size());
-  std::vector<std::int64_t> fill(inc.offset.begin(), inc.offset.end() - 1);
-  for (std::size_t k = 0; k < m.simplices.size(); ++k) {
-    if (!(g.measure[k] > 0.0)) continue;
-    for (int a = 0; a < nv; ++a) {
-      const int i = idx[static_cast<std::size_t>(m.simplices[k][static_cast<std::size_t>(a)])];
-      if (i < 0) continue;
-      const auto e = static_cast<std::size_t>(fill[static_cast<std::size_t>(i)]++);
-      inc.simplex[e] = static_cast<std::int32_t>(k);
-      inc.vertex[e] = static_cast<std::int8_t>(a);
-    }
-  }
+Incidence incidence(const HhdMesh& m, const std::vector<int>& idx, int n) {
+  Incidence inc{vertex_simplices(m.dim, m.simplices, m.points.size()),
+                std::vector<int>(static_cast<std::size_t>(n))};
+  for (std::size_t p = 0; p < idx.size(); ++p)
+    if (idx[p] >= 0) inc.point[static_cast<std::size_t>(idx[p])] = static_cast<int>(p);
   return inc;
+}
+
+// f(k, |T_k|, (∇φ_i)_k) for every simplex k of positive measure at unknown i, in simplex order.
+template <class F>
+void for_each_simplex(const Incidence& inc, const P1Geometry& g, int i, F&& f) {
+  const auto p = static_cast<std::size_t>(inc.point[static_cast<std::size_t>(i)]);
+  for (auto e = inc.at.offset[p]; e < inc.at.offset[p + 1]; ++e) {
+    const auto k = static_cast<std::size_t>(inc.at.simplex[static_cast<std::size_t>(e)]);
+    const double w = g.measure[k];
+    if (w > 0.0)
+      f(k, w, g.gradient[k][static_cast<std::size_t>(inc.at.vertex[static_cast<std::size_t>(e)])]);
+  }
 }
 
 // Right-hand sides over the unknowns. bu: Σ_k |T_k| ∇φ_i·fu(k) (eq 17 with fu = ξ). b18:
@@ -127,13 +118,8 @@ void right_hand_sides(const HhdMesh& m, const P1Geometry& g, const Incidence& in
   bu = Eigen::VectorXd::Zero(n);
   b18 = Eigen::MatrixXd::Zero(n, nv);
 #pragma omp parallel for schedule(static)
-  for (int i = 0; i < n; ++i) {
-    const auto ii = static_cast<std::size_t>(i);
-    for (auto e = inc.offset[ii]; e < inc.offset[ii + 1]; ++e) {
-      const auto k = static_cast<std::size_t>(inc.simplex[static_cast<std::size_t>(e)]);
-      const double w = g.measure[k];
-      const Eigen::Vector3d& gi =
-          g.gradient[k][static_cast<std::size_t>(inc.vertex[static_cast<std::size_t>(e)])];
+  for (int i = 0; i < n; ++i)
+    for_each_simplex(inc, g, i, [&](std::size_t k, double w, const Eigen::Vector3d& gi) {
       const Eigen::Vector3d a = fu(k), b = fv(k);
       bu(i) += w * gi.dot(a);
       if (nv == 3) {
@@ -141,8 +127,7 @@ void right_hand_sides(const HhdMesh& m, const P1Geometry& g, const Incidence& in
       } else {
         b18(i, 0) += w * cross_z(gi, b);
       }
-    }
-  }
+    });
 }
 
 // P1 stiffness K_ij = Σ_k |T_k| (∇φ_i)_k·(∇φ_j)_k over the unknowns, full symmetric storage
@@ -165,11 +150,7 @@ SpMat stiffness(const HhdMesh& m, const P1Geometry& g, const std::vector<int>& i
         for (int i = static_cast<int>(lo); i < static_cast<int>(hi); ++i) {
           const auto ii = static_cast<std::size_t>(i);
           row.clear();
-          for (auto e = inc.offset[ii]; e < inc.offset[ii + 1]; ++e) {
-            const auto k = static_cast<std::size_t>(inc.simplex[static_cast<std::size_t>(e)]);
-            const double w = g.measure[k];
-            const Eigen::Vector3d& ga =
-                g.gradient[k][static_cast<std::size_t>(inc.vertex[static_cast<std::size_t>(e)])];
+          for_each_simplex(inc, g, i, [&](std::size_t k, double w, const Eigen::Vector3d& ga) {
             for (int b = 0; b < nvert; ++b) {
               const int j =
                   idx[static_cast<std::size_t>(m.simplices[k][static_cast<std::size_t>(b)])];
@@ -184,7 +165,7 @@ SpMat stiffness(const HhdMesh& m, const P1Geometry& g, const std::vector<int>& i
                 row[static_cast<std::size_t>(pos[static_cast<std::size_t>(j)])].second += value;
               }
             }
-          }
+          });
           std::sort(row.begin(), row.end(),
                     [](const auto& x, const auto& y) { return x.first < y.first; });
           for (const auto& [j, value] : row) {
@@ -398,15 +379,13 @@ Rows3 apply_blocks(const std::vector<Eigen::Matrix3d>& d, const Rows3& r) {
 }
 
 // Σ over [0, n) of f(begin, end) (N sums) taken per chunk of rows on the threads, then over the
-// chunks in order: the same bits for any number of threads.
+// chunks in order (thread_rows.hpp): the same bits for any number of threads.
 template <std::size_t N, class F>
 std::array<double, N> chunked_sums(Eigen::Index n, F&& f) {
-  constexpr Eigen::Index chunk = 2048;
-  const Eigen::Index nc = (n + chunk - 1) / chunk;
-  std::vector<std::array<double, N>> part(static_cast<std::size_t>(nc));
-#pragma omp parallel for schedule(static)
-  for (Eigen::Index k = 0; k < nc; ++k)
-    part[static_cast<std::size_t>(k)] = f(k * chunk, std::min(n, (k + 1) * chunk));
+  std::vector<std::array<double, N>> part(static_cast<std::size_t>(row_chunks(n)));
+  for_row_chunks(n, [&](Eigen::Index lo, Eigen::Index hi, Eigen::Index k) {
+    part[static_cast<std::size_t>(k)] = f(lo, hi);
+  });
   std::array<double, N> sum{};
   for (const auto& x : part)
     for (std::size_t q = 0; q < N; ++q) sum[q] += x[q];
@@ -736,7 +715,7 @@ HhdResult helmholtz_hodge(const HhdMesh& m, const std::vector<Eigen::Vector3d>& 
     for (auto& x : r.xi) x.z() = 0.0;
   Eigen::VectorXd bu;
   Eigen::MatrixXd b18;
-  const Incidence inc = incidence(m, g, idx, n);
+  const Incidence inc = incidence(m, idx, n);
   {
     const auto field = [&](std::size_t k) { return r.xi[k]; };
     right_hand_sides(m, g, inc, n, field, field, bu, b18);

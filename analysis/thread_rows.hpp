@@ -1,8 +1,11 @@
-// Sparse matrices assembled row by row on threads: each thread builds a contiguous range of rows
-// into its own column and value lists; this joins them into one compressed matrix.
+// Rows on the threads. Sparse matrices assembled row by row: each thread builds a contiguous range
+// of rows into its own column and value lists, joined into one compressed matrix. Sums over rows
+// in fixed chunks: taken per chunk, then over the chunks in order, they have the same bits for
+// any number of threads.
 #pragma once
 
 #include <Eigen/Sparse>
+#include <algorithm>
 #include <cstddef>
 #include <vector>
 
@@ -11,6 +14,23 @@
 #endif
 
 namespace gs::analysis {
+
+/// Rows go to the threads in chunks of this many.
+inline constexpr Eigen::Index kRowChunk = 2048;
+/// Below this many rows the threads are not woken.
+inline constexpr Eigen::Index kParallelRows = 8192;
+
+inline Eigen::Index row_chunks(Eigen::Index n) {
+  return (n + kRowChunk - 1) / kRowChunk;
+}
+
+/// f(begin, end, chunk) for every chunk of the rows [0, n), the chunks on the threads.
+template <class F>
+void for_row_chunks(Eigen::Index n, F&& f) {
+  const Eigen::Index nc = row_chunks(n);
+#pragma omp parallel for schedule(static) if (n >= kParallelRows)
+  for (Eigen::Index k = 0; k < nc; ++k) f(k * kRowChunk, std::min(n, (k + 1) * kRowChunk), k);
+}
 
 /// `outer[i + 1]` holds the number of entries of row i (outer[0] = 0); `inner[t]` and `value[t]`
 /// the entries of thread t's rows, in row order, threads in row order. Returns the compressed

@@ -59,7 +59,8 @@ void add_field_options(CLI::App* s, FieldArgs& a) {
       "gauge as a penalty) | ldlt (path c) | cg (path b, AMG-preconditioned CG) | bicgstab "
       "(path a: eq 17-18 as written, the paper's)");
   s->add_option("--tolerance", a.tolerance,
-                "iterative solvers: relative residual (projection 1e-7, cg and bicgstab 1e-10)");
+                "iterative solvers: relative residual (projection-amg and projection 1e-7, cg and "
+                "bicgstab 1e-10)");
   s->add_option("--max-iterations", a.max_iterations, "iterative solvers (10000)");
   s->add_option("--axis", a.axis,
                 "3D: out-of-plane axis x y z giving the handedness of vortices (default z, or the "
