@@ -51,9 +51,10 @@ using AmgBlock = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::Ro
 struct AmgWorkspace {
   std::vector<AmgBlock> x, b, t;
 };
-/// amg_vcycle for a row-major block (no change of layout): x ≈ A⁻¹b, the same bits; `w` holds
-/// the blocks between calls.
-void amg_vcycle(const AmgHierarchy& h, const Eigen::Ref<const AmgBlock>& b, AmgBlock& x,
+/// amg_vcycle for a row-major block (no change of layout, no copy: x may be any row-major
+/// matrix of b's size, such as an N×3 one): x ≈ A⁻¹b, the same bits; `w` holds the blocks
+/// between calls. Throws std::invalid_argument when x is not b's size.
+void amg_vcycle(const AmgHierarchy& h, const Eigen::Ref<const AmgBlock>& b, Eigen::Ref<AmgBlock> x,
                 AmgWorkspace& w);
 
 /// Conjugate gradients on A x = b (A: the matrix the hierarchy was built from) for every column

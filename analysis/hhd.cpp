@@ -16,6 +16,7 @@
 #include <string>
 
 #include "aggregation_amg.hpp"
+#include "curl_curl_operator.hpp"
 #include "delaunay_mesh.hpp"
 #include "thread_rows.hpp"
 
@@ -228,119 +229,54 @@ SpMat curl_curl_eq18(const HhdMesh& m, const P1Geometry& g, const std::vector<in
   return a;
 }
 
-// Vectors over the unknowns with a node's three components side by side.
-using Rows3 = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
-
-// A = CᵀMC (the matrix of eq 18 up to its sign), matrix-free, laid out for its products: the
-// tetrahedra of positive measure in the order of their smallest unknown (the unknowns follow a
-// Hilbert curve, so consecutive tetrahedra read and write nearby rows), each with its four
-// unknowns (−1: a Dirichlet node), |T_k| and ∇φ_1..3.
-struct CurlCurl {
-  std::vector<std::array<int, 4>> node;
-  std::vector<double> measure;
-  // ∇φ_1..3 (9 values); ∇φ_0 = −∇φ_1 − ∇φ_2 − ∇φ_3, summed as p1_geometry sums it (the same
-  // bits): 96 bytes a tetrahedron to stream per product instead of 120.
-  std::vector<std::array<double, 9>> gradient;
-};
-
-CurlCurl curl_curl_operator(const HhdMesh& m, const P1Geometry& g, const std::vector<int>& idx) {
-  std::vector<std::pair<int, std::int32_t>> order;  // (smallest unknown, simplex)
-  order.reserve(m.simplices.size());
-  for (std::size_t k = 0; k < m.simplices.size(); ++k) {
+// A = CᵀMC (the matrix of eq 18 up to its sign), laid out for its products: the tetrahedra of
+// positive measure in the order of their smallest unknown (the unknowns follow a Hilbert curve,
+// so consecutive tetrahedra read and write nearby rows), each with its four unknowns (−1: a
+// Dirichlet node), |T_k| and ∇φ_1..3 (∇φ_0 = −∇φ_1 − ∇φ_2 − ∇φ_3, summed as p1_geometry sums
+// it: the same bits).
+CurlCurlOperator curl_curl_operator(const HhdMesh& m, const P1Geometry& g,
+                                    const std::vector<int>& idx, Eigen::Index n) {
+  // Stable counting sort by the smallest unknown (simplices of one key in simplex order).
+  const auto ns = static_cast<std::ptrdiff_t>(m.simplices.size());
+  std::vector<int> first(m.simplices.size(), -1);
+#pragma omp parallel for schedule(static)
+  for (std::ptrdiff_t kk = 0; kk < ns; ++kk) {
+    const auto k = static_cast<std::size_t>(kk);
     if (!(g.measure[k] > 0.0)) continue;
-    int first = std::numeric_limits<int>::max();
+    int f = std::numeric_limits<int>::max();
     for (std::size_t a = 0; a < 4; ++a) {
       const int j = idx[static_cast<std::size_t>(m.simplices[k][a])];
-      if (j >= 0) first = std::min(first, j);
+      if (j >= 0) f = std::min(f, j);
     }
-    if (first != std::numeric_limits<int>::max())
-      order.emplace_back(first, static_cast<std::int32_t>(k));
+    if (f != std::numeric_limits<int>::max()) first[k] = f;
   }
-  std::sort(order.begin(), order.end());
-  CurlCurl op;
-  op.node.resize(order.size());
-  op.measure.resize(order.size());
-  op.gradient.resize(order.size());
-  for (std::size_t e = 0; e < order.size(); ++e) {
-    const auto k = static_cast<std::size_t>(order[e].second);
-    for (std::size_t a = 0; a < 4; ++a)
-      op.node[e][a] = idx[static_cast<std::size_t>(m.simplices[k][a])];
-    op.measure[e] = g.measure[k];
-    for (std::size_t a = 1; a < 4; ++a)
-      for (std::size_t q = 0; q < 3; ++q) op.gradient[e][3 * (a - 1) + q] = g.gradient[k][a][q];
+  std::vector<std::size_t> start(static_cast<std::size_t>(n) + 1, 0);
+  for (const int f : first)
+    if (f >= 0) ++start[static_cast<std::size_t>(f) + 1];
+  for (std::size_t i = 0; i < static_cast<std::size_t>(n); ++i) start[i + 1] += start[i];
+  std::vector<std::int32_t> order(start.back());
+  for (std::size_t k = 0; k < first.size(); ++k)
+    if (first[k] >= 0)
+      order[start[static_cast<std::size_t>(first[k])]++] = static_cast<std::int32_t>(k);
+  CurlCurlOperator op(order.size());
+  const auto nb = static_cast<std::ptrdiff_t>(op.blocks.size());
+#pragma omp parallel for schedule(static)
+  for (std::ptrdiff_t bb = 0; bb < nb; ++bb) {
+    const auto lo = static_cast<std::size_t>(bb) * CurlCurlOperator::kLanes;
+    const std::size_t hi = std::min(order.size(), lo + CurlCurlOperator::kLanes);
+    for (std::size_t e = lo; e < hi; ++e) {
+      const auto k = static_cast<std::size_t>(order[e]);
+      std::array<int, 4> node{};
+      for (std::size_t a = 0; a < 4; ++a)
+        node[a] = idx[static_cast<std::size_t>(m.simplices[k][a])];
+      std::array<double, 9> gradient{};
+      for (std::size_t a = 1; a < 4; ++a)
+        for (std::size_t q = 0; q < 3; ++q)
+          gradient[3 * (a - 1) + q] = g.gradient[k][a][static_cast<Eigen::Index>(q)];
+      op.set(e, node, g.measure[k], gradient);
+    }
   }
   return op;
-}
-
-// out = A·V: per tetrahedron c_k = |T_k| Σ_a ∇φ_a × v_a, then row i gets c_k × ∇φ_i. Each thread
-// sums a fixed range of tetrahedra into its own buffer (`part`, kept by the caller between
-// products: at 10⁶ nodes fresh buffers cost more in page faults than the product) and the
-// buffers are added in thread order, so the result does not depend on the scheduling.
-void apply_curl_curl(const CurlCurl& op, const Rows3& v, Rows3& result, std::vector<Rows3>& part) {
-  const Eigen::Index n = v.rows();
-  const auto ns = static_cast<std::ptrdiff_t>(op.node.size());
-  int threads = 1;
-#ifdef _OPENMP
-  threads = omp_get_max_threads();
-#endif
-  part.resize(static_cast<std::size_t>(threads));
-#pragma omp parallel num_threads(threads)
-  {
-    int t = 0;
-#ifdef _OPENMP
-    t = omp_get_thread_num();
-#endif
-    Rows3& out = t == 0 ? result : part[static_cast<std::size_t>(t)];
-    out.setZero(n, 3);
-    const std::ptrdiff_t lo = ns * t / threads, hi = ns * (t + 1) / threads;
-    static constexpr double zero[3] = {0.0, 0.0, 0.0};
-    const double* vd = v.data();
-    double* od = out.data();
-    for (std::ptrdiff_t kk = lo; kk < hi; ++kk) {
-      const auto k = static_cast<std::size_t>(kk);
-      const auto& j = op.node[k];
-      const double* g = op.gradient[k].data();  // ∇φ_1, ∇φ_2, ∇φ_3
-      // Σ_a ∇φ_a × v_a = Σ_{a≥1} ∇φ_a × (v_a − v_0), since ∇φ_0 = −Σ_{a≥1} ∇φ_a.
-      const double* v0 = j[0] >= 0 ? vd + 3 * j[0] : zero;
-      double c[3] = {0.0, 0.0, 0.0};
-      for (std::size_t a = 1; a < 4; ++a) {
-        const double* va = j[a] >= 0 ? vd + 3 * j[a] : zero;
-        const double* ga = g + 3 * (a - 1);
-        const double d0 = va[0] - v0[0], d1 = va[1] - v0[1], d2 = va[2] - v0[2];
-        c[0] += ga[1] * d2 - ga[2] * d1;
-        c[1] += ga[2] * d0 - ga[0] * d2;
-        c[2] += ga[0] * d1 - ga[1] * d0;
-      }
-      const double w = op.measure[k];
-      c[0] *= w;
-      c[1] *= w;
-      c[2] *= w;
-      // Row a gets c × ∇φ_a; row 0 minus their sum.
-      double s[3] = {0.0, 0.0, 0.0};
-      for (std::size_t a = 1; a < 4; ++a) {
-        const double* ga = g + 3 * (a - 1);
-        const double e0 = c[1] * ga[2] - c[2] * ga[1];
-        const double e1 = c[2] * ga[0] - c[0] * ga[2];
-        const double e2 = c[0] * ga[1] - c[1] * ga[0];
-        s[0] += e0;
-        s[1] += e1;
-        s[2] += e2;
-        if (j[a] >= 0) {
-          double* o = od + 3 * j[a];
-          o[0] += e0;
-          o[1] += e1;
-          o[2] += e2;
-        }
-      }
-      if (j[0] >= 0) {
-        double* o = od + 3 * j[0];
-        o[0] -= s[0];
-        o[1] -= s[1];
-        o[2] -= s[2];
-      }
-    }
-  }
-  for (std::size_t t = 1; t < part.size(); ++t) result += part[t];
 }
 
 // The 3×3 diagonal blocks of A, Σ_k |T_k| (|∇φ_i|² I − ∇φ_i ∇φ_iᵀ), inverted (pseudo-inverse
@@ -359,7 +295,9 @@ std::vector<Eigen::Matrix3d> curl_curl_block_inverses(const HhdMesh& m, const P1
           w * (gi.squaredNorm() * Eigen::Matrix3d::Identity() - gi * gi.transpose());
     }
   }
-  for (auto& b : d) {
+#pragma omp parallel for schedule(static)
+  for (int i = 0; i < n; ++i) {
+    Eigen::Matrix3d& b = d[static_cast<std::size_t>(i)];
     const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(b);
     const Eigen::Vector3d ev = es.eigenvalues();
     Eigen::Vector3d inv = Eigen::Vector3d::Zero();
@@ -428,7 +366,7 @@ Eigen::MatrixXd projection_pcg(const HhdMesh& m, const P1Geometry& g, const std:
   const double bnorm = b.norm();
   if (bnorm == 0.0) return Eigen::MatrixXd(v);
   const auto d = curl_curl_block_inverses(m, g, idx, static_cast<int>(n));
-  const CurlCurl op = curl_curl_operator(m, g, idx);
+  const CurlCurlOperator op = curl_curl_operator(m, g, idx, n);
   auto dot = [n](const Rows3& x, const Rows3& y) {
     return chunked_sum(n, [&](Eigen::Index lo, Eigen::Index hi) {
       double s = 0.0;
@@ -787,13 +725,7 @@ HhdResult helmholtz_hodge(const HhdMesh& m, const std::vector<Eigen::Vector3d>& 
       if (m.dim == 3) {
         r.report.iterations_v = 0;
         AmgWorkspace w;
-        AmgBlock z;
-        project(
-            [&](const Rows3& q, Rows3& out) {
-              amg_vcycle(h, q, z, w);
-              out = z;
-            },
-            true);
+        project([&](const Rows3& q, Rows3& out) { amg_vcycle(h, q, out, w); }, true);
       } else {
         r.report.tolerance = std::min(tolerance, kHhdTolerance);  // (no projection iterations)
       }

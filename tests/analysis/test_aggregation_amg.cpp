@@ -129,6 +129,29 @@ TEST(AggregationAmg, GalerkinCoarseMatricesAndColumnsSolvedAsAlone) {
   }
 }
 
+TEST(AggregationAmg, VcycleWritesIntoAnyRowMajorBlockOfTheRightSize) {
+  const SpMat a = grid_laplacian(20, 1.0);
+  const AmgHierarchy h = build_amg(a);
+  ASSERT_GE(h.levels.size(), 2u);
+  // Three and four columns (the vector row sums) give each column's one-column cycle (the
+  // scalar loop), written straight into an N×3 matrix or a block.
+  const Eigen::MatrixXd b = random_columns(a.rows(), 4, 21);
+  AmgWorkspace w;
+  Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> x3(a.rows(), 3);
+  amg_vcycle(h, AmgBlock(b.leftCols(3)), x3, w);
+  AmgBlock x4(a.rows(), 4);
+  amg_vcycle(h, AmgBlock(b), x4, w);
+  for (int c = 0; c < 4; ++c) {
+    const Eigen::MatrixXd alone = amg_vcycle(h, Eigen::MatrixXd(b.col(c)));
+    EXPECT_EQ(Eigen::VectorXd(x4.col(c)), Eigen::VectorXd(alone.col(0))) << "column " << c;
+    if (c < 3) {
+      EXPECT_EQ(Eigen::VectorXd(x3.col(c)), Eigen::VectorXd(alone.col(0))) << "column " << c;
+    }
+  }
+  AmgBlock wrong(a.rows(), 2);
+  EXPECT_THROW(amg_vcycle(h, AmgBlock(b.leftCols(3)), wrong, w), std::invalid_argument);
+}
+
 TEST(AggregationAmg, SmallMatrixIsSolvedDirectly) {
   const SpMat a = grid_laplacian(5, 1.0);  // 125 unknowns: below the coarsest size
   const AmgHierarchy h = build_amg(a);

@@ -473,6 +473,20 @@ mass = "union"
   expect_same_run(dir / "one" / "rods.h5", resumed / "rods.h5");
 }
 
+/// Waits (up to a minute) until no process holds the run directory's lock: a process of a job
+/// whose launcher was stopped may still be ending.
+void wait_unlocked(const fs::path& dir) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (std::chrono::steady_clock::now() < deadline) {
+    const int fd = ::open((dir / ".simulate.lock").c_str(), O_RDWR | O_CLOEXEC);
+    if (fd < 0) return;
+    const bool free = ::flock(fd, LOCK_EX | LOCK_NB) == 0;
+    ::close(fd);
+    if (free) return;
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+}
+
 // A checkpoint is one process's format whatever wrote it: a two-process run stopped after a
 // checkpoint resumes on one process, and a one-process run's on two, to the uninterrupted run.
 TEST(Mpi, CheckpointsResumeOnAnyNumberOfProcesses) {
@@ -488,6 +502,9 @@ TEST(Mpi, CheckpointsResumeOnAnyNumberOfProcesses) {
       << "the run ended before it could be stopped";
   ASSERT_TRUE(gs::test::stop_at_checkpoint(words(kExe + args + one_then_two.string()), one_then_two,
                                            3000, SIGTERM));
+  // (mpirun returns before its processes have all ended; the resume needs the directory's lock)
+  wait_unlocked(two_then_one);
+  wait_unlocked(one_then_two);
   std::string err;
   ASSERT_EQ(run(kExe + args + two_then_one.string() + " --resume", &err), 0) << err;
   ASSERT_EQ(run(kMpirun + "2 " + kExe + args + one_then_two.string() + " --resume", &err), 0)
@@ -506,20 +523,6 @@ std::vector<std::string> removal_columns(const fs::path& history) {
     if (a != std::string::npos) out.push_back(line.substr(a + 1));
   }
   return out;
-}
-
-/// Waits (up to a minute) until no process holds the run directory's lock: a process of a job
-/// whose launcher was stopped may still be ending.
-void wait_unlocked(const fs::path& dir) {
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
-  while (std::chrono::steady_clock::now() < deadline) {
-    const int fd = ::open((dir / ".simulate.lock").c_str(), O_RDWR | O_CLOEXEC);
-    if (fd < 0) return;
-    const bool free = ::flock(fd, LOCK_EX | LOCK_NB) == 0;
-    ::close(fd);
-    if (free) return;
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
-  }
 }
 
 /// A scene with an outlet on one process, then on each of `processes`, then on two stopped
