@@ -40,16 +40,21 @@ Sparse join_thread_rows(Eigen::Index rows, Eigen::Index cols, std::vector<int>& 
                         const std::vector<std::vector<int>>& inner,
                         const std::vector<std::vector<double>>& value) {
   for (std::size_t i = 0; i + 1 < outer.size(); ++i) outer[i + 1] += outer[i];
-  std::vector<int> all_inner;
-  std::vector<double> all_value;
-  all_inner.reserve(static_cast<std::size_t>(outer.back()));
-  all_value.reserve(static_cast<std::size_t>(outer.back()));
-  for (std::size_t t = 0; t < inner.size(); ++t) {
-    all_inner.insert(all_inner.end(), inner[t].begin(), inner[t].end());
-    all_value.insert(all_value.end(), value[t].begin(), value[t].end());
+  // Written straight into the matrix's arrays (a join and a copy of a map would touch the
+  // entries twice more: at 5.6e4 nodes, 10 MB of fresh pages each).
+  Sparse m(rows, cols);
+  m.resizeNonZeros(outer.back());
+  std::copy(outer.begin(), outer.end(), m.outerIndexPtr());
+  std::vector<std::size_t> offset(inner.size() + 1, 0);
+  for (std::size_t t = 0; t < inner.size(); ++t) offset[t + 1] = offset[t] + inner[t].size();
+  const auto threads = static_cast<std::ptrdiff_t>(inner.size());
+#pragma omp parallel for schedule(static)
+  for (std::ptrdiff_t tt = 0; tt < threads; ++tt) {
+    const auto t = static_cast<std::size_t>(tt);
+    std::copy(inner[t].begin(), inner[t].end(), m.innerIndexPtr() + offset[t]);
+    std::copy(value[t].begin(), value[t].end(), m.valuePtr() + offset[t]);
   }
-  return Sparse(Eigen::Map<const Sparse>(rows, cols, outer.back(), outer.data(), all_inner.data(),
-                                         all_value.data()));
+  return m;
 }
 
 /// Rows [0, rows) built on `threads` threads in contiguous ranges: build(lo, hi, inner, value,
