@@ -53,7 +53,9 @@ struct AmgWorkspace {
 };
 /// amg_vcycle for a row-major block (no change of layout, no copy: x may be any row-major
 /// matrix of b's size, such as an N×3 one): x ≈ A⁻¹b, the same bits; `w` holds the blocks
-/// between calls. Throws std::invalid_argument when x is not b's size.
+/// between calls; x must not share storage with b. The row sums of three or four columns use
+/// AVX2 where the CPU has it (GS_SIMD=generic: the plain loop; the same bits either way). Throws
+/// std::invalid_argument when x is not b's size.
 void amg_vcycle(const AmgHierarchy& h, const Eigen::Ref<const AmgBlock>& b, Eigen::Ref<AmgBlock> x,
                 AmgWorkspace& w);
 
