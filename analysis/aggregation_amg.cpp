@@ -6,13 +6,12 @@
 // pass over a matrix serves all of them; rows go to the threads, and each row's sums are taken in
 // the matrix's order whatever the number of threads or columns (the same bits).
 #include "aggregation_amg.hpp"
+#include "simd_choice.hpp"
 #include "thread_rows.hpp"
 
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <cstdlib>
-#include <cstring>
 #include <stdexcept>
 #include <string>
 
@@ -84,13 +83,6 @@ __attribute__((target("avx2"))) void row_sums_avx2(const int* outer, const int* 
 
 #undef GS_LOAD
 
-bool amg_avx2() {
-  static const bool ok = [] {
-    const char* s = std::getenv("GS_SIMD");
-    return __builtin_cpu_supports("avx2") && !(s && std::strcmp(s, "generic") == 0);
-  }();
-  return ok;
-}
 #else
 #define GS_AMG_X86 0
 #endif
@@ -136,7 +128,8 @@ void for_rows_fixed(const RowMat& a, const Block& x, Ranges&& ranges, Row&& row)
   const Index cols = C > 0 ? C : x.cols();
 #if GS_AMG_X86
   if constexpr (C == 3 || C == 4) {
-    if (amg_avx2()) {
+    static const bool avx2 = simd_allowed(SimdCap::Avx2);
+    if (avx2) {
       ranges([&](Index begin, Index end, Index chunk) {
         constexpr Index kPiece = 256;  // rows a piece: its sums stay in L1
         alignas(32) double s[4 * kPiece];

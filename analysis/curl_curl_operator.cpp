@@ -1,9 +1,9 @@
 // A = CᵀMC of eq 18 (seed 000) applied matrix-free; see curl_curl_operator.hpp.
 #include "curl_curl_operator.hpp"
 
+#include "simd_choice.hpp"
+
 #include <algorithm>
-#include <cstdlib>
-#include <cstring>
 #include <stdexcept>
 #include <string>
 
@@ -43,6 +43,13 @@ void CurlCurlOperator::set(std::size_t e, const std::array<int, 4>& node, double
 }
 
 namespace {
+
+// The lanes [l0, l1) of block bi that lie in the tetrahedra [lo, hi).
+void lane_bounds(std::size_t bi, std::size_t lo, std::size_t hi, int& l0, int& l1) {
+  const std::size_t first = bi * kLanes;
+  l0 = static_cast<int>(std::max(lo, first) - first);
+  l1 = static_cast<int>(std::min(hi, first + kLanes) - first);
+}
 
 bool live(const Block& b, std::size_t a, int lane) {
   return ((b.live[a] >> lane) & 1u) != 0;
@@ -99,9 +106,8 @@ void range_generic(const CurlCurlOperator& op, std::size_t lo, std::size_t hi, c
                    double* od) {
   if (lo >= hi) return;
   for (std::size_t bi = lo / kLanes; bi * kLanes < hi; ++bi) {
-    const std::size_t first = bi * kLanes;
-    const int l0 = static_cast<int>(std::max(lo, first) - first);
-    const int l1 = static_cast<int>(std::min(hi, first + kLanes) - first);
+    int l0 = 0, l1 = 0;
+    lane_bounds(bi, lo, hi, l0, l1);
     block_generic(op.blocks[bi], l0, l1, vd, od);
   }
 }
@@ -118,9 +124,8 @@ __attribute__((target("avx512f"))) void range_avx512(const CurlCurlOperator& op,
   const __m512d zero = _mm512_setzero_pd();
   for (std::size_t bi = lo / kLanes; bi * kLanes < hi; ++bi) {
     const Block& b = op.blocks[bi];
-    const std::size_t first = bi * kLanes;
-    const int l0 = static_cast<int>(std::max(lo, first) - first);
-    const int l1 = static_cast<int>(std::min(hi, first + kLanes) - first);
+    int l0 = 0, l1 = 0;
+    lane_bounds(bi, lo, hi, l0, l1);
     __m512d v0[3], c[3] = {zero, zero, zero};
     {
       const __m256i idx = _mm256_load_si256(reinterpret_cast<const __m256i*>(b.offset[0]));
@@ -176,14 +181,6 @@ __attribute__((target("avx512f"))) void range_avx512(const CurlCurlOperator& op,
 }
 #endif
 
-bool avx512_wanted() {
-  static const bool wanted = [] {
-    const char* s = std::getenv("GS_SIMD");
-    return !(s && (std::strcmp(s, "generic") == 0 || std::strcmp(s, "avx2") == 0));
-  }();
-  return wanted;
-}
-
 }  // namespace
 
 bool curl_curl_avx512_supported() {
@@ -199,9 +196,8 @@ void apply_curl_curl(const CurlCurlOperator& op, const Rows3& v, Rows3& result,
                      std::vector<Rows3>& part, CurlCurlKernel kernel) {
   if (kernel == CurlCurlKernel::Avx512 && !curl_curl_avx512_supported())
     throw std::invalid_argument("the AVX-512 curl-curl kernel needs a CPU with AVX-512F");
-  const bool vector =
-      kernel == CurlCurlKernel::Avx512 ||
-      (kernel == CurlCurlKernel::Best && curl_curl_avx512_supported() && avx512_wanted());
+  const bool vector = kernel == CurlCurlKernel::Avx512 ||
+                      (kernel == CurlCurlKernel::Best && simd_allowed(SimdCap::Avx512));
   const Eigen::Index n = v.rows();
   const std::size_t ns = op.size;
   int threads = 1;

@@ -308,11 +308,16 @@ std::vector<Eigen::Matrix3d> curl_curl_block_inverses(const HhdMesh& m, const P1
   return d;
 }
 
+// Row i of x times its node's 3×3 block.
+Eigen::RowVector3d block_row(const std::vector<Eigen::Matrix3d>& d, const Rows3& x,
+                             Eigen::Index i) {
+  return (d[static_cast<std::size_t>(i)] * x.row(i).transpose()).transpose();
+}
+
 Rows3 apply_blocks(const std::vector<Eigen::Matrix3d>& d, const Rows3& r) {
   Rows3 z(r.rows(), 3);
 #pragma omp parallel for schedule(static)
-  for (Eigen::Index i = 0; i < r.rows(); ++i)
-    z.row(i) = (d[static_cast<std::size_t>(i)] * r.row(i).transpose()).transpose();
+  for (Eigen::Index i = 0; i < r.rows(); ++i) z.row(i) = block_row(d, r, i);
   return z;
 }
 
@@ -395,8 +400,7 @@ Eigen::MatrixXd projection_pcg(const HhdMesh& m, const P1Geometry& g, const std:
   auto jacobi = [&](const Rows3& x, bool add) {
 #pragma omp parallel for schedule(static)
     for (Eigen::Index i = 0; i < n; ++i) {
-      const Eigen::RowVector3d y =
-          omega * (d[static_cast<std::size_t>(i)] * x.row(i).transpose()).transpose();
+      const Eigen::RowVector3d y = omega * block_row(d, x, i);
       z.row(i) = add ? Eigen::RowVector3d(z.row(i) + y) : y;
     }
   };
@@ -407,8 +411,7 @@ Eigen::MatrixXd projection_pcg(const HhdMesh& m, const P1Geometry& g, const std:
       return chunked_sum(n, [&](Eigen::Index lo, Eigen::Index hi) {
         double s = 0.0;
         for (Eigen::Index i = lo; i < hi; ++i) {
-          z.row(i) = k.row(i) +
-                     omega * (d[static_cast<std::size_t>(i)] * r.row(i).transpose()).transpose();
+          z.row(i) = k.row(i) + omega * block_row(d, r, i);
           s += r.row(i).dot(z.row(i));
         }
         return s;
