@@ -318,35 +318,37 @@ RowMat filtered(const RowMat& a, const std::vector<char>& strong) {
   const int* outer = a.outerIndexPtr();
   const int* inner = a.innerIndexPtr();
   const double* val = a.valuePtr();
-  std::vector<int> fo(static_cast<std::size_t>(n) + 1, 0);
+  RowMat f(n, a.cols());  // (filled in place: compressed, outer index first)
+  int* fo = f.outerIndexPtr();
+  fo[0] = 0;
 #pragma omp parallel for schedule(static) if (a.nonZeros() >= kParallelWork)
   for (Index i = 0; i < n; ++i) {
     int c = 0;
     for (int e = outer[i]; e < outer[i + 1]; ++e)
       c += (strong[static_cast<std::size_t>(e)] || inner[e] == i) ? 1 : 0;
-    fo[static_cast<std::size_t>(i) + 1] = c;
+    fo[i + 1] = c;
   }
-  for (Index i = 0; i < n; ++i)
-    fo[static_cast<std::size_t>(i) + 1] += fo[static_cast<std::size_t>(i)];
-  std::vector<int> fi(static_cast<std::size_t>(fo.back()));
-  std::vector<double> fv(fi.size());
+  for (Index i = 0; i < n; ++i) fo[i + 1] += fo[i];
+  f.resizeNonZeros(fo[n]);
+  int* fi = f.innerIndexPtr();
+  double* fv = f.valuePtr();
 #pragma omp parallel for schedule(static) if (a.nonZeros() >= kParallelWork)
   for (Index i = 0; i < n; ++i) {
     double lumped = 0.0;
     for (int e = outer[i]; e < outer[i + 1]; ++e)
       if (inner[e] != i && !strong[static_cast<std::size_t>(e)]) lumped += val[e];
-    int q = fo[static_cast<std::size_t>(i)];
+    int q = fo[i];
     for (int e = outer[i]; e < outer[i + 1]; ++e) {
       if (inner[e] == i) {
-        fi[static_cast<std::size_t>(q)] = inner[e];
-        fv[static_cast<std::size_t>(q++)] = val[e] + lumped;
+        fi[q] = inner[e];
+        fv[q++] = val[e] + lumped;
       } else if (strong[static_cast<std::size_t>(e)]) {
-        fi[static_cast<std::size_t>(q)] = inner[e];
-        fv[static_cast<std::size_t>(q++)] = val[e];
+        fi[q] = inner[e];
+        fv[q++] = val[e];
       }
     }
   }
-  return RowMat(Eigen::Map<const RowMat>(n, a.cols(), fo.back(), fo.data(), fi.data(), fv.data()));
+  return f;
 }
 
 // λ_max(D⁻¹A) by power iteration from a fixed start (a lower bound, close after a few steps).
@@ -477,11 +479,14 @@ AmgHierarchy build_amg(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& 
                                 std::to_string(a0.cols()) + ")");
   AmgHierarchy h;
   h.sweeps = std::max(1, o.sweeps);
+  // (Eigen 3.4's sparse matrices have no move operations: std::move copies them, swap does not;
+  // the levels are filled in place.)
+  h.levels.reserve(static_cast<std::size_t>(std::max(1, o.max_levels)));
   RowMat a = a0;
   a.makeCompressed();
   while (true) {
-    AmgLevel L;
-    L.a = std::move(a);
+    AmgLevel& L = h.levels.emplace_back();
+    L.a.swap(a);
     const Eigen::VectorXd diag = L.a.diagonal();
     if (diag.size() > 0 && !(diag.minCoeff() > 0.0))
       throw std::invalid_argument("AMG: non-positive diagonal entry (" +
@@ -494,10 +499,7 @@ AmgHierarchy build_amg(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& 
       strong = strong_entries(L.a, diag, o.strength);
       agg = aggregates(L.a, strong, nc);
     }
-    if (agg.empty() || nc >= L.a.rows()) {  // (the coarsest level: small, or no coarsening)
-      h.levels.push_back(std::move(L));
-      break;
-    }
+    if (agg.empty() || nc >= L.a.rows()) break;  // (the coarsest level: small, or no coarsening)
     // P = (I − ω_F D_F⁻¹A_F) P_t, P_t the constant on each aggregate, A_F the filtered matrix
     // (which keeps P as local as the aggregates); the next level RᵀAP, R = Pᵀ.
     L.omega = 4.0 / (3.0 * largest_eigenvalue(L.a, L.inv_diag));
@@ -514,12 +516,16 @@ AmgHierarchy build_amg(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& 
     t.reserve(agg.size());
     for (std::size_t i = 0; i < agg.size(); ++i) t.emplace_back(static_cast<int>(i), agg[i], 1.0);
     pt.setFromTriplets(t.begin(), t.end());
-    L.p = multiply(smoother, pt);
+    {
+      RowMat p = multiply(smoother, pt);
+      L.p.swap(p);
+    }
     L.p.prune(0.0);
     L.r = L.p.transpose();
-    a = multiply(L.r, multiply(L.a, L.p));
-    a = 0.5 * (a + RowMat(a.transpose()));  // (symmetric to the last bit: an SPD V-cycle)
-    h.levels.push_back(std::move(L));
+    {
+      RowMat rap = multiply(L.r, multiply(L.a, L.p));
+      a = 0.5 * (rap + RowMat(rap.transpose()));  // (symmetric to the last bit: an SPD V-cycle)
+    }
   }
   h.coarsest.compute(Eigen::MatrixXd(h.levels.back().a));
   if (h.coarsest.info() != Eigen::Success)

@@ -116,19 +116,24 @@ template <class Fu, class Fv>
 void right_hand_sides(const HhdMesh& m, const P1Geometry& g, const Incidence& inc, int n, Fu&& fu,
                       Fv&& fv, Eigen::VectorXd& bu, Eigen::MatrixXd& b18) {
   const int nv = m.dim == 3 ? 3 : 1;
-  bu = Eigen::VectorXd::Zero(n);
-  b18 = Eigen::MatrixXd::Zero(n, nv);
+  bu.resize(n);  // (every row written below)
+  b18.resize(n, nv);
 #pragma omp parallel for schedule(static)
-  for (int i = 0; i < n; ++i)
+  for (int i = 0; i < n; ++i) {
+    double su = 0.0;  // (the sums in registers, written once)
+    Eigen::Vector3d sv = Eigen::Vector3d::Zero();
     for_each_simplex(inc, g, i, [&](std::size_t k, double w, const Eigen::Vector3d& gi) {
       const Eigen::Vector3d a = fu(k), b = fv(k);
-      bu(i) += w * gi.dot(a);
+      su += w * gi.dot(a);
       if (nv == 3) {
-        b18.row(i) += w * gi.cross(b).transpose();
+        sv += w * gi.cross(b);
       } else {
-        b18(i, 0) += w * cross_z(gi, b);
+        sv.x() += w * cross_z(gi, b);
       }
     });
+    bu(i) = su;
+    for (int c = 0; c < nv; ++c) b18(i, c) = sv(c);
+  }
 }
 
 // P1 stiffness K_ij = Σ_k |T_k| (∇φ_i)_k·(∇φ_j)_k over the unknowns, full symmetric storage
