@@ -474,15 +474,19 @@ void cycle(const AmgHierarchy& h, std::size_t l, AmgWorkspace& w, const B& b, Ou
 
 AmgHierarchy build_amg(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& a0,
                        const AmgOptions& o) {
-  if (a0.rows() != a0.cols())
-    throw std::invalid_argument("AMG: matrix not square (" + std::to_string(a0.rows()) + "x" +
-                                std::to_string(a0.cols()) + ")");
+  RowMat a = a0;
+  return build_amg(std::move(a), o);
+}
+
+AmgHierarchy build_amg(RowMat&& a, const AmgOptions& o) {
+  if (a.rows() != a.cols())
+    throw std::invalid_argument("AMG: matrix not square (" + std::to_string(a.rows()) + "x" +
+                                std::to_string(a.cols()) + ")");
   AmgHierarchy h;
   h.sweeps = std::max(1, o.sweeps);
   // (Eigen 3.4's sparse matrices have no move operations: std::move copies them, swap does not;
   // the levels are filled in place.)
   h.levels.reserve(static_cast<std::size_t>(std::max(1, o.max_levels)));
-  RowMat a = a0;
   a.makeCompressed();
   while (true) {
     AmgLevel& L = h.levels.emplace_back();

@@ -39,6 +39,10 @@ struct AmgHierarchy {
 /// matrix that is not square or has a non-positive diagonal entry.
 AmgHierarchy build_amg(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& a,
                        const AmgOptions& options = {});
+/// The same from a row-major matrix given up to the hierarchy (its finest level takes its
+/// storage: no copy; `a` is left empty).
+AmgHierarchy build_amg(Eigen::SparseMatrix<double, Eigen::RowMajor, int>&& a,
+                       const AmgOptions& options = {});
 
 /// One symmetric V-cycle from a zero initial guess applied to each column of b: an SPD
 /// approximation of A⁻¹b (the columns share each pass over the matrices).

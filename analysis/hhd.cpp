@@ -139,20 +139,30 @@ void right_hand_sides(const HhdMesh& m, const P1Geometry& g, const Incidence& in
 // P1 stiffness K_ij = Σ_k |T_k| (∇φ_i)_k·(∇φ_j)_k over the unknowns, full symmetric storage
 // (compressed, inner indices sorted), assembled row by row on the threads: each entry summed in
 // simplex order (exactly symmetric).
-SpMat stiffness(const HhdMesh& m, const P1Geometry& g, const std::vector<int>& idx,
-                const Incidence& inc, int n) {
+template <class Sparse>
+Sparse stiffness(const HhdMesh& m, const P1Geometry& g, const std::vector<int>& idx,
+                 const Incidence& inc, int n) {
   const int nvert = vertices_of(m);
   int threads = 1;
 #ifdef _OPENMP
   threads = omp_get_max_threads();
 #endif
   // Symmetric: the rows are the columns.
-  return assemble_rows<SpMat>(
+  return assemble_rows<Sparse>(
       n, n, threads,
       [&](Eigen::Index lo, Eigen::Index hi, std::vector<int>& c, std::vector<double>& v,
           std::vector<int>& outer) {
         std::vector<int> mark(static_cast<std::size_t>(n), -1), pos(static_cast<std::size_t>(n), 0);
         std::vector<std::pair<int, double>> row;
+        // (room for about as many entries as the rows have simplices, ~1.7 times what a Delaunay
+        // row holds: no regrowth; pages never written are never touched)
+        std::size_t room = 0;
+        for (auto i = lo; i < hi; ++i) {
+          const auto p = static_cast<std::size_t>(inc.point[static_cast<std::size_t>(i)]);
+          room += static_cast<std::size_t>(inc.at.offset[p + 1] - inc.at.offset[p]) + 1;
+        }
+        c.reserve(room);
+        v.reserve(room);
         for (int i = static_cast<int>(lo); i < static_cast<int>(hi); ++i) {
           const auto ii = static_cast<std::size_t>(i);
           row.clear();
@@ -559,11 +569,12 @@ std::vector<Eigen::Vector3d> simplex_mean(const HhdMesh& m,
                                 " for " + std::to_string(m.points.size()) + ")");
   }
   const int nv = vertices_of(m);
-  std::vector<Eigen::Vector3d> xi(m.simplices.size(), Eigen::Vector3d::Zero());
+  std::vector<Eigen::Vector3d> xi(m.simplices.size());  // (first written on the threads)
   const auto ns = static_cast<std::ptrdiff_t>(m.simplices.size());
 #pragma omp parallel for schedule(static)
   for (std::ptrdiff_t kk = 0; kk < ns; ++kk) {
     const auto k = static_cast<std::size_t>(kk);
+    xi[k] = Eigen::Vector3d::Zero();
     for (int a = 0; a < nv; ++a)
       xi[k] += nodal[static_cast<std::size_t>(m.simplices[k][static_cast<std::size_t>(a)])];
     xi[k] /= nv;
@@ -574,11 +585,12 @@ std::vector<Eigen::Vector3d> simplex_mean(const HhdMesh& m,
 
 std::vector<Eigen::Vector3d> p1_gradient(const HhdMesh& m, const P1Geometry& g,
                                          const Eigen::VectorXd& u) {
-  std::vector<Eigen::Vector3d> out(m.simplices.size(), Eigen::Vector3d::Zero());
+  std::vector<Eigen::Vector3d> out(m.simplices.size());  // (first written on the threads)
   const auto ns = static_cast<std::ptrdiff_t>(m.simplices.size());
 #pragma omp parallel for schedule(static)
   for (std::ptrdiff_t kk = 0; kk < ns; ++kk) {
     const auto k = static_cast<std::size_t>(kk);
+    out[k] = Eigen::Vector3d::Zero();
     for (int a = 0; a < vertices_of(m); ++a)
       out[k] += u(m.simplices[k][static_cast<std::size_t>(a)]) *
                 g.gradient[k][static_cast<std::size_t>(a)];
@@ -588,10 +600,11 @@ std::vector<Eigen::Vector3d> p1_gradient(const HhdMesh& m, const P1Geometry& g,
 
 std::vector<Eigen::Vector3d> p1_curl(const HhdMesh& m, const P1Geometry& g,
                                      const Eigen::MatrixXd& v) {
-  std::vector<Eigen::Vector3d> out(m.simplices.size(), Eigen::Vector3d::Zero());
+  std::vector<Eigen::Vector3d> out(m.simplices.size());  // (first written on the threads)
   const auto ns = static_cast<std::ptrdiff_t>(m.simplices.size());
 #pragma omp parallel for schedule(static)
-  for (std::ptrdiff_t kk = 0; kk < ns; ++kk)
+  for (std::ptrdiff_t kk = 0; kk < ns; ++kk) {
+    out[static_cast<std::size_t>(kk)] = Eigen::Vector3d::Zero();
     for (int a = 0; a < vertices_of(m); ++a) {
       const auto k = static_cast<std::size_t>(kk);
       const auto i = m.simplices[k][static_cast<std::size_t>(a)];
@@ -602,6 +615,7 @@ std::vector<Eigen::Vector3d> p1_curl(const HhdMesh& m, const P1Geometry& g,
         out[k] += v(i, 0) * Eigen::Vector3d(gr.y(), -gr.x(), 0.0);
       }
     }
+  }
   return out;
 }
 
@@ -656,9 +670,14 @@ HhdResult helmholtz_hodge(const HhdMesh& m, const std::vector<Eigen::Vector3d>& 
                          (solver == HhdSolver::Projection && m.dim == 3);
   r.report.tolerance = iterative ? tolerance : 0.0;
   r.report.solver = hhd_solver_name(solver);
-  r.xi = xi;
-  if (m.dim == 2)
-    for (auto& x : r.xi) x.z() = 0.0;
+  r.xi.resize(xi.size());  // (copied on the threads: the pages first touched there)
+  const auto n_simplices = static_cast<std::ptrdiff_t>(xi.size());
+#pragma omp parallel for schedule(static)
+  for (std::ptrdiff_t kk = 0; kk < n_simplices; ++kk) {
+    const auto k = static_cast<std::size_t>(kk);
+    r.xi[k] = xi[k];
+    if (m.dim == 2) r.xi[k].z() = 0.0;
+  }
   Eigen::VectorXd bu;
   Eigen::MatrixXd b18;
   const Incidence inc = incidence(m, idx, n);
@@ -666,7 +685,13 @@ HhdResult helmholtz_hodge(const HhdMesh& m, const std::vector<Eigen::Vector3d>& 
     const auto field = [&](std::size_t k) { return r.xi[k]; };
     right_hand_sides(m, g, inc, n, field, field, bu, b18);
   }
-  const SpMat k = stiffness(m, g, idx, inc, n);
+  // K: column-major for the factorisations; row-major (the same arrays: K is symmetric) for
+  // the AMG paths, which take it over.
+  const bool amg = solver == HhdSolver::Cg || solver == HhdSolver::ProjectionAmg;
+  const SpMat k = amg ? SpMat() : stiffness<SpMat>(m, g, idx, inc, n);
+  Eigen::SparseMatrix<double, Eigen::RowMajor, int> k_rows =
+      amg ? stiffness<Eigen::SparseMatrix<double, Eigen::RowMajor, int>>(m, g, idx, inc, n)
+          : Eigen::SparseMatrix<double, Eigen::RowMajor, int>();
   r.report.seconds_assembly = seconds_since(t0);
 
   // Solutions over the unknowns: column 0 = u, columns 1.. = v.
@@ -726,7 +751,7 @@ HhdResult helmholtz_hodge(const HhdMesh& m, const std::vector<Eigen::Vector3d>& 
       // the tolerance asked for, if smaller); in 3D eq 18's projection with the V-cycle as the
       // Laplacian part of its preconditioner.
       t0 = Clock::now();
-      const AmgHierarchy h = build_amg(k);
+      const AmgHierarchy h = build_amg(std::move(k_rows));
       r.report.seconds_factor = seconds_since(t0);
       amg_path_b(h, std::min(tolerance, kHhdTolerance));
       if (o.poll) o.poll();
@@ -754,7 +779,7 @@ HhdResult helmholtz_hodge(const HhdMesh& m, const std::vector<Eigen::Vector3d>& 
       // Path (b) by conjugate gradients, every column at once, preconditioned with one V-cycle
       // of smoothed-aggregation AMG (its setup reported as the factor).
       t0 = Clock::now();
-      const AmgHierarchy h = build_amg(k);
+      const AmgHierarchy h = build_amg(std::move(k_rows));
       r.report.seconds_factor = seconds_since(t0);
       amg_path_b(h, tolerance);
       break;

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <random>
 #include <stdexcept>
+#include <utility>
 
 #include "aggregation_amg.hpp"
 
@@ -127,6 +128,26 @@ TEST(AggregationAmg, GalerkinCoarseMatricesAndColumnsSolvedAsAlone) {
     EXPECT_EQ(Eigen::VectorXd(x.col(c)), Eigen::VectorXd(x1.col(0))) << "column " << c;
     EXPECT_LE((b.col(c) - a * x.col(c)).norm(), 1e-10 * b.col(c).norm());
   }
+}
+
+TEST(AggregationAmg, RowMajorMatrixGivenUpBuildsTheSameHierarchy) {
+  // The row-major overload takes the matrix's storage (no copy) and builds what the
+  // column-major one builds from the same symmetric matrix, to the bit.
+  using RowMat = Eigen::SparseMatrix<double, Eigen::RowMajor, int>;
+  const SpMat a = grid_laplacian(20, 1e2);
+  const AmgHierarchy h = build_amg(a);
+  RowMat rows = a;
+  const AmgHierarchy g = build_amg(std::move(rows));
+  EXPECT_EQ(rows.nonZeros(), 0);  // (given up)
+  ASSERT_EQ(g.levels.size(), h.levels.size());
+  for (std::size_t l = 0; l < h.levels.size(); ++l) {
+    EXPECT_EQ((g.levels[l].a - h.levels[l].a).norm(), 0.0) << "level " << l;
+    EXPECT_EQ((g.levels[l].p - h.levels[l].p).norm(), 0.0) << "level " << l;
+    EXPECT_EQ(g.levels[l].omega, h.levels[l].omega) << "level " << l;
+  }
+  const Eigen::MatrixXd b = random_columns(a.rows(), 2, 5);
+  EXPECT_EQ(amg_vcycle(g, b), amg_vcycle(h, b));
+  EXPECT_THROW(build_amg(RowMat(3, 4)), std::invalid_argument);
 }
 
 TEST(AggregationAmg, VcycleWritesIntoAnyRowMajorBlockOfTheRightSize) {
