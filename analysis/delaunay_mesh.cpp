@@ -320,22 +320,55 @@ std::vector<std::int32_t> hilbert_order(const std::vector<Eigen::Vector3d>& poin
 VertexSimplices vertex_simplices(int dim, const std::vector<std::array<std::int32_t, 4>>& simplices,
                                  std::size_t n_points) {
   const int nv = dim + 1;
-  VertexSimplices v;  // (a counting sort by vertex)
+  // A counting sort by vertex, stable: each thread counts the vertices of a contiguous range of
+  // simplices, then writes them from its own starts (after the ranges before it), so each
+  // vertex's simplices come in simplex order whatever the number of threads.
+  int threads = 1;
+#ifdef _OPENMP
+  if (simplices.size() >= 100000) threads = omp_get_max_threads();
+#endif
+  const auto ns = static_cast<std::ptrdiff_t>(simplices.size());
+  std::vector<std::vector<std::int64_t>> start(static_cast<std::size_t>(threads));
+  VertexSimplices v;
   v.offset.assign(n_points + 1, 0);
-  for (const auto& s : simplices)
-    for (int a = 0; a < nv; ++a)
-      ++v.offset[static_cast<std::size_t>(s[static_cast<std::size_t>(a)]) + 1];
-  for (std::size_t i = 0; i < n_points; ++i) v.offset[i + 1] += v.offset[i];
-  v.simplex.resize(static_cast<std::size_t>(v.offset[n_points]));
-  v.vertex.resize(v.simplex.size());
-  std::vector<std::int64_t> fill(v.offset.begin(), v.offset.end() - 1);
-  for (std::size_t k = 0; k < simplices.size(); ++k)
-    for (int a = 0; a < nv; ++a) {
-      const auto e = static_cast<std::size_t>(
-          fill[static_cast<std::size_t>(simplices[k][static_cast<std::size_t>(a)])]++);
-      v.simplex[e] = static_cast<std::int32_t>(k);
-      v.vertex[e] = static_cast<std::int8_t>(a);
-    }
+#pragma omp parallel num_threads(threads)
+  {
+    int t = 0;
+#ifdef _OPENMP
+    t = omp_get_thread_num();
+#endif
+    auto& mine = start[static_cast<std::size_t>(t)];
+    mine.assign(n_points, 0);
+    const std::ptrdiff_t lo = ns * t / threads, hi = ns * (t + 1) / threads;
+    for (auto k = lo; k < hi; ++k)
+      for (int a = 0; a < nv; ++a)
+        ++mine[static_cast<std::size_t>(
+            simplices[static_cast<std::size_t>(k)][static_cast<std::size_t>(a)])];
+#pragma omp barrier
+#pragma omp single
+    {
+      std::int64_t e = 0;  // vertex by vertex, the threads' counts become their starts
+      for (std::size_t i = 0; i < n_points; ++i) {
+        v.offset[i] = e;
+        for (auto& c : start) {
+          const std::int64_t count = c[i];
+          c[i] = e;
+          e += count;
+        }
+      }
+      v.offset[n_points] = e;
+      v.simplex.resize(static_cast<std::size_t>(e));
+      v.vertex.resize(static_cast<std::size_t>(e));
+    }  // (implicit barrier)
+    for (auto k = lo; k < hi; ++k)
+      for (int a = 0; a < nv; ++a) {
+        const auto i = static_cast<std::size_t>(
+            simplices[static_cast<std::size_t>(k)][static_cast<std::size_t>(a)]);
+        const auto e = static_cast<std::size_t>(mine[i]++);
+        v.simplex[e] = static_cast<std::int32_t>(k);
+        v.vertex[e] = static_cast<std::int8_t>(a);
+      }
+  }
   return v;
 }
 

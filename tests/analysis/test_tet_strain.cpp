@@ -317,6 +317,14 @@ TEST(DelaunayMesh, HilbertOrderIsAPermutationThatKeepsNeighboursClose) {
   for (int i = 0; i < 20000; ++i) p.emplace_back(u(rng), u(rng), u(rng));
   for (int dim : {2, 3}) {
     const auto order = hilbert_order(p, dim);
+    const int threads = omp_get_max_threads();
+    omp_set_num_threads(1);  // (3D from 20 000 points: CGAL's parallel split on the threads)
+    const auto order1 = hilbert_order(p, dim);
+    omp_set_num_threads(3);
+    const auto order3 = hilbert_order(p, dim);
+    omp_set_num_threads(threads);
+    EXPECT_EQ(order, order1) << "dim " << dim;
+    EXPECT_EQ(order, order3) << "dim " << dim;
     std::vector<std::int32_t> sorted = order;
     std::sort(sorted.begin(), sorted.end());
     for (std::size_t i = 0; i < sorted.size(); ++i)
@@ -332,6 +340,38 @@ TEST(DelaunayMesh, HilbertOrderIsAPermutationThatKeepsNeighboursClose) {
     const double spacing = std::pow(20000.0, -1.0 / dim);
     EXPECT_LT(along, 2.0 * spacing) << "dim " << dim;
   }
+}
+
+TEST(DelaunayMesh, VertexSimplicesInSimplexOrderOnAnyNumberOfThreads) {
+  // Each vertex's simplices in increasing order with the vertex's place in them, the same
+  // lists for 1 and 3 threads (1.3e5 tetrahedra: the threads' counting sort).
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::vector<Eigen::Vector3d> p;
+  for (int i = 0; i < 20000; ++i) p.emplace_back(u(rng), u(rng), u(rng));
+  const DelaunayMesh m = delaunay_mesh(p);
+  ASSERT_GE(m.simplices.size(), 100000u);
+  const int threads = omp_get_max_threads();
+  omp_set_num_threads(1);
+  const VertexSimplices one = vertex_simplices(3, m.simplices, p.size());
+  omp_set_num_threads(3);
+  const VertexSimplices three = vertex_simplices(3, m.simplices, p.size());
+  omp_set_num_threads(threads);
+  EXPECT_EQ(one.offset, three.offset);
+  EXPECT_EQ(one.simplex, three.simplex);
+  EXPECT_EQ(one.vertex, three.vertex);
+  ASSERT_EQ(one.offset.size(), p.size() + 1);
+  EXPECT_EQ(one.offset.back(), static_cast<std::int64_t>(4 * m.simplices.size()));
+  for (std::size_t i = 0; i < p.size(); ++i)
+    for (auto e = one.offset[i]; e < one.offset[i + 1]; ++e) {
+      const auto k = static_cast<std::size_t>(one.simplex[static_cast<std::size_t>(e)]);
+      ASSERT_EQ(m.simplices[k][static_cast<std::size_t>(one.vertex[static_cast<std::size_t>(e)])],
+                static_cast<std::int32_t>(i));
+      if (e > one.offset[i]) {
+        ASSERT_LT(one.simplex[static_cast<std::size_t>(e - 1)],
+                  one.simplex[static_cast<std::size_t>(e)]);
+      }
+    }
 }
 
 }  // namespace
