@@ -112,6 +112,17 @@ void for_each_simplex(const Incidence& inc, const P1Geometry& g, int i, F&& f) {
 // Right-hand sides over the unknowns. bu: Σ_k |T_k| ∇φ_i·fu(k) (eq 17 with fu = ξ). b18:
 // Σ_k |T_k| ∇φ_i × fv(k) (eq 18 as written with fv = ξ; 1 column in 2D, its z component, 3
 // columns in 3D). Rows on the threads, each summed in simplex order.
+// One simplex's terms at a node (sums su, sv held by the caller, nv = 3 or 1 columns of b18).
+inline void add_rhs_terms(int nv, double w, const Eigen::Vector3d& gi, const Eigen::Vector3d& a,
+                          const Eigen::Vector3d& b, double& su, Eigen::Vector3d& sv) {
+  su += w * gi.dot(a);
+  if (nv == 3) {
+    sv += w * gi.cross(b);
+  } else {
+    sv.x() += w * cross_z(gi, b);
+  }
+}
+
 template <class Fu, class Fv>
 void right_hand_sides(const HhdMesh& m, const P1Geometry& g, const Incidence& inc, int n, Fu&& fu,
                       Fv&& fv, Eigen::VectorXd& bu, Eigen::MatrixXd& b18) {
@@ -123,13 +134,7 @@ void right_hand_sides(const HhdMesh& m, const P1Geometry& g, const Incidence& in
     double su = 0.0;  // (the sums in registers, written once)
     Eigen::Vector3d sv = Eigen::Vector3d::Zero();
     for_each_simplex(inc, g, i, [&](std::size_t k, double w, const Eigen::Vector3d& gi) {
-      const Eigen::Vector3d a = fu(k), b = fv(k);
-      su += w * gi.dot(a);
-      if (nv == 3) {
-        sv += w * gi.cross(b);
-      } else {
-        sv.x() += w * cross_z(gi, b);
-      }
+      add_rhs_terms(nv, w, gi, fu(k), fv(k), su, sv);
     });
     bu(i) = su;
     for (int c = 0; c < nv; ++c) b18(i, c) = sv(c);
@@ -138,11 +143,16 @@ void right_hand_sides(const HhdMesh& m, const P1Geometry& g, const Incidence& in
 
 // P1 stiffness K_ij = Σ_k |T_k| (∇φ_i)_k·(∇φ_j)_k over the unknowns, full symmetric storage
 // (compressed, inner indices sorted), assembled row by row on the threads: each entry summed in
-// simplex order (exactly symmetric).
+// simplex order (exactly symmetric). Also right_hand_sides(fu = fv = ξ) into bu and b18 in the
+// same pass over each row's simplices (the same sums in the same order: the same bits).
 template <class Sparse>
 Sparse stiffness(const HhdMesh& m, const P1Geometry& g, const std::vector<int>& idx,
-                 const Incidence& inc, int n) {
+                 const Incidence& inc, int n, const std::vector<Eigen::Vector3d>& xi,
+                 Eigen::VectorXd& bu, Eigen::MatrixXd& b18) {
   const int nvert = vertices_of(m);
+  const int nv = m.dim == 3 ? 3 : 1;
+  bu.resize(n);  // (every row written below)
+  b18.resize(n, nv);
   int threads = 1;
 #ifdef _OPENMP
   threads = omp_get_max_threads();
@@ -166,7 +176,10 @@ Sparse stiffness(const HhdMesh& m, const P1Geometry& g, const std::vector<int>& 
         for (int i = static_cast<int>(lo); i < static_cast<int>(hi); ++i) {
           const auto ii = static_cast<std::size_t>(i);
           row.clear();
+          double su = 0.0;
+          Eigen::Vector3d sv = Eigen::Vector3d::Zero();
           for_each_simplex(inc, g, i, [&](std::size_t k, double w, const Eigen::Vector3d& ga) {
+            add_rhs_terms(nv, w, ga, xi[k], xi[k], su, sv);
             for (int b = 0; b < nvert; ++b) {
               const int j =
                   idx[static_cast<std::size_t>(m.simplices[k][static_cast<std::size_t>(b)])];
@@ -189,6 +202,8 @@ Sparse stiffness(const HhdMesh& m, const P1Geometry& g, const std::vector<int>& 
             v.push_back(value);
           }
           outer[ii + 1] = static_cast<int>(row.size());
+          bu(i) = su;
+          for (int q = 0; q < nv; ++q) b18(i, q) = sv(q);
         }
       });
 }
@@ -583,18 +598,54 @@ std::vector<Eigen::Vector3d> simplex_mean(const HhdMesh& m,
   return xi;
 }
 
+namespace {
+
+// ∇u, ∇×v and ∇·v on simplex k (one expression each for the p1_* functions and the fused pass
+// of helmholtz_hodge: the same bits).
+Eigen::Vector3d gradient_on(const HhdMesh& m, const P1Geometry& g, const Eigen::VectorXd& u,
+                            std::size_t k) {
+  Eigen::Vector3d out = Eigen::Vector3d::Zero();
+  for (int a = 0; a < vertices_of(m); ++a)
+    out +=
+        u(m.simplices[k][static_cast<std::size_t>(a)]) * g.gradient[k][static_cast<std::size_t>(a)];
+  return out;
+}
+
+Eigen::Vector3d curl_on(const HhdMesh& m, const P1Geometry& g, const Eigen::MatrixXd& v,
+                        std::size_t k) {
+  Eigen::Vector3d out = Eigen::Vector3d::Zero();
+  for (int a = 0; a < vertices_of(m); ++a) {
+    const auto i = m.simplices[k][static_cast<std::size_t>(a)];
+    const Eigen::Vector3d& gr = g.gradient[k][static_cast<std::size_t>(a)];
+    if (m.dim == 3) {
+      out += gr.cross(Eigen::Vector3d(v(i, 0), v(i, 1), v(i, 2)));
+    } else {
+      out += v(i, 0) * Eigen::Vector3d(gr.y(), -gr.x(), 0.0);
+    }
+  }
+  return out;
+}
+
+double divergence_on(const HhdMesh& m, const P1Geometry& g, const Eigen::MatrixXd& v,
+                     std::size_t k) {
+  double out = 0.0;
+  if (m.dim != 3) return out;
+  for (std::size_t a = 0; a < 4; ++a) {
+    const auto i = m.simplices[k][a];
+    out += g.gradient[k][a].dot(Eigen::Vector3d(v(i, 0), v(i, 1), v(i, 2)));
+  }
+  return out;
+}
+
+}  // namespace
+
 std::vector<Eigen::Vector3d> p1_gradient(const HhdMesh& m, const P1Geometry& g,
                                          const Eigen::VectorXd& u) {
   std::vector<Eigen::Vector3d> out(m.simplices.size());  // (first written on the threads)
   const auto ns = static_cast<std::ptrdiff_t>(m.simplices.size());
 #pragma omp parallel for schedule(static)
-  for (std::ptrdiff_t kk = 0; kk < ns; ++kk) {
-    const auto k = static_cast<std::size_t>(kk);
-    out[k] = Eigen::Vector3d::Zero();
-    for (int a = 0; a < vertices_of(m); ++a)
-      out[k] += u(m.simplices[k][static_cast<std::size_t>(a)]) *
-                g.gradient[k][static_cast<std::size_t>(a)];
-  }
+  for (std::ptrdiff_t kk = 0; kk < ns; ++kk)
+    out[static_cast<std::size_t>(kk)] = gradient_on(m, g, u, static_cast<std::size_t>(kk));
   return out;
 }
 
@@ -603,19 +654,8 @@ std::vector<Eigen::Vector3d> p1_curl(const HhdMesh& m, const P1Geometry& g,
   std::vector<Eigen::Vector3d> out(m.simplices.size());  // (first written on the threads)
   const auto ns = static_cast<std::ptrdiff_t>(m.simplices.size());
 #pragma omp parallel for schedule(static)
-  for (std::ptrdiff_t kk = 0; kk < ns; ++kk) {
-    out[static_cast<std::size_t>(kk)] = Eigen::Vector3d::Zero();
-    for (int a = 0; a < vertices_of(m); ++a) {
-      const auto k = static_cast<std::size_t>(kk);
-      const auto i = m.simplices[k][static_cast<std::size_t>(a)];
-      const Eigen::Vector3d& gr = g.gradient[k][static_cast<std::size_t>(a)];
-      if (m.dim == 3) {
-        out[k] += gr.cross(Eigen::Vector3d(v(i, 0), v(i, 1), v(i, 2)));
-      } else {
-        out[k] += v(i, 0) * Eigen::Vector3d(gr.y(), -gr.x(), 0.0);
-      }
-    }
-  }
+  for (std::ptrdiff_t kk = 0; kk < ns; ++kk)
+    out[static_cast<std::size_t>(kk)] = curl_on(m, g, v, static_cast<std::size_t>(kk));
   return out;
 }
 
@@ -625,11 +665,7 @@ std::vector<double> p1_divergence(const HhdMesh& m, const P1Geometry& g, const E
   const auto ns = static_cast<std::ptrdiff_t>(m.simplices.size());
 #pragma omp parallel for schedule(static)
   for (std::ptrdiff_t kk = 0; kk < ns; ++kk)
-    for (std::size_t a = 0; a < 4; ++a) {
-      const auto k = static_cast<std::size_t>(kk);
-      const auto i = m.simplices[k][a];
-      out[k] += g.gradient[k][a].dot(Eigen::Vector3d(v(i, 0), v(i, 1), v(i, 2)));
-    }
+    out[static_cast<std::size_t>(kk)] = divergence_on(m, g, v, static_cast<std::size_t>(kk));
   return out;
 }
 
@@ -681,16 +717,14 @@ HhdResult helmholtz_hodge(const HhdMesh& m, const std::vector<Eigen::Vector3d>& 
   Eigen::VectorXd bu;
   Eigen::MatrixXd b18;
   const Incidence inc = incidence(m, idx, n);
-  {
-    const auto field = [&](std::size_t k) { return r.xi[k]; };
-    right_hand_sides(m, g, inc, n, field, field, bu, b18);
-  }
-  // K: column-major for the factorisations; row-major (the same arrays: K is symmetric) for
-  // the AMG paths, which take it over.
+  // K and the right-hand sides (eq 17 and eq 18 with ξ) in one pass. K: column-major for the
+  // factorisations; row-major (the same arrays: K is symmetric) for the AMG paths, which take
+  // it over.
   const bool amg = solver == HhdSolver::Cg || solver == HhdSolver::ProjectionAmg;
-  const SpMat k = amg ? SpMat() : stiffness<SpMat>(m, g, idx, inc, n);
+  const SpMat k = amg ? SpMat() : stiffness<SpMat>(m, g, idx, inc, n, r.xi, bu, b18);
   Eigen::SparseMatrix<double, Eigen::RowMajor, int> k_rows =
-      amg ? stiffness<Eigen::SparseMatrix<double, Eigen::RowMajor, int>>(m, g, idx, inc, n)
+      amg ? stiffness<Eigen::SparseMatrix<double, Eigen::RowMajor, int>>(m, g, idx, inc, n, r.xi,
+                                                                         bu, b18)
           : Eigen::SparseMatrix<double, Eigen::RowMajor, int>();
   r.report.seconds_assembly = seconds_since(t0);
 
@@ -824,10 +858,10 @@ HhdResult helmholtz_hodge(const HhdMesh& m, const std::vector<Eigen::Vector3d>& 
     r.v_coulomb.row(ii) = v_coulomb.rows() > 0 ? v_coulomb.row(idx[i]) : r.v.row(ii);
   }
   r.measure = g.measure;
-  r.grad_u = p1_gradient(m, g, r.u);
-  r.curl_v = p1_curl(m, g, r.v);
-  const auto div = p1_divergence(m, g, r.v);
-  // h, and the norms and inner products in one pass (chunked: the same bits on any threads).
+  // ∇u, ∇×v (p1_gradient, p1_curl), h, and the norms and inner products (with ∇·v's) in one
+  // pass over the simplices (chunked: the same bits on any threads).
+  r.grad_u.resize(r.xi.size());
+  r.curl_v.resize(r.xi.size());
   r.harmonic.resize(r.xi.size());
   const auto sums = chunked_sums<8>(
       static_cast<Eigen::Index>(r.xi.size()), [&](Eigen::Index lo, Eigen::Index hi) {
@@ -835,6 +869,9 @@ HhdResult helmholtz_hodge(const HhdMesh& m, const std::vector<Eigen::Vector3d>& 
         for (auto kk = lo; kk < hi; ++kk) {
           const auto k = static_cast<std::size_t>(kk);
           const double w = r.measure[k];
+          r.grad_u[k] = gradient_on(m, g, r.u, k);
+          r.curl_v[k] = curl_on(m, g, r.v, k);
+          const double div_k = divergence_on(m, g, r.v, k);
           const Eigen::Vector3d &xi_k = r.xi[k], &gu = r.grad_u[k], &cv = r.curl_v[k];
           const Eigen::Vector3d h = xi_k - gu - cv;
           r.harmonic[k] = h;
@@ -845,7 +882,7 @@ HhdResult helmholtz_hodge(const HhdMesh& m, const std::vector<Eigen::Vector3d>& 
           q[4] += w * gu.dot(cv);
           q[5] += w * gu.dot(h);
           q[6] += w * cv.dot(h);
-          q[7] += w * div[k] * div[k];
+          q[7] += w * div_k * div_k;
         }
         return q;
       });
