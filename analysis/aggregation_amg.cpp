@@ -233,12 +233,6 @@ void times(const RowMat& a, const Block& x, Block& y) {
   });
 }
 
-Block times(const RowMat& a, const Block& x) {
-  Block y;
-  times(a, x, y);
-  return y;
-}
-
 // One damped Jacobi sweep: Y = X + ω D⁻¹ (B − A·X) (Y: a block or a view of B's size).
 template <class B, class Y>
 void jacobi(const AmgLevel& L, const Block& x, const B& b, Y& y) {
@@ -252,8 +246,9 @@ void jacobi(const AmgLevel& L, const Block& x, const B& b, Y& y) {
 
 // A·B of two sparse matrices (Gustavson: row by row with a dense accumulator), rows on the
 // threads in contiguous ranges; each entry summed in A's row order, then B's, for any number of
-// threads.
-RowMat multiply(const RowMat& a, const RowMat& b) {
+// threads. sorted = false leaves each row's columns in the order they first appear: for a
+// factor that only this product reads again (its sums do not depend on that order).
+RowMat multiply(const RowMat& a, const RowMat& b, bool sorted = true) {
   const Index n = a.rows(), m = b.cols();
   const int* ao = a.outerIndexPtr();
   const int* ai = a.innerIndexPtr();
@@ -288,7 +283,7 @@ RowMat multiply(const RowMat& a, const RowMat& b) {
                 acc[j] += av[e] * bv[f];
               }
             }
-          std::sort(c.begin() + static_cast<std::ptrdiff_t>(start), c.end());
+          if (sorted) std::sort(c.begin() + static_cast<std::ptrdiff_t>(start), c.end());
           for (std::size_t q = start; q < c.size(); ++q)
             v.push_back(acc[static_cast<std::size_t>(c[q])]);
           outer[static_cast<std::size_t>(i) + 1] = static_cast<int>(c.size() - start);
@@ -354,12 +349,12 @@ RowMat filtered(const RowMat& a, const std::vector<char>& strong) {
 // λ_max(D⁻¹A) by power iteration from a fixed start (a lower bound, close after a few steps).
 double largest_eigenvalue(const RowMat& a, const Eigen::VectorXd& inv_diag) {
   const Index n = a.rows();
-  Block q(n, 1);
+  Block q(n, 1), z(n, 1);
   for (Index i = 0; i < n; ++i) q(i, 0) = 1.0 + 0.37 * static_cast<double>(i % 11);
   q /= q.norm();
   double lambda = 1.0;
   for (int it = 0; it < 10; ++it) {
-    Block z = inv_diag.asDiagonal() * times(a, q);
+    for_rows(a, q, [&](Index i, const double* s, Index) { z(i, 0) = inv_diag(i) * s[0]; });
     const double norm = z.norm();
     if (!(norm > 0.0)) break;
     lambda = norm;
@@ -511,15 +506,19 @@ AmgHierarchy build_amg(RowMat&& a, const AmgOptions& o) {
     {
       const Eigen::VectorXd inv_f = smoother.diagonal().cwiseInverse();
       const double omega_f = 4.0 / (3.0 * largest_eigenvalue(smoother, inv_f));
+#pragma omp parallel for schedule(static) if (smoother.nonZeros() >= kParallelWork)
       for (Index i = 0; i < smoother.outerSize(); ++i)  // I − ω_F D_F⁻¹A_F
         for (RowMat::InnerIterator it(smoother, i); it; ++it)
           it.valueRef() = (it.col() == i ? 1.0 : 0.0) - omega_f * inv_f(i) * it.value();
     }
-    RowMat pt(L.a.rows(), nc);
-    std::vector<Eigen::Triplet<double, int>> t;
-    t.reserve(agg.size());
-    for (std::size_t i = 0; i < agg.size(); ++i) t.emplace_back(static_cast<int>(i), agg[i], 1.0);
-    pt.setFromTriplets(t.begin(), t.end());
+    RowMat pt(L.a.rows(), nc);  // (one 1 per row, in its aggregate's column)
+    pt.resizeNonZeros(L.a.rows());
+    for (Index i = 0; i < L.a.rows(); ++i) {
+      pt.outerIndexPtr()[i] = static_cast<int>(i);
+      pt.innerIndexPtr()[i] = agg[static_cast<std::size_t>(i)];
+      pt.valuePtr()[i] = 1.0;
+    }
+    pt.outerIndexPtr()[L.a.rows()] = static_cast<int>(L.a.rows());
     {
       RowMat p = multiply(smoother, pt);
       L.p.swap(p);
@@ -527,7 +526,7 @@ AmgHierarchy build_amg(RowMat&& a, const AmgOptions& o) {
     L.p.prune(0.0);
     L.r = L.p.transpose();
     {
-      RowMat rap = multiply(L.r, multiply(L.a, L.p));
+      RowMat rap = multiply(L.r, multiply(L.a, L.p, false));
       a = 0.5 * (rap + RowMat(rap.transpose()));  // (symmetric to the last bit: an SPD V-cycle)
     }
   }
