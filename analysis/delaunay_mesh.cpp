@@ -17,6 +17,7 @@
 #include <cmath>
 #include <iterator>
 #include <map>
+#include <memory>
 #include <numeric>
 #include <optional>
 #include <stdexcept>
@@ -100,39 +101,74 @@ void check_input(const std::vector<Vec>& points, std::size_t min_points, const c
 // Tetrahedra in a canonical form and order, whatever order the triangulation holds them in:
 // each rotated by an even permutation (orientation kept) so that its smallest vertex comes first
 // and the smallest of the other three second; then sorted (counting sort on the first vertex,
-// a sort of the few sharing it).
+// each thread counting and placing a contiguous range, then a sort of the few sharing it; the
+// tetrahedra are distinct, so the order is the same for any number of threads).
 void canonical_order(std::vector<std::array<std::int32_t, 4>>& t, std::size_t n_points) {
+  using Tet = std::array<std::int32_t, 4>;
   const auto nt = static_cast<std::ptrdiff_t>(t.size());
-#pragma omp parallel for schedule(static) if (nt >= 100000)
-  for (std::ptrdiff_t kk = 0; kk < nt; ++kk) {
-    auto& s = t[static_cast<std::size_t>(kk)];
-    const auto first = static_cast<std::size_t>(std::min_element(s.begin(), s.end()) - s.begin());
-    if (first != 0) {  // two transpositions: (0 first) and the two other places
-      std::size_t o[2], q = 0;
-      for (std::size_t a = 1; a < 4; ++a)
-        if (a != first) o[q++] = a;
-      std::swap(s[0], s[first]);
-      std::swap(s[o[0]], s[o[1]]);
-    }
-    while (s[1] > s[2] || s[1] > s[3]) {  // 3-cycle of the last three
-      const std::int32_t x = s[1];
-      s[1] = s[2];
-      s[2] = s[3];
-      s[3] = x;
-    }
-  }
+  int threads = 1;
+#ifdef _OPENMP
+  if (nt >= 100000) threads = omp_get_max_threads();
+#endif
+  std::vector<std::vector<std::size_t>> fill(static_cast<std::size_t>(threads));
   std::vector<std::size_t> start(n_points + 1, 0);
-  for (const auto& s : t) ++start[static_cast<std::size_t>(s[0]) + 1];
-  for (std::size_t i = 0; i < n_points; ++i) start[i + 1] += start[i];
-  std::vector<std::array<std::int32_t, 4>> sorted(t.size());
-  std::vector<std::size_t> fill(start.begin(), start.end() - 1);
-  for (const auto& s : t) sorted[fill[static_cast<std::size_t>(s[0])]++] = s;
-  const auto np = static_cast<std::ptrdiff_t>(n_points);
-#pragma omp parallel for schedule(static) if (nt >= 100000)
-  for (std::ptrdiff_t i = 0; i < np; ++i)
-    std::sort(sorted.begin() + static_cast<std::ptrdiff_t>(start[static_cast<std::size_t>(i)]),
-              sorted.begin() + static_cast<std::ptrdiff_t>(start[static_cast<std::size_t>(i) + 1]));
-  t.swap(sorted);
+  // (not initialised: every place is written once, on the thread that fills it)
+  const auto sorted = std::make_unique_for_overwrite<Tet[]>(t.size());
+#pragma omp parallel num_threads(threads)
+  {
+    int th = 0;
+#ifdef _OPENMP
+    th = omp_get_thread_num();
+#endif
+    const std::ptrdiff_t lo = nt * th / threads, hi = nt * (th + 1) / threads;
+    auto& mine = fill[static_cast<std::size_t>(th)];
+    mine.assign(n_points, 0);
+    for (auto kk = lo; kk < hi; ++kk) {
+      auto& s = t[static_cast<std::size_t>(kk)];
+      const auto first = static_cast<std::size_t>(std::min_element(s.begin(), s.end()) - s.begin());
+      if (first != 0) {  // two transpositions: (0 first) and the two other places
+        std::size_t o[2], q = 0;
+        for (std::size_t a = 1; a < 4; ++a)
+          if (a != first) o[q++] = a;
+        std::swap(s[0], s[first]);
+        std::swap(s[o[0]], s[o[1]]);
+      }
+      while (s[1] > s[2] || s[1] > s[3]) {  // 3-cycle of the last three
+        const std::int32_t x = s[1];
+        s[1] = s[2];
+        s[2] = s[3];
+        s[3] = x;
+      }
+      ++mine[static_cast<std::size_t>(s[0])];
+    }
+#pragma omp barrier
+#pragma omp single
+    {
+      std::size_t e = 0;  // vertex by vertex, the threads' counts become their places
+      for (std::size_t i = 0; i < n_points; ++i) {
+        start[i] = e;
+        for (auto& c : fill) {
+          const std::size_t count = c[i];
+          c[i] = e;
+          e += count;
+        }
+      }
+      start[n_points] = e;
+    }  // (implicit barrier)
+    for (auto kk = lo; kk < hi; ++kk) {
+      const Tet& s = t[static_cast<std::size_t>(kk)];
+      sorted[mine[static_cast<std::size_t>(s[0])]++] = s;
+    }
+#pragma omp barrier
+    const auto np = static_cast<std::ptrdiff_t>(n_points);
+#pragma omp for schedule(static)
+    for (std::ptrdiff_t i = 0; i < np; ++i)
+      std::sort(sorted.get() + start[static_cast<std::size_t>(i)],
+                sorted.get() + start[static_cast<std::size_t>(i) + 1]);
+#pragma omp for schedule(static)
+    for (std::ptrdiff_t kk = 0; kk < nt; ++kk)
+      t[static_cast<std::size_t>(kk)] = sorted[static_cast<std::size_t>(kk)];
+  }
 }
 
 template <class Triangulation>
