@@ -272,17 +272,23 @@ RowMat multiply(const RowMat& a, const RowMat& b, bool sorted = true) {
         v.reserve(guess);
         for (Index i = lo; i < hi; ++i) {
           const std::size_t start = c.size();
+          std::size_t room = 0;
+          for (int e = ao[i]; e < ao[i + 1]; ++e)
+            room += static_cast<std::size_t>(bo[ai[e] + 1] - bo[ai[e]]);
+          c.resize(start + room);
+          std::size_t q = start;
+          // A new column starts from −0 (−0 + x is x, to the bit) and takes the next place, an
+          // old one adds: selects, not a branch to mispredict.
           for (int e = ao[i]; e < ao[i + 1]; ++e)
             for (int f = bo[ai[e]]; f < bo[ai[e] + 1]; ++f) {
               const auto j = static_cast<std::size_t>(bi[f]);
-              if (mark[j] != i) {
-                mark[j] = i;
-                c.push_back(bi[f]);
-                acc[j] = av[e] * bv[f];
-              } else {
-                acc[j] += av[e] * bv[f];
-              }
+              const bool fresh = mark[j] != i;
+              mark[j] = i;
+              acc[j] = (fresh ? -0.0 : acc[j]) + av[e] * bv[f];
+              c[q] = bi[f];
+              q += fresh ? 1 : 0;
             }
+          c.resize(q);
           if (sorted) std::sort(c.begin() + static_cast<std::ptrdiff_t>(start), c.end());
           for (std::size_t q = start; q < c.size(); ++q)
             v.push_back(acc[static_cast<std::size_t>(c[q])]);

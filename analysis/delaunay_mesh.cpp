@@ -431,27 +431,43 @@ VertexRings vertex_rings(int dim, const std::vector<std::array<std::int32_t, 4>>
 #endif
     const std::ptrdiff_t lo = n * t / threads, hi = n * (t + 1) / threads;
     auto& out = part[static_cast<std::size_t>(t)];
+    // (room for one entry per simplex at a vertex, ~1.7 times a Delaunay ring: no regrowth;
+    // pages never written are never touched)
+    out.reserve(static_cast<std::size_t>(offset[static_cast<std::size_t>(hi)] -
+                                         offset[static_cast<std::size_t>(lo)]));
     std::vector<std::ptrdiff_t> mark(n_points, -1);
+    std::vector<std::int32_t> ring;
     for (std::ptrdiff_t i = lo; i < hi; ++i) {
-      const auto begin = out.size();
-      for (auto e = offset[static_cast<std::size_t>(i)];
-           e < offset[static_cast<std::size_t>(i) + 1]; ++e) {
+      const auto e0 = offset[static_cast<std::size_t>(i)],
+                 e1 = offset[static_cast<std::size_t>(i) + 1];
+      ring.resize(static_cast<std::size_t>(nv * (e1 - e0)));
+      // Every candidate written, kept (the count advanced) when new: no branch to mispredict.
+      std::size_t q = 0;
+      for (auto e = e0; e < e1; ++e) {
         const auto& s =
             simplices[static_cast<std::size_t>(at.simplex[static_cast<std::size_t>(e)])];
         for (int b = 0; b < nv; ++b) {
           const std::int32_t j = s[static_cast<std::size_t>(b)];
-          if (j == i || mark[static_cast<std::size_t>(j)] == i) continue;
-          mark[static_cast<std::size_t>(j)] = i;
-          out.push_back(j);
+          auto& mj = mark[static_cast<std::size_t>(j)];
+          ring[q] = j;
+          q += static_cast<std::size_t>(j != i && mj != i);
+          mj = i;
         }
       }
-      std::sort(out.begin() + static_cast<std::ptrdiff_t>(begin), out.end());
-      r.offset[static_cast<std::size_t>(i) + 1] = static_cast<std::int64_t>(out.size() - begin);
+      std::sort(ring.begin(), ring.begin() + static_cast<std::ptrdiff_t>(q));
+      out.insert(out.end(), ring.begin(), ring.begin() + static_cast<std::ptrdiff_t>(q));
+      r.offset[static_cast<std::size_t>(i) + 1] = static_cast<std::int64_t>(q);
     }
+#pragma omp barrier
+#pragma omp single
+    {
+      for (std::size_t i = 0; i < n_points; ++i) r.offset[i + 1] += r.offset[i];
+      r.index.resize(static_cast<std::size_t>(r.offset[n_points]));
+    }  // (implicit barrier; each thread's rings then copied to their place)
+    std::copy(
+        out.begin(), out.end(),
+        r.index.begin() + static_cast<std::ptrdiff_t>(r.offset[static_cast<std::size_t>(lo)]));
   }
-  for (std::size_t i = 0; i < n_points; ++i) r.offset[i + 1] += r.offset[i];
-  r.index.reserve(static_cast<std::size_t>(r.offset[n_points]));
-  for (const auto& p : part) r.index.insert(r.index.end(), p.begin(), p.end());
   return r;
 }
 

@@ -175,7 +175,9 @@ Sparse stiffness(const HhdMesh& m, const P1Geometry& g, const std::vector<int>& 
         v.reserve(room);
         for (int i = static_cast<int>(lo); i < static_cast<int>(hi); ++i) {
           const auto ii = static_cast<std::size_t>(i);
-          row.clear();
+          const auto p = static_cast<std::size_t>(inc.point[ii]);
+          row.resize(static_cast<std::size_t>(nvert * (inc.at.offset[p + 1] - inc.at.offset[p])));
+          std::size_t q = 0;  // (the row's entries so far)
           double su = 0.0;
           Eigen::Vector3d sv = Eigen::Vector3d::Zero();
           for_each_simplex(inc, g, i, [&](std::size_t k, double w, const Eigen::Vector3d& ga) {
@@ -185,23 +187,26 @@ Sparse stiffness(const HhdMesh& m, const P1Geometry& g, const std::vector<int>& 
                   idx[static_cast<std::size_t>(m.simplices[k][static_cast<std::size_t>(b)])];
               if (j < 0) continue;
               const double value = w * ga.dot(g.gradient[k][static_cast<std::size_t>(b)]);
+              // A new column takes the next place and starts from −0 (−0 + x is x, to the bit),
+              // an old one adds to its place: selects, not a branch to mispredict.
               auto& mk = mark[static_cast<std::size_t>(j)];
-              if (mk != i) {
-                mk = i;
-                pos[static_cast<std::size_t>(j)] = static_cast<int>(row.size());
-                row.emplace_back(j, value);
-              } else {
-                row[static_cast<std::size_t>(pos[static_cast<std::size_t>(j)])].second += value;
-              }
+              const bool fresh = mk != i;
+              auto& pj = pos[static_cast<std::size_t>(j)];
+              pj = fresh ? static_cast<int>(q) : pj;
+              mk = i;
+              auto& entry = row[static_cast<std::size_t>(pj)];
+              entry.second = (fresh ? -0.0 : entry.second) + value;
+              entry.first = j;
+              q += fresh ? 1 : 0;
             }
           });
-          std::sort(row.begin(), row.end(),
+          std::sort(row.begin(), row.begin() + static_cast<std::ptrdiff_t>(q),
                     [](const auto& x, const auto& y) { return x.first < y.first; });
-          for (const auto& [j, value] : row) {
-            c.push_back(j);
-            v.push_back(value);
+          for (std::size_t e = 0; e < q; ++e) {
+            c.push_back(row[e].first);
+            v.push_back(row[e].second);
           }
-          outer[ii + 1] = static_cast<int>(row.size());
+          outer[ii + 1] = static_cast<int>(q);
           bu(i) = su;
           for (int q = 0; q < nv; ++q) b18(i, q) = sv(q);
         }
