@@ -290,8 +290,8 @@ RowMat multiply(const RowMat& a, const RowMat& b, bool sorted = true) {
             }
           c.resize(q);
           if (sorted) std::sort(c.begin() + static_cast<std::ptrdiff_t>(start), c.end());
-          for (std::size_t q = start; q < c.size(); ++q)
-            v.push_back(acc[static_cast<std::size_t>(c[q])]);
+          for (std::size_t e = start; e < c.size(); ++e)
+            v.push_back(acc[static_cast<std::size_t>(c[e])]);
           outer[static_cast<std::size_t>(i) + 1] = static_cast<int>(c.size() - start);
         }
       });
@@ -500,7 +500,8 @@ AmgHierarchy build_amg(RowMat&& a, const AmgOptions& o) {
     int nc = 0;
     std::vector<int> agg;
     std::vector<char> strong;
-    if (L.a.rows() > o.coarsest && static_cast<int>(h.levels.size()) + 1 < o.max_levels) {
+    // (L is already in h.levels: at most max_levels levels)
+    if (L.a.rows() > o.coarsest && static_cast<int>(h.levels.size()) < o.max_levels) {
       strong = strong_entries(L.a, diag, o.strength);
       agg = aggregates(L.a, strong, nc);
     }

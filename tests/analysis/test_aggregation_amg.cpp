@@ -150,6 +150,27 @@ TEST(AggregationAmg, RowMajorMatrixGivenUpBuildsTheSameHierarchy) {
   EXPECT_THROW(build_amg(RowMat(3, 4)), std::invalid_argument);
 }
 
+TEST(AggregationAmg, MaxLevelsBoundsTheHierarchy) {
+  const SpMat a = grid_laplacian(20, 1.0);
+  const std::size_t free_levels = build_amg(a).levels.size();
+  ASSERT_GE(free_levels, 3u);
+  for (int max_levels = 2; max_levels <= static_cast<int>(free_levels); ++max_levels) {
+    AmgOptions o;
+    o.max_levels = max_levels;
+    EXPECT_EQ(build_amg(a, o).levels.size(), static_cast<std::size_t>(max_levels));
+  }
+  // One level: no coarsening, the V-cycle is the direct solve (8³ unknowns, above `coarsest`).
+  const SpMat small = grid_laplacian(8, 1.0);
+  ASSERT_GE(build_amg(small).levels.size(), 2u);
+  AmgOptions one;
+  one.max_levels = 1;
+  const AmgHierarchy h = build_amg(small, one);
+  ASSERT_EQ(h.levels.size(), 1u);
+  const Eigen::MatrixXd b = random_columns(small.rows(), 1, 3);
+  const Eigen::MatrixXd x = Eigen::SimplicialLDLT<SpMat>(small).solve(b);
+  EXPECT_LT((amg_vcycle(h, b) - x).norm(), 1e-10 * x.norm());
+}
+
 TEST(AggregationAmg, VcycleWritesIntoAnyRowMajorBlockOfTheRightSize) {
   const SpMat a = grid_laplacian(20, 1.0);
   const AmgHierarchy h = build_amg(a);
