@@ -208,7 +208,7 @@ Sparse stiffness(const HhdMesh& m, const P1Geometry& g, const std::vector<int>& 
           }
           outer[ii + 1] = static_cast<int>(q);
           bu(i) = su;
-          for (int q = 0; q < nv; ++q) b18(i, q) = sv(q);
+          for (int col = 0; col < nv; ++col) b18(i, col) = sv(col);
         }
       });
 }
