@@ -17,7 +17,10 @@
 #include <vtkXMLPolyDataWriter.h>
 #include <vtkXMLUnstructuredGridWriter.h>
 
+#include <zlib.h>
+
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <fstream>
 #include <numeric>
@@ -73,6 +76,51 @@ struct H5Type<std::uint8_t> {
   static hid_t file() { return H5T_STD_U8LE; }
   static hid_t mem() { return H5T_NATIVE_UINT8; }
 };
+
+// A large dataset's chunks (first-axis slabs of `chunk_rows` rows) filtered on the threads, then
+// written as they are with H5Dwrite_chunk: HDF5 runs its filter pipeline on one thread, and
+// deflate was most of `analyze hhd`'s time (0.9 s of 1.5 s at 5.5e4 nodes). Each chunk holds
+// what the dataset's declared filters make of it, so any HDF5 reader reads it back: the chunk
+// zero-padded to full size (as HDF5 pads an edge chunk), HDF5's byte shuffle (byte j of element
+// i at j·elements + i), then zlib at level 1 (the deflate filter's compress2).
+template <class T>
+void write_filtered_chunks(hid_t ds, const std::vector<T>& v, std::size_t rank,
+                           std::size_t chunk_rows, std::size_t row, const std::string& file,
+                           const std::string& path) {
+  static_assert(std::endian::native == std::endian::little, "the file types are little-endian");
+  const std::size_t elems = chunk_rows * row, bytes = elems * sizeof(T);
+  const std::size_t chunks = (v.size() + elems - 1) / elems;
+  constexpr std::size_t kBatch = 8;  // (compressed on the threads, then written in order)
+  std::vector<std::vector<Bytef>> out(kBatch);
+  std::vector<uLongf> size(kBatch);
+  for (std::size_t b0 = 0; b0 < chunks; b0 += kBatch) {
+    const auto nb = static_cast<std::ptrdiff_t>(std::min(kBatch, chunks - b0));
+    int failed = 0;
+#pragma omp parallel for schedule(dynamic) reduction(+ : failed)
+    for (std::ptrdiff_t q = 0; q < nb; ++q) {
+      const std::size_t first = (b0 + static_cast<std::size_t>(q)) * elems;
+      const std::size_t count = std::min(elems, v.size() - first);
+      const auto* src = reinterpret_cast<const unsigned char*>(v.data() + first);
+      std::vector<unsigned char> shuffled(bytes, 0);
+      for (std::size_t i = 0; i < count; ++i)
+        for (std::size_t j = 0; j < sizeof(T); ++j)
+          shuffled[j * elems + i] = src[i * sizeof(T) + j];
+      auto& o = out[static_cast<std::size_t>(q)];
+      uLongf n = compressBound(static_cast<uLong>(bytes));
+      o.resize(n);
+      failed += compress2(o.data(), &n, shuffled.data(), static_cast<uLong>(bytes), 1) != Z_OK;
+      size[static_cast<std::size_t>(q)] = n;
+    }
+    if (failed) throw InputError(file, "cannot compress HDF5 output", path);
+    for (std::ptrdiff_t q = 0; q < nb; ++q) {
+      std::vector<hsize_t> offset(rank, 0);
+      offset[0] = (b0 + static_cast<std::size_t>(q)) * chunk_rows;
+      if (H5Dwrite_chunk(ds, H5P_DEFAULT, 0, offset.data(), size[static_cast<std::size_t>(q)],
+                         out[static_cast<std::size_t>(q)].data()) < 0)
+        throw InputError(file, "cannot write HDF5 output", path);
+    }
+  }
+}
 
 vtkNew<vtkDoubleArray> to_vtk(const VtkArray& a, std::size_t tuples, const std::string& file) {
   const auto comps = static_cast<std::size_t>(std::max(1, a.components));
@@ -155,19 +203,26 @@ struct H5FieldFile::Impl {
     const Handle space(H5Screate_simple(static_cast<int>(hd.size()), hd.data(), nullptr), H5Sclose,
                        name, path);
     const Handle plist(H5Pcreate(H5P_DATASET_CREATE), H5Pclose, name, path);
-    if (n >= 4096) {  // large arrays: chunked (about 1 MiB along the first axis) and compressed
-      std::vector<hsize_t> chunk(hd);
-      const std::size_t row = n / std::max<std::size_t>(1, dims[0]);
+    // Large arrays: chunked (about 1 MiB along the first axis), shuffled and deflated (the
+    // shuffle makes doubles compress: 36 MB instead of 40 for the 47 MB of a 5.5e4-node HHD).
+    const bool large = n >= 4096;
+    const std::size_t row = n / std::max<std::size_t>(1, dims[0]);
+    std::vector<hsize_t> chunk(hd);
+    if (large) {
       chunk[0] = std::clamp<hsize_t>((1u << 20) / sizeof(T) / std::max<std::size_t>(1, row), 1,
                                      std::max<hsize_t>(1, hd[0]));
       H5Pset_chunk(plist.get(), static_cast<int>(chunk.size()), chunk.data());
+      H5Pset_shuffle(plist.get());
       H5Pset_deflate(plist.get(), 1);
     }
     const Handle ds(H5Dcreate2(file.get(), path.c_str(), H5Type<T>::file(), space.get(),
                                H5P_DEFAULT, plist.get(), H5P_DEFAULT),
                     H5Dclose, name, path);
-    if (n > 0 &&
-        H5Dwrite(ds.get(), H5Type<T>::mem(), H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data()) < 0) {
+    if (large) {
+      write_filtered_chunks(ds.get(), v, hd.size(), static_cast<std::size_t>(chunk[0]), row, name,
+                            path);
+    } else if (n > 0 &&
+               H5Dwrite(ds.get(), H5Type<T>::mem(), H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data()) < 0) {
       throw InputError(name, "cannot write HDF5 output", path);
     }
   }

@@ -373,6 +373,20 @@ TEST(Mpi, TwoProcessesStepMeshWallsAsOne) {
   EXPECT_GT(loaded, 50u);
 }
 
+/// Waits (up to a minute) until no process holds the run directory's lock: a process of a job
+/// whose launcher was stopped may still be ending.
+void wait_unlocked(const fs::path& dir) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (std::chrono::steady_clock::now() < deadline) {
+    const int fd = ::open((dir / ".simulate.lock").c_str(), O_RDWR | O_CLOEXEC);
+    if (fd < 0) return;
+    const bool free = ::flock(fd, LOCK_EX | LOCK_NB) == 0;
+    ::close(fd);
+    if (free) return;
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+}
+
 // Clumps: 234 rods of four overlapping spheres (r = 0.6 mm, 1 mm apart: each member up to
 // 1.5 mm from the centre of mass, more than 2 r_max + skin) dropped into a 60 mm long trough,
 // so that the slabs (along x) cut through the settled pile. A clump is owned, with its members,
@@ -469,22 +483,9 @@ mass = "union"
       words(kMpirun + "2 " + kExe + args + resumed.string() + " --threads 1"), resumed, 5000,
       SIGTERM))
       << "the run ended before it could be stopped";
+  wait_unlocked(resumed);  // (mpirun returns before its processes have all ended)
   ASSERT_EQ(run(kExe + args + resumed.string() + " --threads 1 --resume", &err), 0) << err;
   expect_same_run(dir / "one" / "rods.h5", resumed / "rods.h5");
-}
-
-/// Waits (up to a minute) until no process holds the run directory's lock: a process of a job
-/// whose launcher was stopped may still be ending.
-void wait_unlocked(const fs::path& dir) {
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
-  while (std::chrono::steady_clock::now() < deadline) {
-    const int fd = ::open((dir / ".simulate.lock").c_str(), O_RDWR | O_CLOEXEC);
-    if (fd < 0) return;
-    const bool free = ::flock(fd, LOCK_EX | LOCK_NB) == 0;
-    ::close(fd);
-    if (free) return;
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
-  }
 }
 
 // A checkpoint is one process's format whatever wrote it: a two-process run stopped after a
