@@ -70,6 +70,37 @@ int openmp_threads() {
 }
 #endif
 
+// This thread's number in a parallel region (0 outside, or without OpenMP).
+int thread_number() {
+#ifdef _OPENMP
+  return omp_get_thread_num();
+#else
+  return 0;
+#endif
+}
+
+// Thread t's contiguous share [first, second) of n items split among `threads`.
+std::pair<std::ptrdiff_t, std::ptrdiff_t> share(std::ptrdiff_t n, int t, int threads) {
+  return {n * t / threads, n * (t + 1) / threads};
+}
+
+// The middle of a counting sort done by threads: counts[t][i], thread t's items of key i,
+// become the places where thread t writes them (key by key, thread by thread: the threads'
+// ranges in order within each key); offset[i] = key i's first place. Returns the total.
+template <class Int>
+Int counts_to_places(std::vector<std::vector<Int>>& counts, std::size_t keys, Int* offset) {
+  Int e = 0;
+  for (std::size_t i = 0; i < keys; ++i) {
+    offset[i] = e;
+    for (auto& c : counts) {
+      const Int count = c[i];
+      c[i] = e;
+      e += count;
+    }
+  }
+  return e;
+}
+
 template <class Vec>
 [[noreturn]] void throw_duplicate(const std::vector<Vec>& points) {
   std::map<std::vector<double>, std::size_t> seen;
@@ -116,11 +147,8 @@ void canonical_order(std::vector<std::array<std::int32_t, 4>>& t, std::size_t n_
   const auto sorted = std::make_unique_for_overwrite<Tet[]>(t.size());
 #pragma omp parallel num_threads(threads)
   {
-    int th = 0;
-#ifdef _OPENMP
-    th = omp_get_thread_num();
-#endif
-    const std::ptrdiff_t lo = nt * th / threads, hi = nt * (th + 1) / threads;
+    const int th = thread_number();
+    const auto [lo, hi] = share(nt, th, threads);
     auto& mine = fill[static_cast<std::size_t>(th)];
     mine.assign(n_points, 0);
     for (auto kk = lo; kk < hi; ++kk) {
@@ -143,18 +171,7 @@ void canonical_order(std::vector<std::array<std::int32_t, 4>>& t, std::size_t n_
     }
 #pragma omp barrier
 #pragma omp single
-    {
-      std::size_t e = 0;  // vertex by vertex, the threads' counts become their places
-      for (std::size_t i = 0; i < n_points; ++i) {
-        start[i] = e;
-        for (auto& c : fill) {
-          const std::size_t count = c[i];
-          c[i] = e;
-          e += count;
-        }
-      }
-      start[n_points] = e;
-    }  // (implicit barrier)
+    start[n_points] = counts_to_places(fill, n_points, start.data());  // (implicit barrier)
     for (auto kk = lo; kk < hi; ++kk) {
       const Tet& s = t[static_cast<std::size_t>(kk)];
       sorted[mine[static_cast<std::size_t>(s[0])]++] = s;
@@ -369,13 +386,10 @@ VertexSimplices vertex_simplices(int dim, const std::vector<std::array<std::int3
   v.offset.assign(n_points + 1, 0);
 #pragma omp parallel num_threads(threads)
   {
-    int t = 0;
-#ifdef _OPENMP
-    t = omp_get_thread_num();
-#endif
+    const int t = thread_number();
     auto& mine = start[static_cast<std::size_t>(t)];
     mine.assign(n_points, 0);
-    const std::ptrdiff_t lo = ns * t / threads, hi = ns * (t + 1) / threads;
+    const auto [lo, hi] = share(ns, t, threads);
     for (auto k = lo; k < hi; ++k)
       for (int a = 0; a < nv; ++a)
         ++mine[static_cast<std::size_t>(
@@ -383,15 +397,7 @@ VertexSimplices vertex_simplices(int dim, const std::vector<std::array<std::int3
 #pragma omp barrier
 #pragma omp single
     {
-      std::int64_t e = 0;  // vertex by vertex, the threads' counts become their starts
-      for (std::size_t i = 0; i < n_points; ++i) {
-        v.offset[i] = e;
-        for (auto& c : start) {
-          const std::int64_t count = c[i];
-          c[i] = e;
-          e += count;
-        }
-      }
+      const std::int64_t e = counts_to_places(start, n_points, v.offset.data());
       v.offset[n_points] = e;
       v.simplex.resize(static_cast<std::size_t>(e));
       v.vertex.resize(static_cast<std::size_t>(e));
@@ -425,11 +431,8 @@ VertexRings vertex_rings(int dim, const std::vector<std::array<std::int32_t, 4>>
   r.offset.assign(n_points + 1, 0);
 #pragma omp parallel num_threads(threads)
   {
-    int t = 0;
-#ifdef _OPENMP
-    t = omp_get_thread_num();
-#endif
-    const std::ptrdiff_t lo = n * t / threads, hi = n * (t + 1) / threads;
+    const int t = thread_number();
+    const auto [lo, hi] = share(n, t, threads);
     auto& out = part[static_cast<std::size_t>(t)];
     // (room for one entry per simplex at a vertex, ~1.7 times a Delaunay ring: no regrowth;
     // pages never written are never touched)
