@@ -155,6 +155,10 @@ void write_vtk(const std::filesystem::path& path, Data& data) {
   w->SetFileName(out.temp_path().string().c_str());
   w->SetInputData(data);
   w->SetDataModeToBinary();
+  // LZ4, not VTK's default zlib: the 3.4e5-tetrahedron HHD mesh in 0.36 s instead of 1.6 s, for
+  // 61 MB instead of 54 (ParaView and VTK's readers decompress either; zlib at level 1 took
+  // 1.0 s). Inline (base64) data, whose header ranges are exact (appended data's are not).
+  w->SetCompressorTypeToLZ4();
   if (w->Write() != 1 || w->GetErrorCode() != 0)
     throw InputError(path.string(), "cannot write VTK output",
                      vtkErrorCode::GetStringFromErrorCode(w->GetErrorCode()));
