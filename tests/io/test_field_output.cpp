@@ -1,9 +1,16 @@
 // H5FieldFile (io/field_output.hpp): large arrays are chunked, shuffled and deflated, their
 // chunks filtered on the threads and written directly; HDF5 reads back every value exactly,
-// edge chunks included, for each element type.
+// edge chunks included, for each element type. The VTK meshes (LZ4) read back exactly too.
 #include <gtest/gtest.h>
 #include <hdf5.h>
+#include <vtkCellData.h>
+#include <vtkDataArray.h>
+#include <vtkNew.h>
+#include <vtkPointData.h>
+#include <vtkUnstructuredGrid.h>
+#include <vtkXMLUnstructuredGridReader.h>
 
+#include <cmath>
 #include <cstdint>
 #include <filesystem>
 #include <string>
@@ -93,6 +100,43 @@ TEST(FieldOutput, LargeArraysChunkedShuffledDeflatedAndReadBackExactly) {
   EXPECT_EQ(read_back<double>(file, "/small", H5T_NATIVE_DOUBLE, dims, filters), small);
   EXPECT_EQ(filters, 0);
   H5Fclose(file);
+  fs::remove(path);
+}
+
+TEST(FieldOutput, VtuMeshReadBackExactlyByVtk) {
+  // 20 000 tetrahedra of a strip of points: point and cell arrays of several components, in
+  // LZ4-compressed inline blocks, read back by VTK's own reader bit for bit.
+  const fs::path path = fs::temp_directory_path() / "gs_field_output_test.vtu";
+  std::vector<Eigen::Vector3d> points;
+  for (int i = 0; i < 20003; ++i)
+    points.emplace_back(0.001 * i, std::sin(0.1 * i), std::cos(0.37 * i));
+  std::vector<std::vector<std::int64_t>> cells;
+  for (std::int64_t i = 0; i + 3 < static_cast<std::int64_t>(points.size()); ++i)
+    cells.push_back({i, i + 1, i + 2, i + 3});
+  gs::VtkArray u{"u", 1, {}}, g{"grad_u", 3, {}};
+  for (std::size_t i = 0; i < points.size(); ++i) u.values.push_back(1.0 / (3.0 + i));
+  for (std::size_t k = 0; k < cells.size(); ++k)
+    for (int c = 0; c < 3; ++c) g.values.push_back(std::exp(-1e-4 * k) * (c + 0.1));
+  gs::write_vtu_mesh(path, points, 10, cells, {u}, {g});
+  vtkNew<vtkXMLUnstructuredGridReader> reader;
+  reader->SetFileName(path.string().c_str());
+  reader->Update();
+  vtkUnstructuredGrid* grid = reader->GetOutput();
+  ASSERT_EQ(grid->GetNumberOfPoints(), static_cast<vtkIdType>(points.size()));
+  ASSERT_EQ(grid->GetNumberOfCells(), static_cast<vtkIdType>(cells.size()));
+  vtkDataArray* ru = grid->GetPointData()->GetArray("u");
+  vtkDataArray* rg = grid->GetCellData()->GetArray("grad_u");
+  ASSERT_NE(ru, nullptr);
+  ASSERT_NE(rg, nullptr);
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    ASSERT_EQ(ru->GetComponent(static_cast<vtkIdType>(i), 0), u.values[i]);
+    double x[3];
+    grid->GetPoint(static_cast<vtkIdType>(i), x);
+    ASSERT_EQ(x[1], points[i].y());
+  }
+  for (std::size_t k = 0; k < cells.size(); ++k)
+    for (int c = 0; c < 3; ++c)
+      ASSERT_EQ(rg->GetComponent(static_cast<vtkIdType>(k), c), g.values[3 * k + c]);
   fs::remove(path);
 }
 
