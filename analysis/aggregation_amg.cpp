@@ -94,10 +94,7 @@ __attribute__((target("avx2"))) void row_sums_avx2(const int* outer, const int* 
 template <class F>
 void for_row_ranges(const RowMat& a, F&& f) {
   const Index n = a.rows(), nnz = a.nonZeros();
-  int threads = 1;
-#ifdef _OPENMP
-  threads = omp_get_max_threads();
-#endif
+  const int threads = max_threads();
   if (nnz < kParallelWork || threads == 1) {
     f(Index{0}, n, Index{-1});
     return;
@@ -256,10 +253,7 @@ RowMat multiply(const RowMat& a, const RowMat& b, bool sorted = true) {
   const int* bo = b.outerIndexPtr();
   const int* bi = b.innerIndexPtr();
   const double* bv = b.valuePtr();
-  int threads = 1;
-#ifdef _OPENMP
-  if (a.nonZeros() >= kParallelWork) threads = omp_get_max_threads();
-#endif
+  const int threads = a.nonZeros() >= kParallelWork ? max_threads() : 1;
   return assemble_rows<RowMat>(
       n, m, threads,
       [&](Index lo, Index hi, std::vector<int>& c, std::vector<double>& v,

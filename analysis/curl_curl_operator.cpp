@@ -2,6 +2,7 @@
 #include "curl_curl_operator.hpp"
 
 #include "simd_choice.hpp"
+#include "thread_rows.hpp"
 
 #include <algorithm>
 #include <stdexcept>
@@ -200,21 +201,15 @@ void apply_curl_curl(const CurlCurlOperator& op, const Rows3& v, Rows3& result,
                       (kernel == CurlCurlKernel::Best && simd_allowed(SimdCap::Avx512));
   const Eigen::Index n = v.rows();
   const std::size_t ns = op.size;
-  int threads = 1;
-#ifdef _OPENMP
-  threads = omp_get_max_threads();
-#endif
+  const int threads = max_threads();
   part.resize(static_cast<std::size_t>(threads));
 #pragma omp parallel num_threads(threads)
   {
-    int t = 0;
-#ifdef _OPENMP
-    t = omp_get_thread_num();
-#endif
+    const int t = thread_number();
     Rows3& out = t == 0 ? result : part[static_cast<std::size_t>(t)];
     out.setZero(n, 3);
-    const std::size_t lo = ns * static_cast<std::size_t>(t) / static_cast<std::size_t>(threads);
-    const std::size_t hi = ns * static_cast<std::size_t>(t + 1) / static_cast<std::size_t>(threads);
+    const auto [first, last] = thread_share(static_cast<std::ptrdiff_t>(ns), t, threads);
+    const auto lo = static_cast<std::size_t>(first), hi = static_cast<std::size_t>(last);
 #if GS_CURL_X86
     if (vector)
       range_avx512(op, lo, hi, v.data(), out.data());

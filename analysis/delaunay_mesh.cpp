@@ -25,6 +25,8 @@
 #include <utility>
 
 #include <Eigen/Geometry>
+
+#include "thread_rows.hpp"
 #ifdef CGAL_LINKED_WITH_TBB
 #include <tbb/task_arena.h>
 #endif
@@ -59,30 +61,8 @@ using Vb2 = CGAL::Triangulation_vertex_base_with_info_2<std::int32_t, K>;
 using Tds2 = CGAL::Triangulation_data_structure_2<Vb2>;
 using Delaunay2 = CGAL::Delaunay_triangulation_2<K, Tds2>;
 
-#ifdef CGAL_LINKED_WITH_TBB
-// As many threads as the OpenMP parts use (OMP_NUM_THREADS, a scene's `threads`).
-int openmp_threads() {
-#ifdef _OPENMP
-  return omp_get_max_threads();
-#else
-  return 1;
-#endif
-}
-#endif
-
-// This thread's number in a parallel region (0 outside, or without OpenMP).
-int thread_number() {
-#ifdef _OPENMP
-  return omp_get_thread_num();
-#else
-  return 0;
-#endif
-}
-
-// Thread t's contiguous share [first, second) of n items split among `threads`.
-std::pair<std::ptrdiff_t, std::ptrdiff_t> share(std::ptrdiff_t n, int t, int threads) {
-  return {n * t / threads, n * (t + 1) / threads};
-}
+// From this many simplices the counting sorts run on the threads.
+constexpr std::size_t kParallelSimplices = 100000;
 
 // The middle of a counting sort done by threads: counts[t][i], thread t's items of key i,
 // become the places where thread t writes them (key by key, thread by thread: the threads'
@@ -137,10 +117,7 @@ void check_input(const std::vector<Vec>& points, std::size_t min_points, const c
 void canonical_order(std::vector<std::array<std::int32_t, 4>>& t, std::size_t n_points) {
   using Tet = std::array<std::int32_t, 4>;
   const auto nt = static_cast<std::ptrdiff_t>(t.size());
-  int threads = 1;
-#ifdef _OPENMP
-  if (nt >= 100000) threads = omp_get_max_threads();
-#endif
+  const int threads = t.size() >= kParallelSimplices ? max_threads() : 1;
   std::vector<std::vector<std::size_t>> fill(static_cast<std::size_t>(threads));
   std::vector<std::size_t> start(n_points + 1, 0);
   // (not initialised: every place is written once, on the thread that fills it)
@@ -148,7 +125,7 @@ void canonical_order(std::vector<std::array<std::int32_t, 4>>& t, std::size_t n_
 #pragma omp parallel num_threads(threads)
   {
     const int th = thread_number();
-    const auto [lo, hi] = share(nt, th, threads);
+    const auto [lo, hi] = thread_share(nt, th, threads);
     auto& mine = fill[static_cast<std::size_t>(th)];
     mine.assign(n_points, 0);
     for (auto kk = lo; kk < hi; ++kk) {
@@ -224,7 +201,7 @@ DelaunayMesh delaunay_mesh(const std::vector<Eigen::Vector3d>& points) {
     box.extend(points[i]);
   }
 #ifdef CGAL_LINKED_WITH_TBB
-  const int threads = openmp_threads();
+  const int threads = max_threads();
   if (threads > 1 && points.size() >= kParallelDelaunay) {
     PDelaunay3::Lock_data_structure lock(
         CGAL::Bbox_3(box.min().x(), box.min().y(), box.min().z(), box.max().x(), box.max().y(),
@@ -355,7 +332,7 @@ std::vector<std::int32_t> hilbert_order(const std::vector<Eigen::Vector3d>& poin
         CGAL::Spatial_sort_traits_adapter_3<K, CGAL::Pointer_property_map<K::Point_3>::type>;
     const Traits traits(CGAL::make_property_map(p));
 #ifdef CGAL_LINKED_WITH_TBB
-    const int threads = openmp_threads();
+    const int threads = max_threads();
     if (threads > 1 && points.size() >= kParallelDelaunay) {
       // CGAL's parallel median split makes the same cuts as the sequential one (disjoint ranges
       // sorted side by side): the same order.
@@ -376,10 +353,7 @@ VertexSimplices vertex_simplices(int dim, const std::vector<std::array<std::int3
   // A counting sort by vertex, stable: each thread counts the vertices of a contiguous range of
   // simplices, then writes them from its own starts (after the ranges before it), so each
   // vertex's simplices come in simplex order whatever the number of threads.
-  int threads = 1;
-#ifdef _OPENMP
-  if (simplices.size() >= 100000) threads = omp_get_max_threads();
-#endif
+  const int threads = simplices.size() >= kParallelSimplices ? max_threads() : 1;
   const auto ns = static_cast<std::ptrdiff_t>(simplices.size());
   std::vector<std::vector<std::int64_t>> start(static_cast<std::size_t>(threads));
   VertexSimplices v;
@@ -389,7 +363,7 @@ VertexSimplices vertex_simplices(int dim, const std::vector<std::array<std::int3
     const int t = thread_number();
     auto& mine = start[static_cast<std::size_t>(t)];
     mine.assign(n_points, 0);
-    const auto [lo, hi] = share(ns, t, threads);
+    const auto [lo, hi] = thread_share(ns, t, threads);
     for (auto k = lo; k < hi; ++k)
       for (int a = 0; a < nv; ++a)
         ++mine[static_cast<std::size_t>(
@@ -422,17 +396,14 @@ VertexRings vertex_rings(int dim, const std::vector<std::array<std::int32_t, 4>>
   const VertexSimplices at = vertex_simplices(dim, simplices, n_points);
   const std::vector<std::int64_t>& offset = at.offset;
   const auto n = static_cast<std::ptrdiff_t>(n_points);
-  int threads = 1;
-#ifdef _OPENMP
-  threads = omp_get_max_threads();
-#endif
+  const int threads = max_threads();
   std::vector<std::vector<std::int32_t>> part(static_cast<std::size_t>(threads));
   VertexRings r;
   r.offset.assign(n_points + 1, 0);
 #pragma omp parallel num_threads(threads)
   {
     const int t = thread_number();
-    const auto [lo, hi] = share(n, t, threads);
+    const auto [lo, hi] = thread_share(n, t, threads);
     auto& out = part[static_cast<std::size_t>(t)];
     // (room for one entry per simplex at a vertex, ~1.7 times a Delaunay ring: no regrowth;
     // pages never written are never touched)

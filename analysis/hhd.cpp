@@ -153,13 +153,9 @@ Sparse stiffness(const HhdMesh& m, const P1Geometry& g, const std::vector<int>& 
   const int nv = m.dim == 3 ? 3 : 1;
   bu.resize(n);  // (every row written below)
   b18.resize(n, nv);
-  int threads = 1;
-#ifdef _OPENMP
-  threads = omp_get_max_threads();
-#endif
   // Symmetric: the rows are the columns.
   return assemble_rows<Sparse>(
-      n, n, threads,
+      n, n, max_threads(),
       [&](Eigen::Index lo, Eigen::Index hi, std::vector<int>& c, std::vector<double>& v,
           std::vector<int>& outer) {
         std::vector<int> mark(static_cast<std::size_t>(n), -1), pos(static_cast<std::size_t>(n), 0);

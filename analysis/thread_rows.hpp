@@ -7,6 +7,7 @@
 #include <Eigen/Sparse>
 #include <algorithm>
 #include <cstddef>
+#include <utility>
 #include <vector>
 
 #ifdef _OPENMP
@@ -14,6 +15,30 @@
 #endif
 
 namespace gs::analysis {
+
+/// The threads a parallel region gets (OMP_NUM_THREADS, a scene's `threads`; 1 without OpenMP).
+inline int max_threads() {
+#ifdef _OPENMP
+  return omp_get_max_threads();
+#else
+  return 1;
+#endif
+}
+
+/// This thread's number in a parallel region (0 outside one, or without OpenMP).
+inline int thread_number() {
+#ifdef _OPENMP
+  return omp_get_thread_num();
+#else
+  return 0;
+#endif
+}
+
+/// Thread t's contiguous share [first, second) of n items split among `threads`.
+inline std::pair<std::ptrdiff_t, std::ptrdiff_t> thread_share(std::ptrdiff_t n, int t,
+                                                              int threads) {
+  return {n * t / threads, n * (t + 1) / threads};
+}
 
 /// Rows go to the threads in chunks of this many.
 inline constexpr Eigen::Index kRowChunk = 2048;
@@ -67,12 +92,9 @@ Sparse assemble_rows(Eigen::Index rows, Eigen::Index cols, int threads, Build&& 
   std::vector<int> outer(static_cast<std::size_t>(rows) + 1, 0);
 #pragma omp parallel num_threads(threads)
   {
-    int t = 0;
-#ifdef _OPENMP
-    t = omp_get_thread_num();
-#endif
-    build(rows * t / threads, rows * (t + 1) / threads, inner[static_cast<std::size_t>(t)],
-          value[static_cast<std::size_t>(t)], outer);
+    const int t = thread_number();
+    const auto [lo, hi] = thread_share(rows, t, threads);
+    build(lo, hi, inner[static_cast<std::size_t>(t)], value[static_cast<std::size_t>(t)], outer);
   }
   return join_thread_rows<Sparse>(rows, cols, outer, inner, value);
 }
