@@ -12,7 +12,7 @@
 # discharges (a long STEPS). ORIFICE=small: the small-orifice silo instead (RUN_DIR a run of
 # data/scenes/dem8_silo_small_laptop.toml). YADE=0: no YADE run (ratios against LIGGGHTS; YADE
 # takes ~40 ms a step here, so a flowing discharge of tens of thousands of steps is hours).
-#   bench/solver/run_dem8_silo_bench.sh RUN_DIR [BUILD_DIR]   (needs yade and ../shared/dem8)
+#   bench/solver/run_dem8_silo_bench.sh RUN_DIR [BUILD_DIR]   (needs ../shared/dem8; yade unless YADE=0)
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
 root=$(cd "$here/../.." && pwd)
@@ -34,26 +34,8 @@ walls=$d8/case1_silo/walls_${ORIFICE:-large}_orifice.txt
 traj=$run/trajectory.h5
 [ -f "$traj" ] || traj=$run/trajectory.h5.partial
 "$gs" convert "$traj" "$work/frame.csv" --frame "${FRAME:--1}" > /dev/null
-"$py" - "$root/data/scenes/$scene.toml" "$work" "$d8" "$steps" "$scene" <<'PY'
-import csv, re, sys
-scene, work, d8, steps, name = sys.argv[1:6]
-rows = list(csv.DictReader(open(work + "/frame.csv")))
-with open(work + "/packing.csv", "w") as f:
-    f.write("id,x,y,z,r\n")
-    for k, r in enumerate(rows):
-        f.write("%d,%s,%s,%s,%s\n" % (k, r["x"], r["y"], r["z"], r["radius"] if "radius" in r else r["r"]))
-s = open(scene).read()
-s = re.sub(r"\n\[fill\].*?(?=\n\[)", "\n", s, flags=re.S)          # no filling: the packing
-s = re.sub(r"\n\[\[walls\]\].*?(?=\n\[)", "\n", s, flags=re.S)  # no lid: the orifice open
-s = s.replace('name = "%s"' % name, 'name = "silo_bench"\npacking = "packing.csv"')
-s = s.replace('"../../../shared/dem8/', '"%s/' % d8).replace('contact = "merged"', 'contact = "yade"')
-s = re.sub(r"\nsteps = .*", "\nsteps = %s" % steps, s)
-s = re.sub(r"\nevery = .*", "\nevery = 100000000", s)
-s = re.sub(r"\ncheckpoint_every = .*", "\ncheckpoint_every = 100000000", s)
-open(work + "/silo.toml", "w").write(s)
-print(len(rows))
-PY
-n=$($py -c "import csv;print(sum(1 for _ in csv.DictReader(open('$work/packing.csv'))))")
+n=$("$py" "$here/dem8_silo_frame_scene.py" "$root/data/scenes/$scene.toml" "$work" "$d8" "$steps" \
+  --contact yade)
 for t in 1 2; do
   "$gs" simulate "$work/silo.toml" --threads $t -q -o "$work/run$t" > "$work/gs$t.txt"
 done

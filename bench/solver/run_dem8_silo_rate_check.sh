@@ -42,27 +42,9 @@ walls=$d8/case1_silo/walls_${ORIFICE:-large}_orifice.txt
 traj=$run/trajectory.h5
 [ -f "$traj" ] || { echo "$traj: no finished run (stop it after the filling: steps = 1)"; exit 1; }
 "$gs" convert "$traj" "$work/frame.csv" --frame -1 > /dev/null 2>&1
-"$py" - "$root/data/scenes/$scene.toml" "$work" "$d8" "$steps" "$scene" "$every" <<'PY'
-import csv, re, sys
-scene, work, d8, steps, name, every = sys.argv[1:7]
-rows = list(csv.DictReader(open(work + "/frame.csv")))
-with open(work + "/packing.csv", "w") as f:
-    f.write("id,x,y,z,r\n")
-    for k, r in enumerate(rows):
-        f.write("%d,%s,%s,%s,%s\n" % (k, r["x"], r["y"], r["z"], r["radius"] if "radius" in r else r["r"]))
-s = open(scene).read()
-s = re.sub(r"\n\[fill\].*?(?=\n\[)", "\n", s, flags=re.S)          # no filling: the packing
-s = re.sub(r"\n\[\[walls\]\].*?(?=\n\[)", "\n", s, flags=re.S)  # no lid: the orifice open
-s = s.replace('name = "%s"' % name, 'name = "silo_rate"\npacking = "packing.csv"')
-s = s.replace('"../../../shared/dem8/', '"%s/' % d8)
-s = re.sub(r"\nsteps = .*", "\nsteps = %s" % steps, s)
-s = re.sub(r"\nthreads = .*", "\nthreads = 1", s)
-s = re.sub(r"\nevery = .*", "\nevery = 100000000", s)
-s = re.sub(r"\nhistory_every = .*", "\nhistory_every = %s" % every, s)
-s = re.sub(r"\ncheckpoint_every = .*", "\ncheckpoint_every = 100000000", s)
-open(work + "/silo.toml", "w").write(s)
-print("%d spheres from %s" % (len(rows), work + "/frame.csv"))
-PY
+n=$("$py" "$here/dem8_silo_frame_scene.py" "$root/data/scenes/$scene.toml" "$work" "$d8" "$steps" \
+  --threads 1 --history-every "$every")
+echo "$n spheres from $work/frame.csv"
 "$py" "$here/liggghts_dem8_silo.py" "$work/packing.csv" "$walls" "$z_orifice" "$steps" "$every" \
   "$work/lig"
 if [ -z "${REPORT_ONLY:-}" ]; then  # (REPORT_ONLY=1 with WORK=DIR: the report of runs made)
