@@ -25,12 +25,7 @@ work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 [ -x "$gs" ] || { echo "build first (scripts/build)"; exit 1; }
 steps=${STEPS:-2000}
-case ${ORIFICE:-large} in
-  large) scene=dem8_silo_laptop; z_orifice=-0.0554222 ;;
-  small) scene=dem8_silo_small_laptop; z_orifice=-0.0593008 ;;
-  *) echo "ORIFICE: large or small"; exit 1 ;;
-esac
-walls=$d8/case1_silo/walls_${ORIFICE:-large}_orifice.txt
+. "$here/dem8_silo_orifice.sh"
 traj=$run/trajectory.h5
 [ -f "$traj" ] || traj=$run/trajectory.h5.partial
 "$gs" convert "$traj" "$work/frame.csv" --frame "${FRAME:--1}" > /dev/null

@@ -33,12 +33,7 @@ mkdir -p "$work"
 steps=${STEPS:-180000}
 skip=${SKIP:-0.05}
 every=500
-case ${ORIFICE:-large} in
-  large) scene=dem8_silo_laptop; z_orifice=-0.0554222 ;;
-  small) scene=dem8_silo_small_laptop; z_orifice=-0.0593008 ;;
-  *) echo "ORIFICE: large or small"; exit 1 ;;
-esac
-walls=$d8/case1_silo/walls_${ORIFICE:-large}_orifice.txt
+. "$here/dem8_silo_orifice.sh"
 traj=$run/trajectory.h5
 [ -f "$traj" ] || { echo "$traj: no finished run (stop it after the filling: steps = 1)"; exit 1; }
 "$gs" convert "$traj" "$work/frame.csv" --frame -1 > /dev/null 2>&1
