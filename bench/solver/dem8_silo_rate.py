@@ -47,6 +47,21 @@ def fill_count(out):
     return None
 
 
+def fit_rate(xs, ys):
+    """The least-squares line through the removed count ys against time xs (s): its slope (the
+    discharge rate, particles/s), R^2 (nan when ys is constant) and the largest |N - fit|."""
+    n = len(xs)
+    mx, my = sum(xs) / n, sum(ys) / n
+    sxx = sum((x - mx) ** 2 for x in xs)
+    sxy = sum((x - mx) * (y - my) for x, y in zip(xs, ys))
+    slope = sxy / sxx
+    icpt = my - slope * mx
+    res = [y - (icpt + slope * x) for x, y in zip(xs, ys)]
+    syy = sum((y - my) ** 2 for y in ys)
+    r2 = 1 - sum(r * r for r in res) / syy if syy > 0 else float("nan")
+    return slope, r2, max(map(abs, res))
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("out", help="the run's output folder")
@@ -90,19 +105,10 @@ def main():
     if len(sel) < 3:
         sys.exit(f"error: {path}: fewer than 3 rows after the first {a.skip} s")
     xs = [t[i] - t0 for i in sel]
-    ys = [removed[i] for i in sel]
-    n = len(xs)
-    mx, my = sum(xs) / n, sum(ys) / n
-    sxx = sum((x - mx) ** 2 for x in xs)
-    sxy = sum((x - mx) * (y - my) for x, y in zip(xs, ys))
-    slope = sxy / sxx
-    icpt = my - slope * mx
-    res = [y - (icpt + slope * x) for x, y in zip(xs, ys)]
-    syy = sum((y - my) ** 2 for y in ys)
-    r2 = 1 - sum(r * r for r in res) / syy if syy > 0 else float("nan")
+    slope, r2, dev = fit_rate(xs, [removed[i] for i in sel])
     print(f"discharged {removed[-1]:.0f} of {total} in {t[-1] - t0:.4f} s")
-    print(f"rate (fit over {xs[0]:.3f}..{xs[-1]:.3f} s after opening, {n} rows): "
-          f"{slope:.1f} particles/s  R^2 = {r2:.6f}  max |N - fit| = {max(map(abs, res)):.1f}")
+    print(f"rate (fit over {xs[0]:.3f}..{xs[-1]:.3f} s after opening, {len(xs)} rows): "
+          f"{slope:.1f} particles/s  R^2 = {r2:.6f}  max |N - fit| = {dev:.1f}")
 
 
 if __name__ == "__main__":

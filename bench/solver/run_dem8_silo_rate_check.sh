@@ -50,9 +50,11 @@ if [ -z "${REPORT_ONLY:-}" ]; then  # (REPORT_ONLY=1 with WORK=DIR: the report o
   wait $lig || { echo "LIGGGHTS failed: $work/lig/log.txt"; exit 1; }
   wait $ours || { echo "granoscope failed: $work/gs.txt"; exit 1; }
 fi
-"$py" - "$work" "$steps" "$every" "$skip" <<'PY'
+"$py" - "$work" "$steps" "$every" "$skip" "$here" <<'PY'
 import csv, re, sys
 work, steps, every, skip = sys.argv[1], int(sys.argv[2]), int(sys.argv[3]), float(sys.argv[4])
+sys.path.insert(0, sys.argv[5])
+from dem8_silo_rate import fit_rate  # (the fit dem8_silo_rate.py reports)
 dt = 1.5e-6
 n = sum(1 for _ in csv.DictReader(open(work + "/packing.csv")))
 # LIGGGHTS: `run 1`, then `run STEPS` printing the count at the steps that are multiples of
@@ -66,16 +68,9 @@ ours = {0: 0}
 ours.update({int(r["step"]): round(float(r["removed"]))
              for r in csv.DictReader(open(work + "/gs/history.csv"))})
 def fit(c):
-    xs = [k * dt for k in sorted(c) if k * dt >= skip - 1e-12]
-    ys = [c[k] for k in sorted(c) if k * dt >= skip - 1e-12]
-    m = len(xs)
-    mx, my = sum(xs) / m, sum(ys) / m
-    sxx = sum((x - mx) ** 2 for x in xs)
-    slope = sum((x - mx) * (y - my) for x, y in zip(xs, ys)) / sxx
-    res = [y - (my + slope * (x - mx)) for x, y in zip(xs, ys)]
-    syy = sum((y - my) ** 2 for y in ys)
-    r2 = 1 - sum(r * r for r in res) / syy if syy > 0 else float("nan")
-    return slope, r2, max(map(abs, res)), xs[0], xs[-1]
+    ks = [k for k in sorted(c) if k * dt >= skip - 1e-12]
+    xs = [k * dt for k in ks]
+    return fit_rate(xs, [c[k] for k in ks]) + (xs[0], xs[-1])
 print("DEM8 Case 1 discharge from the same settled packing, %d spheres, %d steps of 1.5 us:" % (n, steps))
 print("  t (s)   above the orifice: granoscope  LIGGGHTS 3.8")
 marks = {round(j * 0.1 / dt / every) * every for j in range(int(steps * dt / 0.1) + 1)} | {steps}
