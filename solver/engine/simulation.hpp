@@ -367,6 +367,9 @@ class Simulation {
   /// geometry of a wall pair (a sphere pair's the batch computes); false when a wall pair does
   /// not touch (its history is then marked not real).
   bool prepare_pair(std::size_t k, ContactBatch& batch, int j);
+  /// A wall pair's own fields of lane j (geometry and the bodies' motion), or false (and the
+  /// contact ended) where it does not touch: prepare_pair's part for walls.
+  bool prepare_wall_lane(std::size_t k, ContactBatch& batch, int j);
   /// Material i of the scene (0: cfg_.material).
   const Material& material_at(int i) const {
     return i == 0 ? cfg_.material : cfg_.more_materials[static_cast<std::size_t>(i - 1)];

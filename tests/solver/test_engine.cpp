@@ -19,6 +19,7 @@
 #include "cohesive_frictional_law.hpp"
 #include "contact_geometry.hpp"
 #include "errors.hpp"
+#include "mesh_walls.hpp"
 #include "newton_integrator.hpp"
 #include "scene_file.hpp"
 #include "simd_level.hpp"
@@ -415,6 +416,111 @@ TEST(ContactBatchGeometry, SpherePairLanesAreTheScalarGeometryBitForBit) {
   }
   set_simd_level(before);
   EXPECT_GT(touching, 28);
+}
+
+/// 150 spheres in a V-shaped mesh trough (two tilted flanks and a flat floor, two
+/// triangles each), with the given law and mesh convention.
+Simulation mesh_trough_run(ContactLaw law, MeshContact mode, int threads) {
+  std::mt19937_64 rng(17);
+  std::uniform_real_distribution<double> u(-1, 1);
+  std::vector<Particle> ps;
+  const double a = 2.0e-3;  // (a packing in contact from the start, boxed in)
+  for (int z = 0; z < 6; ++z)
+    for (int y = 0; y < 5; ++y)
+      for (int x = 0; x < 5; ++x) {
+        Particle p;
+        p.id = static_cast<std::int64_t>(ps.size());
+        p.radius = 1e-3 * (1 + 0.03 * u(rng));
+        p.position = Eigen::Vector3d((x - 2) * a, (y - 2) * a, 1e-3 + z * a) +
+                     0.05e-3 * Eigen::Vector3d(u(rng), u(rng), u(rng));
+        p.velocity = 0.2 * Eigen::Vector3d(u(rng), u(rng), u(rng));
+        p.angular_velocity = 200 * Eigen::Vector3d(u(rng), u(rng), u(rng));
+        ps.push_back(p);
+      }
+  SimulationConfig c;
+  c.law = law;
+  c.material = engine_material();
+  c.material.poisson = 0.25;
+  c.material.restitution = 0.5;
+  c.damping = law == ContactLaw::HertzMindlin ? 0.0 : 0.1;
+  c.gravity = Eigen::Vector3d(0, 0, -9.81);
+  c.dt = 0.2 * pwave_timestep({0.98e-3}, c.material.density, c.material.young_ec);
+  c.max_overlap_ratio = 0.5;
+  c.threads = threads;
+  // The floor |x| ≤ 5.2 mm at z = 0 (the outer columns' spheres reach 5.0 mm), the flanks
+  // rising from its edges at 45° to |x| = 12 mm.
+  const double h = 5.2e-3, w = 12e-3, d = 8e-3;
+  auto quad = [](MeshTriangles& m, const Eigen::Vector3d& p0, const Eigen::Vector3d& p1,
+                 const Eigen::Vector3d& p2, const Eigen::Vector3d& p3, const char* group) {
+    m.triangles.push_back({p0, p1, p2});
+    m.triangles.push_back({p0, p2, p3});
+    m.group.insert(m.group.end(), 2, group);
+  };
+  MeshTriangles m;
+  quad(m, {-h, -d, 0}, {h, -d, 0}, {h, d, 0}, {-h, d, 0}, "floor");
+  quad(m, {h, -d, 0}, {w, -d, w - h}, {w, d, w - h}, {h, d, 0}, "right");
+  quad(m, {-w, -d, w - h}, {-h, -d, 0}, {-h, d, 0}, {-w, d, w - h}, "left");
+  // Held in by planes in front, behind and above (plane lanes too).
+  std::vector<WallSpec> walls = mesh_walls(m, mode);
+  walls.push_back(plane_wall({0, -5e-3, 0}, {0, 1, 0}));
+  walls.push_back(plane_wall({0, 5e-3, 0}, {0, -1, 0}));
+  walls.push_back(plane_wall({0, 0, 6 * a}, {0, 0, -1}, {0, 0, -0.2}));
+  return Simulation(c, ps, walls);
+}
+
+// The contact pass's gather (lane_gather.hpp: the pairs' histories and parameters and the sphere
+// pairs' bodies by AVX-512 gathers, the wall lanes' geometry one by one among them) fills the
+// law's batch with the same values as the plain copies: whole runs on a mesh trough (facet lanes
+// among sphere lanes) give the same bits, with both laws, both mesh conventions, and the threads'
+// pass.
+TEST_P(SimdVariant, MeshRunsAreTheSameBitsAsThePlainGather) {
+  const SimdLevel level = GetParam();
+  if (!simd_level_supported(level))
+    GTEST_SKIP() << "this CPU cannot run the " << simd_level_name(level) << " kernels";
+  SimdLevelGuard guard;
+  struct Case {
+    ContactLaw law;
+    MeshContact mode;
+    int threads;
+  };
+  for (const auto& [law, mode, threads] :
+       {Case{ContactLaw::CohesiveFrictional, MeshContact::Merged, 1},
+        Case{ContactLaw::CohesiveFrictional, MeshContact::YadeParity, 1},
+        Case{ContactLaw::HertzMindlin, MeshContact::Merged, 1},
+        Case{ContactLaw::HertzMindlin, MeshContact::YadeParity, 1},
+        Case{ContactLaw::HertzMindlin, MeshContact::Merged, 2}}) {
+    SCOPED_TRACE(::testing::Message() << "law " << static_cast<int>(law) << " mode "
+                                      << static_cast<int>(mode) << " threads " << threads);
+    set_simd_level(SimdLevel::Generic);
+    Simulation plain = mesh_trough_run(law, mode, threads);
+    plain.run(500);
+    set_simd_level(level);
+    Simulation simd = mesh_trough_run(law, mode, threads);
+    simd.run(500);
+    const auto& p = plain.particles();
+    const auto& q = simd.particles();
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      ASSERT_TRUE(same_bits(p.pos[i], q.pos[i])) << i;
+      ASSERT_TRUE(same_bits(p.vel[i], q.vel[i])) << i;
+      ASSERT_TRUE(same_bits(p.angvel[i], q.angvel[i])) << i;
+    }
+    const Frame fp = plain.frame(), fq = simd.frame();
+    ASSERT_EQ(fp.contacts.size(), fq.contacts.size());
+    std::size_t wall_contacts = 0;
+    for (std::size_t k = 0; k < fp.contacts.size(); ++k) {
+      const Contact &x = fp.contacts[k], &y = fq.contacts[k];
+      ASSERT_EQ(x.id1, y.id1);
+      ASSERT_EQ(x.id2, y.id2);
+      ASSERT_TRUE(same_bits(x.normal_force, y.normal_force)) << k;
+      ASSERT_TRUE(same_bits(x.shear_force, y.shear_force)) << k;
+      wall_contacts += x.id1 >= static_cast<std::int64_t>(p.size());
+    }
+    for (std::size_t w = 0; w < plain.walls().size(); ++w)
+      EXPECT_TRUE(same_bits(plain.walls()[w].force, simd.walls()[w].force)) << w;
+    // The runs had both kinds of lanes, mixed in batches.
+    EXPECT_GT(wall_contacts, 20u);
+    EXPECT_GT(fp.contacts.size(), 150u);
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(Engine, SimdVariant, ::testing::Values(SimdLevel::Avx2, SimdLevel::Avx512),
