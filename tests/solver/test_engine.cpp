@@ -187,26 +187,37 @@ ParticleState random_particles(std::mt19937_64& rng, std::size_t n) {
   return p;
 }
 
+/// nx·ny·nz spheres of radius 1 mm ± 3 % on a lattice of 2 mm from `first`, jittered by
+/// ±0.05 mm (many overlapping from the start), with random velocities (±0.2 m/s) and spins
+/// (±`spin` rad/s).
+std::vector<Particle> jittered_lattice(std::mt19937_64& rng, const Eigen::Vector3i& n,
+                                       const Eigen::Vector3d& first, double spin) {
+  std::uniform_real_distribution<double> u(-1, 1);
+  std::vector<Particle> ps;
+  const double a = 2.0e-3;
+  for (int z = 0; z < n.z(); ++z)
+    for (int y = 0; y < n.y(); ++y)
+      for (int x = 0; x < n.x(); ++x) {
+        Particle p;
+        p.id = static_cast<std::int64_t>(ps.size());
+        p.radius = 1e-3 * (1 + 0.03 * u(rng));
+        p.position = first + a * Eigen::Vector3d(x, y, z) +
+                     0.05e-3 * Eigen::Vector3d(u(rng), u(rng), u(rng));
+        p.velocity = 0.2 * Eigen::Vector3d(u(rng), u(rng), u(rng));
+        p.angular_velocity = spin * Eigen::Vector3d(u(rng), u(rng), u(rng));
+        ps.push_back(p);
+      }
+  return ps;
+}
+
 /// A dense jittered lattice of 288 spheres (radii ±3 %, many overlapping from the start), with
 /// random velocities and spins, in a box: bottom box (contact-point form), plane sides, a plane
 /// lid moving down and a box side moving in; a few particles fixed, a few with blocked spin.
 Simulation dense_run(bool twisting) {
   std::mt19937_64 rng(17);
-  std::uniform_real_distribution<double> u(-1, 1);
-  std::vector<Particle> ps;
   const double a = 2.0e-3;
-  for (int z = 0; z < 8; ++z)
-    for (int y = 0; y < 6; ++y)
-      for (int x = 0; x < 6; ++x) {
-        Particle p;
-        p.id = static_cast<std::int64_t>(ps.size());
-        p.radius = 1e-3 * (1 + 0.03 * u(rng));
-        p.position = Eigen::Vector3d((x + 0.5) * a, (y + 0.5) * a, (z + 0.5) * a) +
-                     0.05e-3 * Eigen::Vector3d(u(rng), u(rng), u(rng));
-        p.velocity = 0.2 * Eigen::Vector3d(u(rng), u(rng), u(rng));
-        p.angular_velocity = 300 * Eigen::Vector3d(u(rng), u(rng), u(rng));
-        ps.push_back(p);
-      }
+  const std::vector<Particle> ps =
+      jittered_lattice(rng, {6, 6, 8}, Eigen::Vector3d(0.5 * a, 0.5 * a, 0.5 * a), 300);
   SimulationConfig c;
   c.material = engine_material();
   c.damping = 0.1;
@@ -422,21 +433,9 @@ TEST(ContactBatchGeometry, SpherePairLanesAreTheScalarGeometryBitForBit) {
 /// triangles each), with the given law and mesh convention.
 Simulation mesh_trough_run(ContactLaw law, MeshContact mode, int threads) {
   std::mt19937_64 rng(17);
-  std::uniform_real_distribution<double> u(-1, 1);
-  std::vector<Particle> ps;
   const double a = 2.0e-3;  // (a packing in contact from the start, boxed in)
-  for (int z = 0; z < 6; ++z)
-    for (int y = 0; y < 5; ++y)
-      for (int x = 0; x < 5; ++x) {
-        Particle p;
-        p.id = static_cast<std::int64_t>(ps.size());
-        p.radius = 1e-3 * (1 + 0.03 * u(rng));
-        p.position = Eigen::Vector3d((x - 2) * a, (y - 2) * a, 1e-3 + z * a) +
-                     0.05e-3 * Eigen::Vector3d(u(rng), u(rng), u(rng));
-        p.velocity = 0.2 * Eigen::Vector3d(u(rng), u(rng), u(rng));
-        p.angular_velocity = 200 * Eigen::Vector3d(u(rng), u(rng), u(rng));
-        ps.push_back(p);
-      }
+  const std::vector<Particle> ps =
+      jittered_lattice(rng, {5, 5, 6}, Eigen::Vector3d(-2 * a, -2 * a, 1e-3), 200);
   SimulationConfig c;
   c.law = law;
   c.material = engine_material();
