@@ -248,6 +248,40 @@ Simulation dense_run(bool twisting) {
   return sim;
 }
 
+/// What compare_runs counted in the runs' last frame.
+struct RunCounts {
+  std::size_t contacts = 0, wall_contacts = 0, twisted = 0;
+};
+
+/// Asserts that two runs hold the same bits: the particles' motion, the contacts (ids, forces
+/// and moments) and the walls' forces.
+void compare_runs(const Simulation& plain, const Simulation& simd, RunCounts& n) {
+  const auto& p = plain.particles();
+  const auto& q = simd.particles();
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    ASSERT_TRUE(same_bits(p.pos[i], q.pos[i])) << i;
+    ASSERT_TRUE(same_bits(p.vel[i], q.vel[i])) << i;
+    ASSERT_TRUE(same_bits(p.angvel[i], q.angvel[i])) << i;
+    ASSERT_TRUE(same_bits(p.ori[i], q.ori[i])) << i;
+  }
+  const Frame fp = plain.frame(), fq = simd.frame();
+  ASSERT_EQ(fp.contacts.size(), fq.contacts.size());
+  n.contacts = fp.contacts.size();
+  for (std::size_t k = 0; k < fp.contacts.size(); ++k) {
+    const Contact &a = fp.contacts[k], &b = fq.contacts[k];
+    ASSERT_EQ(a.id1, b.id1);
+    ASSERT_EQ(a.id2, b.id2);
+    ASSERT_TRUE(same_bits(a.normal_force, b.normal_force)) << k;
+    ASSERT_TRUE(same_bits(a.shear_force, b.shear_force)) << k;
+    ASSERT_TRUE(same_bits(a.bending_moment, b.bending_moment)) << k;
+    ASSERT_TRUE(same_bits(a.twisting_moment, b.twisting_moment)) << k;
+    n.wall_contacts += a.id1 >= static_cast<std::int64_t>(p.size());
+    n.twisted += a.twisting_moment.norm() > 0;
+  }
+  for (std::size_t w = 0; w < plain.walls().size(); ++w)
+    EXPECT_TRUE(same_bits(plain.walls()[w].force, simd.walls()[w].force)) << w;
+}
+
 class SimdVariant : public ::testing::TestWithParam<SimdLevel> {};
 
 // Exact answer: the plain x86-64 kernels. The AVX2 and AVX-512 variants must give the same bits
@@ -336,37 +370,16 @@ TEST_P(SimdVariant, SameBitsAsThePlainKernels) {
     Simulation plain = dense_run(twisting);
     set_simd_level(level);
     Simulation simd = dense_run(twisting);
-    const auto& p = plain.particles();
-    const auto& q = simd.particles();
-    for (std::size_t i = 0; i < p.size(); ++i) {
-      ASSERT_TRUE(same_bits(p.pos[i], q.pos[i])) << i;
-      ASSERT_TRUE(same_bits(p.vel[i], q.vel[i])) << i;
-      ASSERT_TRUE(same_bits(p.angvel[i], q.angvel[i])) << i;
-      ASSERT_TRUE(same_bits(p.ori[i], q.ori[i])) << i;
-    }
-    const Frame fp = plain.frame(), fq = simd.frame();
-    ASSERT_EQ(fp.contacts.size(), fq.contacts.size());
-    std::size_t wall_contacts = 0, twisted = 0;
-    for (std::size_t k = 0; k < fp.contacts.size(); ++k) {
-      const Contact &a = fp.contacts[k], &b = fq.contacts[k];
-      ASSERT_EQ(a.id1, b.id1);
-      ASSERT_EQ(a.id2, b.id2);
-      ASSERT_TRUE(same_bits(a.normal_force, b.normal_force)) << k;
-      ASSERT_TRUE(same_bits(a.shear_force, b.shear_force)) << k;
-      ASSERT_TRUE(same_bits(a.bending_moment, b.bending_moment)) << k;
-      ASSERT_TRUE(same_bits(a.twisting_moment, b.twisting_moment)) << k;
-      wall_contacts += a.id1 >= static_cast<std::int64_t>(p.size());
-      twisted += a.twisting_moment.norm() > 0;
-    }
-    for (std::size_t w = 0; w < plain.walls().size(); ++w)
-      EXPECT_TRUE(same_bits(plain.walls()[w].force, simd.walls()[w].force)) << w;
+    RunCounts n;
+    compare_runs(plain, simd, n);
+    if (HasFatalFailure()) return;
     // Every branch was exercised: contacts slid and rolled at their caps, walls were touched.
     const EnergyLedger ep = plain.energy(), eq = simd.energy();
     EXPECT_GT(ep.friction_dissipation, 0);
     EXPECT_GT(ep.rolling_dissipation, 0);
-    EXPECT_GT(wall_contacts, 20u);
-    EXPECT_GT(fp.contacts.size(), 300u);
-    EXPECT_EQ(twisted > 0, twisting);
+    EXPECT_GT(n.wall_contacts, 20u);
+    EXPECT_GT(n.contacts, 300u);
+    EXPECT_EQ(n.twisted > 0, twisting);
     EXPECT_TRUE(same_bits(ep.friction_dissipation, eq.friction_dissipation));
     EXPECT_TRUE(same_bits(ep.rolling_dissipation, eq.rolling_dissipation));
     EXPECT_TRUE(same_bits(ep.damping_dissipation, eq.damping_dissipation));
@@ -496,29 +509,12 @@ TEST_P(SimdVariant, MeshRunsAreTheSameBitsAsThePlainGather) {
     set_simd_level(level);
     Simulation simd = mesh_trough_run(law, mode, threads);
     simd.run(500);
-    const auto& p = plain.particles();
-    const auto& q = simd.particles();
-    for (std::size_t i = 0; i < p.size(); ++i) {
-      ASSERT_TRUE(same_bits(p.pos[i], q.pos[i])) << i;
-      ASSERT_TRUE(same_bits(p.vel[i], q.vel[i])) << i;
-      ASSERT_TRUE(same_bits(p.angvel[i], q.angvel[i])) << i;
-    }
-    const Frame fp = plain.frame(), fq = simd.frame();
-    ASSERT_EQ(fp.contacts.size(), fq.contacts.size());
-    std::size_t wall_contacts = 0;
-    for (std::size_t k = 0; k < fp.contacts.size(); ++k) {
-      const Contact &x = fp.contacts[k], &y = fq.contacts[k];
-      ASSERT_EQ(x.id1, y.id1);
-      ASSERT_EQ(x.id2, y.id2);
-      ASSERT_TRUE(same_bits(x.normal_force, y.normal_force)) << k;
-      ASSERT_TRUE(same_bits(x.shear_force, y.shear_force)) << k;
-      wall_contacts += x.id1 >= static_cast<std::int64_t>(p.size());
-    }
-    for (std::size_t w = 0; w < plain.walls().size(); ++w)
-      EXPECT_TRUE(same_bits(plain.walls()[w].force, simd.walls()[w].force)) << w;
+    RunCounts n;
+    compare_runs(plain, simd, n);
+    if (HasFatalFailure()) return;
     // The runs had both kinds of lanes, mixed in batches.
-    EXPECT_GT(wall_contacts, 20u);
-    EXPECT_GT(fp.contacts.size(), 150u);
+    EXPECT_GT(n.wall_contacts, 20u);
+    EXPECT_GT(n.contacts, 150u);
   }
 }
 
