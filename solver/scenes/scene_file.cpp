@@ -62,6 +62,15 @@ struct Reader {
     return v;
   }
 
+  // An optional true/false (absent: the fallback).
+  bool boolean(const toml::table* t, const std::string& sec, const std::string& key,
+               bool fallback) const {
+    if (!t || !t->contains(key)) return fallback;
+    const auto* v = (*t)[key].as_boolean();
+    if (!v) fail(sec + "." + key, "expected true or false");
+    return v->get();
+  }
+
   Eigen::Vector3d vec3(const toml::table* t, const std::string& sec, const std::string& key,
                        bool required, Eigen::Vector3d fallback) const {
     if (!t || !t->contains(key)) {
@@ -796,11 +805,7 @@ SwitchOff read_switch_off(const Reader& r, const toml::table* t, const std::stri
   SwitchOff o;
   o.at_s = r.number(t, sec, "off_at_s", false, HUGE_VAL);
   if (!(o.at_s >= 0)) r.fail(sec + ".off_at_s", "must be >= 0", value_str(o.at_s));
-  if (t->contains("off_after_fill")) {
-    const auto* v = (*t)["off_after_fill"].as_boolean();
-    if (!v) r.fail(sec + ".off_after_fill", "expected true or false");
-    o.after_fill = v->get();
-  }
+  o.after_fill = r.boolean(t, sec, "off_after_fill", false);
   return o;
 }
 
@@ -1388,11 +1393,7 @@ Scene load_scene(const std::filesystem::path& path, int sweep_point,
       s.output.track_ids.push_back(*id);
     }
   }
-  if (out && out->contains("facet_forces")) {
-    const auto* v = (*out)["facet_forces"].as_boolean();
-    if (!v) r.fail("output.facet_forces", "expected true or false");
-    s.output.facet_forces = v->get();
-  }
+  s.output.facet_forces = r.boolean(out, "output", "facet_forces", false);
   read_lab_sections(r, root, s);
 
   if (s.test == "interface_shear" && root.contains("outlet"))
