@@ -338,13 +338,22 @@ TEST(HertzMindlin, MaterialsByRadiusAndPairTable) {
   std::filesystem::remove_all(dir);
 }
 
+/// The project's scene files.
+std::filesystem::path shipped_scenes() {
+  return std::filesystem::path(GS_SOURCE_DIR) / "data" / "scenes";
+}
+
+/// The DEM8 scenes read their inputs from ../shared/dem8 (public data, never in the project).
+bool dem8_absent() {
+  return !std::filesystem::exists(std::filesystem::path(GS_SOURCE_DIR) / ".." / "shared" / "dem8");
+}
+
 // The shipped DEM8 Case 3 scenes (skipped without ../shared/dem8): 25 000 M1 grains of the
 // benchmark's bed (its last row, not a particle, left unread), the steel ball as particle 25000,
 // the 56-triangle steel box; the pair table as the benchmark's (M1-M1 0.5, M1-steel 0.4).
 TEST(HertzMindlin, Dem8ImpactScenes) {
-  const auto scenes = std::filesystem::path(GS_SOURCE_DIR) / "data" / "scenes";
-  if (!std::filesystem::exists(std::filesystem::path(GS_SOURCE_DIR) / ".." / "shared" / "dem8"))
-    GTEST_SKIP() << "../shared/dem8 absent";
+  const auto scenes = shipped_scenes();
+  if (dem8_absent()) GTEST_SKIP() << "../shared/dem8 absent";
   for (const char* name : {"dem8_impact.toml", "dem8_impact_laptop.toml"}) {
     const Scene s = load_scene(scenes / name);
     ASSERT_EQ(s.particles.size(), 25001u) << name;
@@ -377,9 +386,8 @@ TEST(HertzMindlin, Dem8ImpactScenes) {
 // by 34 µm at step 6000, their density 4 % off by 6 µm and their friction 16.7° → 20° by 12 µm
 // at step 2000.
 TEST(HertzMindlin, Dem8ImpactLaptopFollowsYade) {
-  const auto scenes = std::filesystem::path(GS_SOURCE_DIR) / "data" / "scenes";
-  if (!std::filesystem::exists(std::filesystem::path(GS_SOURCE_DIR) / ".." / "shared" / "dem8"))
-    GTEST_SKIP() << "../shared/dem8 absent";
+  const auto scenes = shipped_scenes();
+  if (dem8_absent()) GTEST_SKIP() << "../shared/dem8 absent";
   Scene s = load_scene(scenes / "dem8_impact_laptop.toml", -1, {{"mesh.0.contact", "\"yade\""}});
   s.config.threads = 1;
   Simulation sim(s.config, s.particles, s.walls);
@@ -399,9 +407,8 @@ TEST(HertzMindlin, Dem8ImpactLaptopFollowsYade) {
 // M2 grains of 4 mm poured from a lattice onto a lid under the orifice that opens when they are
 // at rest, removal below the orifice plane, the benchmark's dt and pair table.
 TEST(HertzMindlin, Dem8SiloScenes) {
-  const auto scenes = std::filesystem::path(GS_SOURCE_DIR) / "data" / "scenes";
-  if (!std::filesystem::exists(std::filesystem::path(GS_SOURCE_DIR) / ".." / "shared" / "dem8"))
-    GTEST_SKIP() << "../shared/dem8 absent";
+  const auto scenes = shipped_scenes();
+  if (dem8_absent()) GTEST_SKIP() << "../shared/dem8 absent";
   struct Case {
     const char* file;
     bool small, m2;
@@ -453,9 +460,8 @@ TEST(HertzMindlin, Dem8SiloScenes) {
 // 1 200-triangle drum of steel turning at 2 rad/s about +y through the origin, the pair table of
 // the benchmark's YADE script.
 TEST(HertzMindlin, Dem8DrumScene) {
-  const auto scenes = std::filesystem::path(GS_SOURCE_DIR) / "data" / "scenes";
-  if (!std::filesystem::exists(std::filesystem::path(GS_SOURCE_DIR) / ".." / "shared" / "dem8"))
-    GTEST_SKIP() << "../shared/dem8 absent";
+  const auto scenes = shipped_scenes();
+  if (dem8_absent()) GTEST_SKIP() << "../shared/dem8 absent";
   for (const char* name : {"dem8_drum.toml", "dem8_drum_laptop.toml"}) {
     SCOPED_TRACE(name);
     const Scene s = load_scene(scenes / name);
