@@ -109,7 +109,8 @@ std::string DirectShear::curve_row(const Simulation& sim) const {
       ++outside;
       continue;
     }
-    vs += 4.0 / 3.0 * M_PI * std::pow(p.radius[i], 3);
+    const double share = !p.clump.empty() && p.clump[i] >= 0 ? spec_.clump_solid_factor : 1.0;
+    vs += share * 4.0 / 3.0 * M_PI * std::pow(p.radius[i], 3);
   }
   const double ratio = tau / sn;
   if (ratio > peak_ratio_) peak_ratio_ = ratio;

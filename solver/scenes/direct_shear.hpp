@@ -46,6 +46,7 @@ struct DirectShearSpec {
   double frame_every_m = 0;       // trajectory frames every Δu
   double servo_gain = 0.25;
   double max_platen_speed_m_s = 0.05;
+  double clump_solid_factor = 1;  // a clump member's share of its volume (void ratios)
 };
 
 class DirectShear final : public MeasuredProgramme {

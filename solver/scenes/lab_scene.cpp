@@ -54,6 +54,21 @@ std::vector<Particle> generate(const Scene& s, const Eigen::Vector3d& cloud,
   }
 }
 
+/// How far the clump that replaces a sphere reaches from its centre, in the sphere's radii (1
+/// without [clumps] replace): the clump of a sphere's volume reaches further than the sphere, so
+/// the spheres are placed as if that much larger (their cloud as much larger), and the clumps
+/// start apart. (Without it a cloud at solid fraction 0.3 of the four-sphere clumps starts with
+/// members of neighbouring clumps overlapping by more than a radius.)
+double clump_reach(const Scene& s) {
+  if (!s.clump_replace) return 1.0;
+  const auto& shape = s.clump_replace->shape;
+  const MassProperties m = clump_mass_properties(shape, 1.0, ClumpMassModel::Union);
+  double enclosing = 0;
+  for (const auto& c : shape)
+    enclosing = std::max(enclosing, (c.offset - m.centroid).norm() + c.radius);
+  return std::max(1.0, std::cbrt(4.0 / 3.0 * M_PI / m.volume) * enclosing);
+}
+
 /// Union volume over the members' summed volume of the scene's clumps (1 without clumps): what
 /// a void ratio counts of a member sphere (the members of a clump overlap).
 double clump_solid_factor(const Scene& s) {
@@ -119,17 +134,7 @@ std::vector<std::unique_ptr<LoadingProgramme>> scene_programmes(Scene& s) {
                          "half must exceed " +
                              value_str(x.radius_m + sp.sizes.dmax_m) + " m)",
                          value_str(sp.size_m.z()));
-      // The clump of a sphere's volume reaches further than the sphere: the spheres are placed
-      // as if that much larger (the cloud as much higher), so that the clumps start apart.
-      double reach = 1.0;
-      if (s.clump_replace) {
-        const auto& shape = s.clump_replace->shape;
-        const MassProperties m = clump_mass_properties(shape, 1.0, ClumpMassModel::Union);
-        double enclosing = 0;
-        for (const auto& c : shape)
-          enclosing = std::max(enclosing, (c.offset - m.centroid).norm() + c.radius);
-        reach = std::max(1.0, std::cbrt(4.0 / 3.0 * M_PI / m.volume) * enclosing);
-      }
+      const double reach = clump_reach(s);
       const double cloud_h =
           sp.size_m.z() / (1 + sp.void_ratio) / sp.cloud_solid_fraction * reach * reach * reach;
       const Eigen::Vector3d lo(-0.5 * sp.size_m.x(), -0.5 * sp.size_m.y(), -0.5 * sp.size_m.z());
@@ -199,10 +204,11 @@ std::vector<std::unique_ptr<LoadingProgramme>> scene_programmes(Scene& s) {
     Eigen::Vector3d lo, hi;
     if (s.specimen) {
       const double phi = 1 / (1 + s.specimen->void_ratio);
-      const double scale = std::cbrt(phi / s.specimen->cloud_solid_fraction);
+      const double reach = clump_reach(s);
+      const double scale = std::cbrt(phi / s.specimen->cloud_solid_fraction) * reach;
       lo.setZero();
       hi = s.specimen->size_m * scale;
-      s.particles = generate(s, hi);
+      s.particles = generate(s, hi, lo, reach);
       replace_spheres_by_clumps(s);
     } else {
       Frame f;
@@ -216,6 +222,7 @@ std::vector<std::unique_ptr<LoadingProgramme>> scene_programmes(Scene& s) {
     }
     gauge = cuboid_gauge();
     s.triaxial.core_inset_m = s.plane_strain.core_inset_m = max_diameter(s.particles);
+    s.triaxial.clump_solid_factor = s.plane_strain.clump_solid_factor = clump_solid_factor(s);
     if (s.test == "triaxial") {
       test = std::make_unique<TriaxialCompression>(s.triaxial);
     } else {
@@ -237,9 +244,11 @@ std::vector<std::unique_ptr<LoadingProgramme>> scene_programmes(Scene& s) {
     try {
       // The surface first: the cloud is placed above its crests, the box around the cloud.
       s.walls = interface_surface_walls(f, g, dmax, idx);
-      const double cloud_h = g.height_m * (1 / (1 + sp.void_ratio)) / sp.cloud_solid_fraction;
+      const double reach = clump_reach(s);
+      const double cloud_h =
+          g.height_m * (1 / (1 + sp.void_ratio)) / sp.cloud_solid_fraction * reach * reach * reach;
       s.particles =
-          generate(s, {g.length_m, g.width_m, cloud_h}, Eigen::Vector3d(0, 0, g.crest_z_m));
+          generate(s, {g.length_m, g.width_m, cloud_h}, Eigen::Vector3d(0, 0, g.crest_z_m), reach);
       replace_spheres_by_clumps(s);
       g.clump_solid_factor = clump_solid_factor(s);
       g.platen_z_m = g.crest_z_m + cloud_h;
@@ -265,8 +274,10 @@ std::vector<std::unique_ptr<LoadingProgramme>> scene_programmes(Scene& s) {
       g.length_m = sp.size_m.x();
       g.width_m = sp.size_m.y();
       g.height_m = sp.size_m.z();
-      top = g.height_m * (1 / (1 + sp.void_ratio)) / sp.cloud_solid_fraction;
-      s.particles = generate(s, {g.length_m, g.width_m, top});
+      const double reach = clump_reach(s);
+      top =
+          g.height_m * (1 / (1 + sp.void_ratio)) / sp.cloud_solid_fraction * reach * reach * reach;
+      s.particles = generate(s, {g.length_m, g.width_m, top}, Eigen::Vector3d::Zero(), reach);
       replace_spheres_by_clumps(s);
     } else {
       Frame f;
@@ -287,11 +298,14 @@ std::vector<std::unique_ptr<LoadingProgramme>> scene_programmes(Scene& s) {
     try {
       s.walls = shear_box_walls(g, idx);
       gauge = shear_box_gauge(g, idx);
+      s.direct_shear.clump_solid_factor = clump_solid_factor(s);
       test = std::make_unique<DirectShear>(s.direct_shear, g, idx);
     } catch (const std::invalid_argument& e) {
       throw InputError(s.file.string(), std::string("[direct_shear]: ") + e.what());
     }
   }
+  // A clump member counts its share of its clump's union volume in every void ratio.
+  if (gauge) gauge->clump_solid_factor = clump_solid_factor(s);
   const double inset = max_diameter(s.particles);  // the loose layer along a wall
   if (s.preparation) {
     if (s.preparation->core_inset_m < 0) s.preparation->core_inset_m = inset;

@@ -159,7 +159,7 @@ std::string PlaneStrainCompression::curve_row(const Simulation& sim) const {
   const double in = spec_.core_inset_m;
   const Eigen::Vector3d clo(xm / std::max<std::size_t>(1, hits) + in, lo.y() + in, lo.z() + in);
   const Eigen::Vector3d chi(xp / std::max<std::size_t>(1, hits) - in, hi.y() - in, hi.z() - in);
-  const double e_core = box_void_ratio(sim.particles(), clo, chi);
+  const double e_core = box_void_ratio(sim.particles(), clo, chi, spec_.clump_solid_factor);
   char buf[512];
   std::snprintf(buf, sizeof buf,
                 "%lld,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.6g,%.6g,"

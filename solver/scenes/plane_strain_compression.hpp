@@ -38,8 +38,9 @@ struct PlaneStrainSpec {
   bool top_sledge = true;     // top cap free along x (false: held)
   double sledge_gain = 0.25;  // fraction of the lateral force removed per step
   double inertial_warning = 1e-4;
-  double d50_m = 0;         // 0: mean diameter
-  double core_inset_m = 0;  // core void ratio: box inset by this from the boundaries
+  double d50_m = 0;               // 0: mean diameter
+  double core_inset_m = 0;        // core void ratio: box inset by this from the boundaries
+  double clump_solid_factor = 1;  // a clump member's share of its volume (void ratios)
 };
 
 /// The four clamp walls (boxes, switched off until the loading starts), appended after the six

@@ -711,10 +711,13 @@ RunOutcome run_scene(Scene scene, const RunOptions& a) {
       sim.contact_count(), sim.unbalanced_force(), e.kinetic, e.residual(),
       std::abs(e.residual()) / std::max(1e-300, e.stored() + e.dissipated()));
   print(buf);
-  std::string wrote = "wrote " + traj.string() + ", " + history.path().string();
-  if (!scene.test.empty()) wrote += ", " + curve.path().string();
-  if (!results.empty()) wrote += ", " + (out / "results.csv").string();
-  print(wrote);
+  // The files this run wrote (a run stopped by --steps during a preparation has no frame or
+  // curve yet).
+  std::string wrote;
+  for (const fs::path& f :
+       {traj, history.path(), prep_curve.path(), curve.path(), out / "results.csv"})
+    if (fs::is_regular_file(f)) wrote += (wrote.empty() ? "wrote " : ", ") + f.string();
+  if (!wrote.empty()) print(wrote);
   outcome.ended = ended;
   outcome.results = results;
   return outcome;

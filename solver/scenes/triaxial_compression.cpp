@@ -90,9 +90,10 @@ std::string TriaxialCompression::curve_row(const Simulation& sim) const {
   const double inertial = inertial_number(sim);
   if (phi > max_phi_deg_) max_phi_deg_ = phi;
   inertial_warning_.check(inertial, "triaxial", e1);
-  const double e = box_void_ratio(sim.particles(), lo, hi);
+  const double e = box_void_ratio(sim.particles(), lo, hi, spec_.clump_solid_factor);
   const Eigen::Vector3d inset = Eigen::Vector3d::Constant(spec_.core_inset_m);
-  const double e_core = box_void_ratio(sim.particles(), lo + inset, hi - inset);
+  const double e_core =
+      box_void_ratio(sim.particles(), lo + inset, hi - inset, spec_.clump_solid_factor);
   char buf[512];
   std::snprintf(buf, sizeof buf,
                 "%lld,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.6g,"

@@ -17,8 +17,9 @@ struct TriaxialSpec {
   double servo_gain = 0.25;
   double max_wall_speed_m_s = 0.1;
   double inertial_warning = 1e-4;
-  double d50_m = 0;         // for the inertial number (0: mean diameter)
-  double core_inset_m = 0;  // core void ratio: box inset by this from the boundaries
+  double d50_m = 0;               // for the inertial number (0: mean diameter)
+  double core_inset_m = 0;        // core void ratio: box inset by this from the boundaries
+  double clump_solid_factor = 1;  // a clump member's share of its volume (void ratios)
 };
 
 class TriaxialCompression final : public MeasuredProgramme {

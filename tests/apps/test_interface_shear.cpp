@@ -12,6 +12,7 @@
 
 namespace {
 
+namespace fs = std::filesystem;
 using gs::test::read_csv_table;
 using gs::test::replaced;
 using gs::test::run_cli;
@@ -161,4 +162,68 @@ TEST(InterfaceShear, BadInputIsOneLine) {
         "sweep.values: expected a non-empty array"},
        {scene(saw, u + "[sweep]\nkey = \"interface_shear.roughness\"\nvalues = [\"a/b\"]\n"),
         "sweep.values: a value names a run directory"}});
+}
+
+// Spheres replaced by seed 004's four-sphere clumps (aspect ratio 1.5) reach further from their
+// centres than the spheres did: each laboratory test places the spheres as if that much larger,
+// so that its clumps start apart. One step of the shipped clump scene and of the interface
+// shear, direct shear and triaxial scenes with clumps: no contact anywhere (before, a cloud at
+// solid fraction 0.3 started with members of neighbouring clumps overlapping by more than a
+// radius, and the run stopped at step 0). The CLI names only the files the step wrote.
+TEST(InterfaceShear, ClumpsReplacingTheSpheresStartApart) {
+  gs::test::ScratchDir dir("is_clumps_apart");
+  const std::string clumps =
+      "[[clump_template]]\nname = \"grain\"\nshape = \"asymmetric4\"\ndiameter_m = 0.001\n"
+      "[clumps]\nreplace = \"grain\"\nseed = 1\n";
+  const std::string is = replaced(
+      scene("surface = \"saw_tooth\"\nroughness = 1.0\nd50_m = 0.001\n",
+            "max_displacement_m = 0.001\n" + clumps),
+      "rolling_stiffness = 0.7\nrolling_limit = 0.4\nrolling_limit_radius = \"mean\"\n", "");
+  const std::string common =
+      "[specimen]\nsize_m = [0.008, 0.006, 0.008]\ndmin_m = 0.0008\ndmax_m = 0.0012\n"
+      "void_ratio = 0.6\nseed = 2\ncloud_solid_fraction = 0.3\n"
+      "[material]\nyoung_Pa = 3.0e8\nstiffness_ratio = 0.3\nfriction_deg = 26.0\n"
+      "density_kg_m3 = 2600.0\n[solver]\ndt_s = \"auto\"\ndt_safety = 0.6\ndamping = 0.08\n"
+      "[preparation]\nstage_steps = 2000\nmax_wall_speed_m_s = 0.5\n"
+      "[output]\nevery = 100000\nhistory_every = 1\n";
+  const std::string ds = "[scene]\nname = \"ds\"\ntest = \"direct_shear\"\n" + common +
+                         "[direct_shear]\nnormal_stress_Pa = 1.0e5\nshear_velocity_m_s = 0.01\n"
+                         "max_displacement_m = 0.001\n" +
+                         clumps;
+  const std::string tx =
+      "[scene]\nname = \"tx\"\ntest = \"triaxial\"\n" + common +
+      "[triaxial]\nconfining_Pa = 1.0e5\nstrain_rate_1_s = 2.0\nmax_strain = 0.01\n"
+      "frame_every_strain = 0.005\n" +
+      clumps;
+  std::ofstream(dir / "is.toml") << replaced(is, "history_every = 1000", "history_every = 1");
+  std::ofstream(dir / "ds.toml") << ds;
+  std::ofstream(dir / "tx.toml") << tx;
+  const fs::path shipped =
+      std::filesystem::path(GS_SOURCE_DIR) / "data" / "scenes" / "interface_shear_clumps.toml";
+  for (const auto& [file, clump_count] :
+       std::vector<std::pair<fs::path, int>>{{shipped, 1700},
+                                             {dir / "is.toml", 250},
+                                             {dir / "ds.toml", 150},
+                                             {dir / "tx.toml", 150}}) {
+    const fs::path out = dir / ("out_" + file.stem().string());
+    const auto r = run_cli(
+        "simulate " + file.string() + " -q --steps 1 --threads 1 -o " + out.string(), dir.path);
+    ASSERT_EQ(r.rc, 0) << file << "\n" << r.err;
+    // The shipped scene is a sweep: its first run's directory.
+    const fs::path run = fs::exists(out / "roughness_2") ? out / "roughness_2" : out;
+    const auto h = read_csv_table(run / "history.csv");
+    ASSERT_GE(h.rows.size(), 2u) << file;
+    EXPECT_EQ(h.num(1, "step"), 1) << file;
+    EXPECT_EQ(h.num(1, "contacts"), 0) << file;
+    // Every sphere became a clump of four members, at least as many as the specimen asks for.
+    const auto at = r.out.find(" steps of ");
+    ASSERT_NE(at, std::string::npos) << r.out;
+    const long members = std::strtol(r.out.c_str() + at + 10, nullptr, 10);
+    EXPECT_EQ(members % 4, 0) << r.out;
+    EXPECT_GT(members / 4, clump_count) << r.out;
+    // Stopped in the preparation: no frame and no curve yet, and the CLI does not claim them.
+    EXPECT_FALSE(fs::exists(run / "trajectory.h5")) << file;
+    EXPECT_EQ(r.out.find("trajectory.h5"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("history.csv"), std::string::npos) << r.out;
+  }
 }
