@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <limits>
 #include <map>
 #include <random>
@@ -949,4 +951,51 @@ TEST(Membrane, PlaneStrainLoadsSumToSigmaCTimesProjectedArea) {
     sim.step();
   }
   EXPECT_EQ(checked, 5);
+}
+
+// A triaxial specimen whose spheres are replaced by seed 004's four-sphere clumps (the union
+// mass model: each clump weighs what its sphere weighed): the clumps start apart (every member
+// pair of two clumps separated), and the test's void ratio counts each clump's union volume
+// once. Its solid volume is Σ m/ρ of the clumps, to the union quadrature's 2e-5; the members'
+// summed volumes would count the overlaps twice (a factor 1/clump_solid_factor more).
+TEST(ClumpReplacement, TriaxialSpecimenStartsApartAndCountsTheUnionVolume) {
+  const auto dir =
+      std::filesystem::temp_directory_path() / ("gs_clump_triaxial_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  {
+    std::ifstream in(std::filesystem::path(GS_TEST_DATA_DIR) / "scenes" / "triaxial_tiny.toml");
+    std::ofstream out(dir / "scene.toml");
+    out << in.rdbuf()
+        << "\n[[clump_template]]\nname = \"grain\"\nshape = \"asymmetric4\"\n"
+           "diameter_m = 0.006\n[clumps]\nreplace = \"grain\"\nmass = \"union\"\nseed = 1\n";
+  }
+  Scene s = load_scene(dir / "scene.toml");
+  auto programmes = scene_programmes(s);
+  std::filesystem::remove_all(dir);
+  ASSERT_EQ(programmes.size(), 2u);
+  ASSERT_GT(s.clumps.size(), 100u);
+  ASSERT_EQ(s.particles.size(), 4 * s.clumps.size());
+  EXPECT_GT(s.triaxial.clump_solid_factor, 0.5);
+  EXPECT_LT(s.triaxial.clump_solid_factor, 0.95);
+  // Apart: no member touches a member of another clump.
+  double closest = 1e9;
+  for (std::size_t i = 0; i < s.particles.size(); ++i)
+    for (std::size_t j = i + 1; j < s.particles.size(); ++j) {
+      if (s.particles[i].clump_id == s.particles[j].clump_id) continue;
+      const double gap = (s.particles[i].position - s.particles[j].position).norm() -
+                         s.particles[i].radius - s.particles[j].radius;
+      closest = std::min(closest, gap);
+    }
+  EXPECT_GT(closest, 0.0);
+  Simulation sim(s.config, s.particles, s.walls);
+  sim.set_clumps(s.clumps);
+  double solid = 0;
+  for (const auto& c : sim.clumps()) solid += c.mass / s.config.material.density;
+  const double expected = (cuboid_hi(sim) - cuboid_lo(sim)).prod() / solid - 1;
+  const std::string row = programmes[1]->curve_row(sim);
+  // void_ratio is the curve's 14th column (curve_header).
+  std::size_t at = 0;
+  for (int k = 0; k < 13; ++k) at = row.find(',', at) + 1;
+  const double e = std::strtod(row.c_str() + at, nullptr);
+  EXPECT_NEAR(e, expected, 1e-4 * (1 + expected)) << row;
 }
