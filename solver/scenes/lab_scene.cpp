@@ -222,7 +222,9 @@ std::vector<std::unique_ptr<LoadingProgramme>> scene_programmes(Scene& s) {
     }
     gauge = cuboid_gauge();
     s.triaxial.core_inset_m = s.plane_strain.core_inset_m = max_diameter(s.particles);
-    s.triaxial.clump_solid_factor = s.plane_strain.clump_solid_factor = clump_solid_factor(s);
+    // A clump member counts its share of its clump's union volume in every void ratio.
+    gauge->clump_solid_factor = s.triaxial.clump_solid_factor = s.plane_strain.clump_solid_factor =
+        clump_solid_factor(s);
     if (s.test == "triaxial") {
       test = std::make_unique<TriaxialCompression>(s.triaxial);
     } else {
@@ -298,14 +300,12 @@ std::vector<std::unique_ptr<LoadingProgramme>> scene_programmes(Scene& s) {
     try {
       s.walls = shear_box_walls(g, idx);
       gauge = shear_box_gauge(g, idx);
-      s.direct_shear.clump_solid_factor = clump_solid_factor(s);
+      gauge->clump_solid_factor = s.direct_shear.clump_solid_factor = clump_solid_factor(s);
       test = std::make_unique<DirectShear>(s.direct_shear, g, idx);
     } catch (const std::invalid_argument& e) {
       throw InputError(s.file.string(), std::string("[direct_shear]: ") + e.what());
     }
   }
-  // A clump member counts its share of its clump's union volume in every void ratio.
-  if (gauge) gauge->clump_solid_factor = clump_solid_factor(s);
   const double inset = max_diameter(s.particles);  // the loose layer along a wall
   if (s.preparation) {
     if (s.preparation->core_inset_m < 0) s.preparation->core_inset_m = inset;
