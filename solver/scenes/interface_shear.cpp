@@ -18,15 +18,17 @@ double rad(double deg) {
   return deg * M_PI / 180.0;
 }
 
-// The surface's patch as merged walls (one contact per tooth face or corrugation strip, a plane
-// wall's stiffness: docs/physics.md), appended to w.
-void append_mesh(const TriangleMesh& tm, double friction_deg, std::vector<WallSpec>& w) {
+// The surface's patch as mesh walls, appended to w: merged (one contact per tooth face or
+// corrugation strip, a plane wall's stiffness) or YADE's facets (docs/physics.md).
+void append_mesh(const TriangleMesh& tm, double friction_deg, const std::string& contact,
+                 std::vector<WallSpec>& w) {
   MeshTriangles tri;
   for (const auto& f : tm.triangles) {
     tri.triangles.push_back({tm.vertices[f[0]], tm.vertices[f[1]], tm.vertices[f[2]]});
     tri.group.push_back("surface");
   }
-  for (auto& x : mesh_walls(tri, MeshContact::Merged, Eigen::Vector3d::Zero(), friction_deg)) {
+  const MeshContact mode = contact == "yade" ? MeshContact::YadeParity : MeshContact::Merged;
+  for (auto& x : mesh_walls(tri, mode, Eigen::Vector3d::Zero(), friction_deg)) {
     x.mesh = "surface";
     x.body = 0;
     w.push_back(std::move(x));
@@ -77,7 +79,7 @@ std::vector<WallSpec> interface_surface_walls(const InterfaceSurfaceSpec& s,
     st.slope_deg = s.tooth_slope_deg;
     st.back_slope_deg = s.tooth_slope_deg;
     st.group = "surface";
-    append_mesh(saw_tooth_wall(st), s.friction_deg, w);
+    append_mesh(saw_tooth_wall(st), s.friction_deg, s.contact, w);
     g.crest_z_m = hg;
     g.trough_z_m = 0;
     g.mean_z_m = 0.5 * hg * base / sg;  // the teeth's area per pitch over the pitch
@@ -99,7 +101,7 @@ std::vector<WallSpec> interface_surface_walls(const InterfaceSurfaceSpec& s,
     ss.wavelength_m = l;
     ss.segments_per_wavelength = s.segments_per_wavelength;
     ss.group = "surface";
-    append_mesh(sinusoidal_wall(ss), s.friction_deg, w);
+    append_mesh(sinusoidal_wall(ss), s.friction_deg, s.contact, w);
     g.crest_z_m = 0.5 * d;
     g.trough_z_m = -0.5 * d;
     g.mean_z_m = 0;

@@ -39,6 +39,9 @@ struct InterfaceSurfaceSpec {
   double wavelength_m = 0;
   int segments_per_wavelength = 32;
   double friction_deg = -1;  // the surface's (negative: the material's)
+  // "merged" (one contact per tooth face or strip, a plane wall's stiffness) or "yade" (YADE's
+  // facets: one contact per triangle, Kn = 4/3·Ec·R; docs/physics.md).
+  std::string contact = "merged";
 };
 
 struct InterfaceShearGeometry {

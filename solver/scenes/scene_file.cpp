@@ -345,6 +345,7 @@ void read_lab_sections(const Reader& r, const toml::table& root, Scene& s) {
             "wavelength_m",
             "segments_per_wavelength",
             "surface_friction_deg",
+            "surface_contact",
             "frame_friction_deg",
             "platen_friction_deg",
             "gap_m",
@@ -394,6 +395,9 @@ void read_lab_sections(const Reader& r, const toml::table& root, Scene& s) {
       return v;
     };
     f.friction_deg = angle("surface_friction_deg", -1);
+    f.contact = r.string(t, sec, "surface_contact", false, "merged");
+    if (f.contact != "merged" && f.contact != "yade")
+      r.fail(sec + ".surface_contact", "expected \"merged\" or \"yade\"", f.contact);
     auto& g = s.interface_geometry;
     g.frame_friction_deg = angle("frame_friction_deg", 0);
     g.platen_friction_deg = angle("platen_friction_deg", -1);

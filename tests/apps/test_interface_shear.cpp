@@ -156,6 +156,8 @@ TEST(InterfaceShear, BadInputIsOneLine) {
        {scene("surface = \"sinusoid\"\nwavelength_m = 0.015\ndepth_ratio = 1.5\n", u),
         "interface_shear.depth_ratio: outside [0, 1) (1.5)"},
        {scene("surface = \"bumpy\"\n", u), "interface_shear.surface: expected"},
+       {scene(saw + "surface_contact = \"facets\"\n", u),
+        "interface_shear.surface_contact: expected \"merged\" or \"yade\" (facets)"},
        {scene(saw, u + "[sweep]\nkey = \"nowhere.roughness\"\nvalues = [1.0]\n"),
         "sweep.key: no such section (nowhere.roughness)"},
        {scene(saw, u + "[sweep]\nkey = \"interface_shear.roughness\"\nvalues = []\n"),

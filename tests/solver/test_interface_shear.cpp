@@ -88,6 +88,36 @@ TEST(InterfaceShearWalls, SawToothCrestMeanAndExtent) {
     EXPECT_EQ(w[k].shape, WallShape::Facets);
 }
 
+// surface_contact = "yade": YADE's facets, one wall (one contact) per triangle with the facet's
+// 2R stiffness, as the thesis's YADE surfaces; "merged" (the default): one wall per tooth face
+// with a plane wall's. The same triangles either way.
+TEST(InterfaceShearWalls, SurfaceContactYadeGivesOneWallPerTriangle) {
+  InterfaceSurfaceSpec s;
+  s.kind = "saw_tooth";
+  s.roughness = 1.0;
+  s.d50_m = 0.001;
+  auto gm = box(), gy = box();
+  InterfaceShearWalls im, iy;
+  const auto wm = gs::solver::interface_shear_walls(s, gm, 0.0014, im);
+  s.contact = "yade";
+  const auto wy = gs::solver::interface_shear_walls(s, gy, 0.0014, iy);
+  ASSERT_EQ(gm.surface_triangles, gy.surface_triangles);
+  // Merged: a face is one flat region of two triangles; yade: each triangle its own wall.
+  EXPECT_EQ(im.surface_end - im.surface_begin, gm.surface_triangles / 2);
+  EXPECT_EQ(iy.surface_end - iy.surface_begin, gy.surface_triangles);
+  for (std::size_t k = im.surface_begin; k < im.surface_end; ++k) EXPECT_TRUE(wm[k].plane_radii);
+  for (std::size_t k = iy.surface_begin; k < iy.surface_end; ++k) {
+    EXPECT_FALSE(wy[k].plane_radii);
+    EXPECT_EQ(wy[k].facets.size(), 1u);
+  }
+  const Extent em = surface_extent(wm, im), ey = surface_extent(wy, iy);
+  EXPECT_NEAR(em.zhi, ey.zhi, 1e-15);
+  EXPECT_NEAR(em.xlo, ey.xlo, 1e-15);
+  EXPECT_NEAR(em.xhi, ey.xhi, 1e-15);
+  // The box walls after the surface are the same walls.
+  EXPECT_EQ(wm.size() - im.surface_end, wy.size() - iy.surface_end);
+}
+
 TEST(InterfaceShearWalls, SinusoidSpansTheDepthAboutTheMidPlane) {
   // §4.4: l = 15 mm, d/l = 0.24: d = 3.6 mm, h = ±1.8 mm; whole wavelengths.
   InterfaceSurfaceSpec s;
