@@ -46,6 +46,9 @@ std::vector<WallSpec> interface_surface_walls(const InterfaceSurfaceSpec& s,
   require_value(g.height_m > 0, "specimen.size_m", g.height_m, "height must be positive");
   require_value(dmax_m > 0, "specimen.dmax_m", dmax_m, "must be positive");
   require_value(g.travel_m > 0, sec + "max_displacement_m", g.travel_m, "must be positive");
+  if (s.contact != "merged" && s.contact != "yade")
+    throw std::invalid_argument(sec + "surface_contact: expected \"merged\" or \"yade\" (" +
+                                s.contact + ")");
   require_value(g.wall_thickness_m > 0, "wall thickness", g.wall_thickness_m, "must be positive");
   const double L = g.length_m, W = g.width_m, t = g.wall_thickness_m;
   // The surface runs from before the frame's start to beyond its end of travel, whole periods;

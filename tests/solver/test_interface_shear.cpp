@@ -178,6 +178,10 @@ TEST(InterfaceShearWalls, BadSurfacesNameKeyAndValue) {
   s.roughness = 1.0;
   s.tooth_spacing_ratio = 1.5;  // 45° teeth are 2·h_g wide
   expect_error(s, "interface_shear.tooth_spacing_ratio: teeth wider than their spacing (1.5)");
+  s.tooth_spacing_ratio = 2.0;
+  s.contact = "facets";
+  expect_error(s, "interface_shear.surface_contact: expected \"merged\" or \"yade\" (facets)");
+  s.contact = "merged";
   s = {};
   s.kind = "sinusoid";
   s.wavelength_m = 0.015;
