@@ -65,6 +65,12 @@ std::vector<int> flat_regions(const MeshTriangles& mesh, double angle_tol, doubl
   return region;
 }
 
+std::optional<MeshContact> mesh_contact_named(const std::string& name) {
+  if (name == "merged") return MeshContact::Merged;
+  if (name == "yade") return MeshContact::YadeParity;
+  return std::nullopt;
+}
+
 std::vector<WallSpec> mesh_walls(const MeshTriangles& mesh, MeshContact mode,
                                  const Eigen::Vector3d& velocity, double friction_deg) {
   if (mesh.group.size() != mesh.triangles.size())

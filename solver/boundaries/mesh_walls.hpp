@@ -15,6 +15,7 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -23,6 +24,9 @@
 namespace gs::solver {
 
 enum class MeshContact { Merged, YadeParity };
+
+/// A scene's name for a mesh contact convention: "merged" or "yade"; nothing for another name.
+std::optional<MeshContact> mesh_contact_named(const std::string& name);
 
 struct MeshTriangles {
   std::vector<std::array<Eigen::Vector3d, 3>> triangles;  // global vertices, m

@@ -20,14 +20,13 @@ double rad(double deg) {
 
 // The surface's patch as mesh walls, appended to w: merged (one contact per tooth face or
 // corrugation strip, a plane wall's stiffness) or YADE's facets (docs/physics.md).
-void append_mesh(const TriangleMesh& tm, double friction_deg, const std::string& contact,
+void append_mesh(const TriangleMesh& tm, double friction_deg, MeshContact mode,
                  std::vector<WallSpec>& w) {
   MeshTriangles tri;
   for (const auto& f : tm.triangles) {
     tri.triangles.push_back({tm.vertices[f[0]], tm.vertices[f[1]], tm.vertices[f[2]]});
     tri.group.push_back("surface");
   }
-  const MeshContact mode = contact == "yade" ? MeshContact::YadeParity : MeshContact::Merged;
   for (auto& x : mesh_walls(tri, mode, Eigen::Vector3d::Zero(), friction_deg)) {
     x.mesh = "surface";
     x.body = 0;
@@ -46,7 +45,8 @@ std::vector<WallSpec> interface_surface_walls(const InterfaceSurfaceSpec& s,
   require_value(g.height_m > 0, "specimen.size_m", g.height_m, "height must be positive");
   require_value(dmax_m > 0, "specimen.dmax_m", dmax_m, "must be positive");
   require_value(g.travel_m > 0, sec + "max_displacement_m", g.travel_m, "must be positive");
-  if (s.contact != "merged" && s.contact != "yade")
+  const std::optional<MeshContact> contact = mesh_contact_named(s.contact);
+  if (!contact)
     throw std::invalid_argument(sec + "surface_contact: expected \"merged\" or \"yade\" (" +
                                 s.contact + ")");
   require_value(g.wall_thickness_m > 0, "wall thickness", g.wall_thickness_m, "must be positive");
@@ -82,7 +82,7 @@ std::vector<WallSpec> interface_surface_walls(const InterfaceSurfaceSpec& s,
     st.slope_deg = s.tooth_slope_deg;
     st.back_slope_deg = s.tooth_slope_deg;
     st.group = "surface";
-    append_mesh(saw_tooth_wall(st), s.friction_deg, s.contact, w);
+    append_mesh(saw_tooth_wall(st), s.friction_deg, *contact, w);
     g.crest_z_m = hg;
     g.trough_z_m = 0;
     g.mean_z_m = 0.5 * hg * base / sg;  // the teeth's area per pitch over the pitch
@@ -104,7 +104,7 @@ std::vector<WallSpec> interface_surface_walls(const InterfaceSurfaceSpec& s,
     ss.wavelength_m = l;
     ss.segments_per_wavelength = s.segments_per_wavelength;
     ss.group = "surface";
-    append_mesh(sinusoidal_wall(ss), s.friction_deg, s.contact, w);
+    append_mesh(sinusoidal_wall(ss), s.friction_deg, *contact, w);
     g.crest_z_m = 0.5 * d;
     g.trough_z_m = -0.5 * d;
     g.mean_z_m = 0;

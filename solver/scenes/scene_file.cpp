@@ -396,7 +396,7 @@ void read_lab_sections(const Reader& r, const toml::table& root, Scene& s) {
     };
     f.friction_deg = angle("surface_friction_deg", -1);
     f.contact = r.string(t, sec, "surface_contact", false, "merged");
-    if (f.contact != "merged" && f.contact != "yade")
+    if (!mesh_contact_named(f.contact))
       r.fail(sec + ".surface_contact", "expected \"merged\" or \"yade\"", f.contact);
     auto& g = s.interface_geometry;
     g.frame_friction_deg = angle("frame_friction_deg", 0);
@@ -1471,9 +1471,9 @@ Scene load_scene(const std::filesystem::path& path, int sweep_point,
       if (!std::filesystem::exists(mesh_path, missing))
         r.fail(sec + ".file", "no such file", mesh_path.string());
       const double scale = r.positive(m, sec, "scale", false, 1.0);
-      const std::string contact = r.string(m, sec, "contact", false, "merged");
-      if (contact != "merged" && contact != "yade")
-        r.fail(sec + ".contact", "expected \"merged\" or \"yade\"", contact);
+      const std::string contact_name = r.string(m, sec, "contact", false, "merged");
+      const std::optional<MeshContact> contact = mesh_contact_named(contact_name);
+      if (!contact) r.fail(sec + ".contact", "expected \"merged\" or \"yade\"", contact_name);
       const std::string name = r.string(m, sec, "name", false, "");
       const TriangleMesh tm = read_mesh(mesh_path, scale);  // (InputError names the mesh file)
       MeshTriangles tri;
@@ -1512,10 +1512,9 @@ Scene load_scene(const std::filesystem::path& path, int sweep_point,
       const int body = static_cast<int>(i);
       const int mesh_material = material_index(r, s, m, sec);
       try {
-        for (auto& w :
-             mesh_walls(tri, contact == "yade" ? MeshContact::YadeParity : MeshContact::Merged,
-                        r.vec3(m, sec, "velocity_m_s", false, Eigen::Vector3d::Zero()),
-                        r.number(m, sec, "friction_deg", false, -1))) {
+        for (auto& w : mesh_walls(tri, *contact,
+                                  r.vec3(m, sec, "velocity_m_s", false, Eigen::Vector3d::Zero()),
+                                  r.number(m, sec, "friction_deg", false, -1))) {
           w.angular_velocity = omega;
           w.rotation_center = centre;
           w.body = body;

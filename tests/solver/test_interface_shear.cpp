@@ -181,7 +181,6 @@ TEST(InterfaceShearWalls, BadSurfacesNameKeyAndValue) {
   s.tooth_spacing_ratio = 2.0;
   s.contact = "facets";
   expect_error(s, "interface_shear.surface_contact: expected \"merged\" or \"yade\" (facets)");
-  s.contact = "merged";
   s = {};
   s.kind = "sinusoid";
   s.wavelength_m = 0.015;
