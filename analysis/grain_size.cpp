@@ -1,6 +1,9 @@
 #include "grain_size.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <sstream>
 #include <stdexcept>
 
 namespace gs::analysis {
@@ -41,6 +44,51 @@ double diameter_percentile(const Frame& frame, double fraction) {
   r.reserve(frame.particles.size());
   for (const auto& p : frame.particles) r.push_back(p.radius);
   return diameter_percentile(std::move(r), fraction, frame.two_d ? 2 : 3);
+}
+
+namespace {
+
+std::optional<double> positive_number(const std::string& text) {
+  const char* begin = text.c_str();
+  char* end = nullptr;
+  const double v = std::strtod(begin, &end);
+  if (end == begin) return std::nullopt;
+  while (*end == ' ' || *end == '\t') ++end;
+  if ((*end != '\0' && *end != '#') || !std::isfinite(v) || !(v > 0)) return std::nullopt;
+  return v;
+}
+
+std::string trimmed(const std::string& s) {
+  const auto a = s.find_first_not_of(" \t\r");
+  if (a == std::string::npos) return {};
+  return s.substr(a, s.find_last_not_of(" \t\r") - a + 1);
+}
+
+}  // namespace
+
+std::optional<double> recorded_d50(
+    const std::vector<std::pair<std::string, std::string>>& parameters) {
+  for (const auto& [key, value] : parameters)
+    if (key == "scene.d50_m") return positive_number(value);
+  // Older runs: the scene file as the run recorded it (one `key = value` a line, tables as
+  // `[name]`, the way the scene reader writes it back).
+  for (const auto& [key, value] : parameters) {
+    if (key != "scene.toml") continue;
+    std::istringstream in(value);
+    std::string line, table;
+    while (std::getline(in, line)) {
+      line = trimmed(line);
+      if (line.size() > 1 && line.front() == '[') {
+        table = trimmed(line.substr(1, line.find(']') - 1));
+        continue;
+      }
+      if (table != "silo" && table != "interface_shear") continue;
+      const auto eq = line.find('=');
+      if (eq == std::string::npos || trimmed(line.substr(0, eq)) != "d50_m") continue;
+      return positive_number(trimmed(line.substr(eq + 1)));
+    }
+  }
+  return std::nullopt;
 }
 
 }  // namespace gs::analysis

@@ -1,6 +1,9 @@
 // Grain-size statistics of a snapshot.
 #pragma once
 
+#include <optional>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include "snapshot.hpp"
@@ -20,5 +23,15 @@ double diameter_percentile(std::vector<double> radii, double fraction, int expon
 inline double d50(const Frame& frame) {
   return diameter_percentile(frame, 0.5);
 }
+
+/// The d50 (m) a granoscope run's scene defined and measured its lengths by, from the run's
+/// metadata: "scene.d50_m" (written by the silo and saw-tooth interface shear scenes, whose
+/// roughness R_n = h_g/d50 is in units of it), or, in runs written before that key, a positive
+/// `d50_m` in the [silo] or [interface_shear] table of the recorded "scene.toml". None when the
+/// run records none (the scene took its d50 from the grading by mass, as d50() does). This
+/// matters where the scene's d50 is a median by number (seed 004's silo: 1.5 mm of a grading
+/// uniform between 0.5 and 2.5 mm, whose median by volume is 2.1 mm).
+std::optional<double> recorded_d50(
+    const std::vector<std::pair<std::string, std::string>>& parameters);
 
 }  // namespace gs::analysis

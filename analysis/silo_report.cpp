@@ -31,6 +31,8 @@ void wall_zones(const Frame& f, const SiloReportOptions& o, const Eigen::Vector3
                 const Eigen::Vector3d& across, double bottom, double top, double x0, double x1,
                 SiloFrameReport& r) {
   if (!(o.zone_band > 0)) throw std::invalid_argument("zone band must be positive");
+  if (!(o.zone_extent_factor > 1) || !std::isfinite(o.zone_extent_factor))
+    throw std::invalid_argument("zone extent factor must be above 1");
   if (!(x1 > x0)) return;
   r.zone_height = o.zone_height > 0 ? o.zone_height : 0.5 * (top - bottom);
   const double z = bottom + r.zone_height;
@@ -60,6 +62,22 @@ void wall_zones(const Frame& f, const SiloReportOptions& o, const Eigen::Vector3
   r.zone_left = profile_inflection(s, pl, +1, o.zone_bin) + 0.5 * o.zone_bin;
   const double right = profile_inflection(s, pr, -1, o.zone_bin);
   r.zone_right = std::isnan(right) ? NAN : (x1 - x0) - (right + 0.5 * o.zone_bin);
+  // The extent: where the profile falls below a multiple of the core's level (the median over
+  // the middle third of the bins).
+  std::vector<double> core(s.begin() + n / 3, s.begin() + std::max(n / 3 + 1, 2 * n / 3));
+  std::sort(core.begin(), core.end());
+  const std::size_t m = core.size();
+  r.zone_core = m % 2 ? core[m / 2] : 0.5 * (core[m / 2 - 1] + core[m / 2]);
+  const double level = o.zone_extent_factor * r.zone_core;
+  // From the peak `b` towards `step`, the crossing's position in bins from bin 0's centre.
+  const auto crossing = [&](int b, int step) {
+    if (!(s[b] >= level)) return static_cast<double>(NAN);
+    while (b + step >= 0 && b + step < n && s[b + step] >= level) b += step;
+    if (b + step < 0 || b + step >= n) return static_cast<double>(NAN);
+    return b + step * (s[b] - level) / (s[b] - s[b + step]);
+  };
+  r.zone_extent_left = (crossing(pl, +1) + 0.5) * o.zone_bin;
+  r.zone_extent_right = (x1 - x0) - (crossing(pr, -1) + 0.5) * o.zone_bin;
 }
 
 void void_ratio_layers(const Frame& f, const SiloReportOptions& o, const Eigen::Vector3d& up,

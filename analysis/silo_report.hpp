@@ -29,7 +29,11 @@
 //    largest mean |rotation| in the half next to a wall, the first sign change of the second
 //    difference towards the middle (linear interpolation) is the zone's inner boundary, and its
 //    distance from the wall's base plane (the extreme wall point across) the zone's thickness
-//    (NaN when the profile has no such point).
+//    (NaN when the profile has no such point). A profile that falls convexly from the wall has
+//    no inflection but its noise's, so the report also gives each zone's extent: the core's
+//    level, the median of the smoothed profile over the middle third of the width, and from the
+//    wall's peak the first point towards the middle (linear interpolation between bin centres)
+//    where the profile falls below `zone_extent_factor` times that level (NaN when it does not).
 //  * Void ratio across the width (§5.3.1; at 10, 25 and 40 cm of the seed's 0.5 m silo): in
 //    horizontal bands (`layer_band` thick, clipped to the fill: from the bottom to the highest
 //    grain's top) centred at fractions of the fill's height (`layer_fractions`), boxes `layer_bin`
@@ -72,6 +76,8 @@ struct SiloReportOptions {
   double zone_bin = 0;                  // m; 0: no shear-zone profile
   double zone_band = 0;                 // m, > 0 with zone_bin
   double zone_height = 0;               // m above the bottom; 0: half the fill's height
+  double zone_extent_factor = 2;        // the zones' extent: where the rotation falls below
+                                        // this multiple of the core's (> 1)
   std::vector<double> layer_fractions;  // of the fill's height; empty: no void-ratio layers
   double layer_bin = 0;                 // m, > 0 with layer_fractions
   double layer_band = 0;                // m, > 0 with layer_fractions
@@ -116,8 +122,10 @@ struct SiloFrameReport {
   double zone_height = 0;                          // m above the bottom
   std::vector<double> zone_across, zone_rotation;  // bin centres (m along across), mean |rot|
   double zone_left = NAN, zone_right = NAN;        // m
-  double fill_height = 0;                          // m: the highest particle top above the bottom
-  double width = 0;                                // m: between the side walls' base planes
+  double zone_core = NAN;                          // rad: the core's mean |rotation| level
+  double zone_extent_left = NAN, zone_extent_right = NAN;  // m from the walls' base planes
+  double fill_height = 0;  // m: the highest particle top above the bottom
+  double width = 0;        // m: between the side walls' base planes
   std::vector<SiloLayer> layers;
   // Left half contact orientation (with fabric_bins > 0).
   std::vector<double> rose_angle_deg, rose_density;  // bin centres from the wall normal; 1/rad

@@ -48,6 +48,10 @@ SiloSeries silo_series(const std::string& file, const std::vector<Frame>& t, con
   require_positive(file, "--zone-band-d50", a.zone_band_d50);
   o.zone_bin = a.zone_bin_d50 * d50;
   o.zone_band = a.zone_band_d50 * d50;
+  if (!(a.zone_extent_factor > 1) || !std::isfinite(a.zone_extent_factor))
+    throw InputError(file, "--zone-extent-factor: must be above 1",
+                     value_str(a.zone_extent_factor));
+  o.zone_extent_factor = a.zone_extent_factor;
   if (a.zone_height) require_positive(file, "--zone-height", *a.zone_height);
   o.zone_height = a.zone_height.value_or(0.0);
   for (const double f : a.layers)

@@ -23,6 +23,7 @@ struct SiloSpec {
   Eigen::Vector3d up = Eigen::Vector3d::UnitZ(), across = Eigen::Vector3d::UnitX();
   std::optional<double> bin, bin_d50, depth, d50, zone_height, from_time;
   double zone_bin_d50 = 1.0, zone_band_d50 = 5.0;
+  double zone_extent_factor = 2.0;
   long from = 0;
   double gravity = 9.81;
   std::vector<double> layers{0.2, 0.5, 0.8};

@@ -6,6 +6,7 @@
 #include "errors.hpp"
 #include "frame_motion.hpp"
 #include "grain_size.hpp"
+#include "hdf5_trajectory.hpp"
 
 namespace gs::cli {
 
@@ -16,7 +17,10 @@ void FrameArgs::add_to(CLI::App& cmd, bool with_to, bool input_required) {
   cmd.add_option("--frame", frame, "frame index, negative from the end (default -1: the last)");
   if (with_to)
     cmd.add_option("--to", to, "second frame: displacement from --frame to --to (by id)");
-  cmd.add_option("--d50", d50, "median diameter in m (default: from the frame, by volume)");
+  cmd.add_option(
+      "--d50", d50,
+      "median diameter in m (default: the one the run's scene recorded, else the frame's "
+      "median by volume)");
 }
 
 long FrameArgs::frame_index() const {
@@ -39,6 +43,11 @@ std::optional<Frame> FrameArgs::load_to() const {
 
 double FrameArgs::d50_of(const Frame& f) const {
   if (d50) return *d50;
+  // The d50 a granoscope scene defined its lengths by (the silo's and the interface shear's
+  // R_n = h_g/d50), when the run recorded one.
+  if (is_hdf5_file(input))
+    if (const auto r = analysis::recorded_d50(TrajectoryReader(input).metadata().parameters))
+      return *r;
   if (f.particles.empty()) throw InputError(input, "the frame has no particles");
   return analysis::d50(f);
 }

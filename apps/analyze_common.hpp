@@ -20,7 +20,7 @@ struct FrameArgs {
   std::string input;
   long frame = -1;  // negative: from the end
   std::optional<long> to;
-  std::optional<double> d50;  // m; default: from the frame
+  std::optional<double> d50;  // m; default: d50_of()
 
   /// Adds INPUT (positional), --frame, --d50 and, with `with_to`, --to.
   void add_to(CLI::App& cmd, bool with_to, bool input_required = true);
@@ -29,7 +29,8 @@ struct FrameArgs {
   /// The --to frame, when given.
   std::optional<Frame> load_to() const;
   long frame_index() const;
-  /// d50 of the frame unless --d50 was given (m).
+  /// --d50, else the d50 the run's scene recorded (analysis::recorded_d50), else the frame's
+  /// median by volume (m).
   double d50_of(const Frame& f) const;
 };
 

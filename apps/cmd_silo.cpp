@@ -14,6 +14,7 @@
 #include "commands.hpp"
 #include "errors.hpp"
 #include "field_output.hpp"
+#include "grain_size.hpp"
 #include "silo_report.hpp"
 #include "silo_series.hpp"
 #include "trajectory_io.hpp"
@@ -33,11 +34,18 @@ void run_silo(const SiloArgs& a) {
   ga::SiloSpec spec = a.spec;
   spec.up = Eigen::Vector3d(a.up[0], a.up[1], a.up[2]);
   spec.across = Eigen::Vector3d(a.across[0], a.across[1], a.across[2]);
-  const ga::SiloSeries run = ga::silo_series(a.input, read_snapshots(a.input).frames, spec);
+  const Trajectory t = read_snapshots(a.input);
+  // The d50 the lengths in d50 are in: given, the one the silo scene recorded, or the last
+  // frame's median by volume.
+  const char* d50_source = spec.d50 ? "given" : "the scene's";
+  if (!spec.d50) spec.d50 = ga::recorded_d50(t.metadata.parameters);
+  if (!spec.d50) d50_source = "median by volume of the last frame";
+  const ga::SiloSeries run = ga::silo_series(a.input, t.frames, spec);
   const auto& reports = run.reports;
   const auto& series = run.series;
   const double d50 = run.d50;
   const long from = run.from;
+  std::printf("d50 %.6g m (%s)\n", d50, d50_source);
   const ga::SiloReportOptions& o = run.options;
   H5FieldFile h(a.output, "granoscope-silo");
   h.attr("source", a.input);
@@ -68,6 +76,9 @@ void run_silo(const SiloArgs& a) {
     h.attr("zone_height_m", r.zone_height, g);
     h.attr("zone_left_m", r.zone_left, g);
     h.attr("zone_right_m", r.zone_right, g);
+    h.attr("zone_core_rad", r.zone_core, g);
+    h.attr("zone_extent_left_m", r.zone_extent_left, g);
+    h.attr("zone_extent_right_m", r.zone_extent_right, g);
     h.write(g + "/zone_across_m", r.zone_across);
     h.write(g + "/zone_rotation_rad", r.zone_rotation);
     // Void ratio across the width at the layers' heights (one row per layer).
@@ -116,10 +127,11 @@ void run_silo(const SiloArgs& a) {
     std::printf(
         "%-8s frame %ld (t = %.4g s): P/G %.3f, T/G %.3f / %.3f, N/G %.3f / %.3f (left / right), "
         "phi_w %.1f / %.1f deg, (P + T_left + T_right)/G %.3f; wall zones %.1f / %.1f d50 at "
-        "%.3g m\n",
+        "%.3g m (extent %.1f / %.1f d50)\n",
         name, from + static_cast<long>(k), r.time, r.P / r.G, r.T_left / r.G, r.T_right / r.G,
         r.N_left / r.G, r.N_right / r.G, r.phi_left_deg, r.phi_right_deg, r.balance,
-        r.zone_left / d50, r.zone_right / d50, r.zone_height);
+        r.zone_left / d50, r.zone_right / d50, r.zone_height, r.zone_extent_left / d50,
+        r.zone_extent_right / d50);
     std::printf("         P/G by the slice method (Eq 5.1, R = b/2, mu = tan %.1f deg): ", phi_w);
     if (std::isnan(k_dr) && !(phi_w > 0))
       std::printf("n/a (no wall friction mobilised)");
@@ -208,13 +220,19 @@ void register_analyze_silo(CLI::App& app) {
   s->add_option("--bin", a->spec.bin, "profile bin along the height in m");
   s->add_option("--bin-d50", a->spec.bin_d50, "profile bin in d50 (default 5)");
   s->add_option("--depth", a->spec.depth, "silo depth in m (default: extent of the particles)");
-  s->add_option("--d50", a->spec.d50, "d50 in m (default: from the last frame)");
+  s->add_option(
+      "--d50", a->spec.d50,
+      "d50 in m (default: the one the silo scene recorded, else the last frame's median by "
+      "volume)");
   s->add_option("--gravity", a->spec.gravity, "m/s^2 for the weight G (default 9.81)");
   s->add_option("--zone-height", a->spec.zone_height,
                 "height of the wall shear zones above the bottom in m (default: half the fill)");
   s->add_option("--zone-band-d50", a->spec.zone_band_d50,
                 "thickness of the band the rotation profile is taken in, d50 (default 5)");
   s->add_option("--zone-bin-d50", a->spec.zone_bin_d50, "bins across the silo, d50 (default 1)");
+  s->add_option("--zone-extent-factor", a->spec.zone_extent_factor,
+                "a wall zone's extent ends where the rotation falls below this multiple of the "
+                "core's (default 2)");
   s->add_option("--layers", a->spec.layers,
                 "heights of the void-ratio layers as fractions of the fill (default 0.2 0.5 0.8: "
                 "10, 25 and 40 cm of the seed's 0.5 m)");

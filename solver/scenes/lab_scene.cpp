@@ -97,6 +97,9 @@ std::vector<std::unique_ptr<LoadingProgramme>> scene_programmes(Scene& s) {
     SiloWalls idx;
     try {
       s.walls = silo_walls(s.silo, d50, f.sizes.dmax_m, idx);
+      // For `analyze silo` (the run's metadata): the d50 the roughness and the report's lengths
+      // are in units of (the seed's is a median by number, not the grading's by volume).
+      s.parameters.emplace_back("scene.d50_m", value_str(d50));
       // What falls through the outlet (or, while filling, bounces over a wall) is removed two
       // grains below the side walls' lower end.
       const double big = 10 * (s.silo.width_m + s.silo.height_m + s.silo.depth_m);
@@ -264,6 +267,7 @@ std::vector<std::unique_ptr<LoadingProgramme>> scene_programmes(Scene& s) {
       // For `analyze interface` (the run's metadata): where the surface is.
       s.parameters.emplace_back("interface_shear.surface_mean_z_m", value_str(g.mean_z_m));
       s.parameters.emplace_back("interface_shear.surface_crest_z_m", value_str(g.crest_z_m));
+      if (f.kind == "saw_tooth") s.parameters.emplace_back("scene.d50_m", value_str(f.d50_m));
       test = std::make_unique<InterfaceShear>(s.interface_shear, g, idx);
     } catch (const std::invalid_argument& e) {
       throw InputError(s.file.string(), e.what());

@@ -47,3 +47,25 @@ TEST(GrainSize, TwoSizesByAreaIn2D) {
   EXPECT_DOUBLE_EQ(diameter_percentile(f, 0.5), diameter_percentile(r, 0.5, 3));
   EXPECT_THROW(diameter_percentile(r, 0.5, 4), std::invalid_argument);
 }
+
+TEST(GrainSize, TheD50ARunsSceneRecorded) {
+  using P = std::vector<std::pair<std::string, std::string>>;
+  // The key the silo and interface shear scenes write wins over the scene file.
+  EXPECT_EQ(gs::analysis::recorded_d50(
+                P{{"scene.toml", "[silo]\nd50_m = 0.002\n"}, {"scene.d50_m", "0.0015"}}),
+            0.0015);
+  // Runs written before the key: the scene file's [silo] or [interface_shear] d50_m, not one
+  // of another table; a zero (the grading's d50 by mass) or an unreadable value is none.
+  const std::string silo =
+      "[fill]\nd50_m = 0.003\ndmin_m = 0.0005\n\n[silo]\nbottom_travel_m = "
+      "0.006\nd50_m = 0.0015\ndepth_m = 0.0075\n";
+  EXPECT_EQ(gs::analysis::recorded_d50(P{{"scene.toml", silo}}), 0.0015);
+  EXPECT_EQ(gs::analysis::recorded_d50(P{{"scene.toml", "[interface_shear]\nd50_m = 0.001\n"}}),
+            0.001);
+  EXPECT_FALSE(gs::analysis::recorded_d50(P{{"scene.toml", "[fill]\nd50_m = 0.003\n"}}));
+  EXPECT_FALSE(gs::analysis::recorded_d50(P{{"scene.toml", "[silo]\nd50_m = 0.0\n"}}));
+  EXPECT_FALSE(gs::analysis::recorded_d50(P{{"scene.d50_m", "x"}}));
+  EXPECT_FALSE(gs::analysis::recorded_d50(P{{"scene.d50_m", "-1"}}));
+  EXPECT_FALSE(gs::analysis::recorded_d50(P{{"scene.name", "silo"}}));
+  EXPECT_FALSE(gs::analysis::recorded_d50(P{}));
+}

@@ -156,6 +156,49 @@ TEST(SiloReport, WallZoneThicknessAtTheInflectionOfTheRotationProfile) {
   EXPECT_TRUE(std::isnan(none.zone_left));
 }
 
+// The wall zones' extent: a step profile of |rotation| across a 40 mm silo, 1 rad out to 6 mm
+// from the left wall and to 10 mm from the right one, 0.1 rad in between, one particle per 1 mm
+// bin. Smoothed by [1 2 1]/4 the left step reads 1, …, 1 (bin 4), 0.775 (bin 5), 0.325 (bin 6),
+// 0.1: the core (the median of the middle third) is 0.1, and twice it, 0.2, is crossed between
+// the centres of bins 6 and 7, at 6.5 + (0.325 − 0.2)/(0.325 − 0.1) mm; the right one mirrors it
+// 4 mm further in. The inflection method meanwhile finds the step's edge (6 and 10 mm).
+TEST(SiloReport, WallZoneExtentWhereTheRotationFallsToTwiceTheCore) {
+  Frame f;
+  f.walls = {wall(100, WallKind::Plane, {0, 0, 0}, {1, 0, 0}, {0, 0, 0}),
+             wall(101, WallKind::Plane, {0.04, 0, 0}, {-1, 0, 0}, {0, 0, 0}),
+             wall(102, WallKind::Plane, {0, 0, 0}, {0, 0, 1}, {0, 0, 0})};
+  for (int b = 0; b < 40; ++b) {
+    Particle p;
+    p.id = b;
+    p.radius = 4e-4;
+    p.mass = 1e-6;
+    p.position = Eigen::Vector3d((b + 0.5) * 1e-3, 0.002, 0.01);
+    p.rotation = Eigen::Vector3d(0, (b < 6 || b >= 30) ? -1.0 : 0.1, 0);
+    f.particles.push_back(p);
+  }
+  analysis::SiloReportOptions o;
+  o.bin = 0.005;
+  o.zone_bin = 0.001;
+  o.zone_band = 0.002;
+  o.zone_height = 0.01;
+  const auto r = analysis::silo_report(f, o);
+  ASSERT_EQ(r.zone_across.size(), 40u);
+  EXPECT_DOUBLE_EQ(r.zone_core, 0.1);
+  const double cross = (6.5 + 0.125 / 0.225) * 1e-3;
+  EXPECT_NEAR(r.zone_extent_left, cross, 1e-15);
+  EXPECT_NEAR(r.zone_extent_right, cross + 0.004, 1e-15);
+  EXPECT_NEAR(r.zone_left, 0.006, 1e-15);
+  EXPECT_NEAR(r.zone_right, 0.010, 1e-15);
+  // Three times the core, 0.3, is crossed just past bin 6's centre; a factor that leaves the
+  // peak below its level finds no extent; a factor of 1 or less is refused.
+  o.zone_extent_factor = 3;
+  EXPECT_NEAR(analysis::silo_report(f, o).zone_extent_left, (6.5 + 0.025 / 0.225) * 1e-3, 1e-15);
+  o.zone_extent_factor = 20;
+  EXPECT_TRUE(std::isnan(analysis::silo_report(f, o).zone_extent_left));
+  o.zone_extent_factor = 1;
+  EXPECT_THROW(analysis::silo_report(f, o), std::invalid_argument);
+}
+
 // Exact answers for the slice method of seed 004 §5.3.1: Eq 5.2 at φw = φi reduces to
 // K = cos²φ / (1 + sin²φ); at 35°/32° it is the printed 0.83. Eq 5.1 with the seed's own
 // inputs (γ = 16 kN/m³, b = 0.2 m, depth 0.6 m, h = 0.5 m, the printed K and the experimental

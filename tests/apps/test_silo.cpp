@@ -21,7 +21,7 @@ using gs::test::read_csv_table;
 using gs::test::replaced;
 using gs::test::run_cli;
 
-// 120 grains of 1.5–2.5 mm in a 20 × 30 × 7.5 mm silo with R_n = 1 teeth (1.9 mm: d50 by mass
+// 120 grains of 1.5–2.5 mm in a 20 × 30 × 7.5 mm silo with R_n = 1 teeth (2 mm: d50 by mass
 // of the straight grading), two layers; the seed's material (Table 5.1).
 std::string scene(const std::string& silo, const std::string& extra = "") {
   return "[scene]\nname = \"silo\"\ntest = \"silo\"\n"
@@ -115,6 +115,18 @@ TEST(Silo, QuasiStaticBottomMovesAndTheForcesBalanceTheWeight) {
   for (const char* col : {"G_N", "P_N", "T_left_N", "T_right_N", "N_left_N", "N_right_N"})
     EXPECT_NEAR(s.num(m, col), c.num(e, col), 1e-10 * c.num(e, "G_N")) << col;
   EXPECT_NE(rep.out.find("residual"), std::string::npos);
+  // The report's lengths in d50 are in the d50 the scene made its teeth by (R_n = h_g/d50),
+  // which the run recorded: here the straight grading's median by mass.
+  std::string recorded;
+  for (const auto& [key, value] : t.metadata.parameters)
+    if (key == "scene.d50_m") recorded = value;
+  ASSERT_FALSE(recorded.empty());
+  EXPECT_NEAR(std::stod(recorded), 0.002, 1e-15);
+  const auto at = rep.out.find("d50 ");
+  ASSERT_NE(at, std::string::npos) << rep.out;
+  EXPECT_NEAR(std::stod(rep.out.substr(at + 4)), std::stod(recorded), 1e-5 * std::stod(recorded))
+      << rep.out;
+  EXPECT_NE(rep.out.find("(the scene's)"), std::string::npos) << rep.out;
   const auto bad = run_cli("analyze silo " + (dir / "out" / "trajectory.h5").string() + " -o " +
                                (dir / "x.h5").string() + " --from 999",
                            dir.path);

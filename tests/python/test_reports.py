@@ -71,6 +71,8 @@ def test_silo_of_a_simulated_silo_equals_the_cli(cli, tmp_path):
             for k in ("sigma11_left_Pa", "sigma21_right_Pa", "height_m"):
                 np.testing.assert_array_equal(g[k][()], st["profile"][k], err_msg=k)
             np.testing.assert_array_equal(g["zone_rotation_rad"][()], st["zone"]["rotation_rad"])
+            for k in ("extent_left_m", "extent_right_m", "core_rad"):
+                np.testing.assert_array_equal(g.attrs["zone_" + k], st["zone"][k], err_msg=k)
             assert g.attrs["P_G_en1991"] == st["P_G_en1991"] or np.isnan(st["P_G_en1991"])
     # The weight is carried by the bottom and the walls: (P + T_left + T_right) / G = 1 at rest
     # (seed 004 §5.3.1), the balance column the report computes.
