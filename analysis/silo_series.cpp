@@ -130,7 +130,11 @@ SiloSeries silo_series(const std::string& file, const std::vector<Frame>& t, con
                          "flow_pattern",
                          "transition_left_m",
                          "transition_right_m",
-                         "flow_speed_m_s"};
+                         "flow_speed_m_s",
+                         "zone_left_m",
+                         "zone_right_m",
+                         "zone_extent_left_m",
+                         "zone_extent_right_m"};
   for (const char* name : names) out.series.emplace_back(name, std::vector<double>{});
   for (std::size_t k = 0; k < reports.size(); ++k) {
     const auto& r = reports[k];
@@ -154,7 +158,11 @@ SiloSeries silo_series(const std::string& file, const std::vector<Frame>& t, con
                         static_cast<double>(static_cast<int>(r.flow)),
                         r.transition_left,
                         r.transition_right,
-                        r.flow_speed};
+                        r.flow_speed,
+                        r.zone_left,
+                        r.zone_right,
+                        r.zone_extent_left,
+                        r.zone_extent_right};
     for (std::size_t c = 0; c < out.series.size(); ++c) out.series[c].second.push_back(v[c]);
   }
   return out;

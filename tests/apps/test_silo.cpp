@@ -115,6 +115,12 @@ TEST(Silo, QuasiStaticBottomMovesAndTheForcesBalanceTheWeight) {
   for (const char* col : {"G_N", "P_N", "T_left_N", "T_right_N", "N_left_N", "N_right_N"})
     EXPECT_NEAR(s.num(m, col), c.num(e, col), 1e-10 * c.num(e, "G_N")) << col;
   EXPECT_NE(rep.out.find("residual"), std::string::npos);
+  // The wall zones per frame, the last the residual state's.
+  const auto zone = gs::test::h5::read(dir / "silo_report.h5", "/series/zone_extent_left_m");
+  ASSERT_EQ(zone.size(), s.rows.size());
+  for (const char* col :
+       {"zone_left_m", "zone_right_m", "zone_extent_left_m", "zone_extent_right_m"})
+    (void)s.num(m, col);
   // The report's lengths in d50 are in the d50 the scene made its teeth by (R_n = h_g/d50),
   // which the run recorded: here the straight grading's median by mass.
   std::string recorded;
