@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <functional>
 #include <stdexcept>
 
 #include "silo_report.hpp"
@@ -62,6 +63,36 @@ Frame silo() {
                 on_wall(11, 0, {0.001, 0.005, 0.006}, {-2.0, 0, -0.25}),
                 on_wall(13, 1, {0.1, 0.005, 0.012}, {3.0, 0, -1.0})};
   return f;
+}
+
+// A silo `bins` mm wide between two plane walls, on a bottom plane, with one particle per 1 mm
+// bin at mid-height (z = 10 mm) whose rotation about the depth axis y is rotation(x) (x in m; the
+// x component, 0.3, is not the profile's), and the options that profile it in those bins.
+Frame zone_silo(int bins, const std::function<double(double)>& rotation) {
+  Frame f;
+  f.walls = {wall(100, WallKind::Plane, {0, 0, 0}, {1, 0, 0}, {0, 0, 0}),
+             wall(101, WallKind::Plane, {bins * 1e-3, 0, 0}, {-1, 0, 0}, {0, 0, 0}),
+             wall(102, WallKind::Plane, {0, 0, 0}, {0, 0, 1}, {0, 0, 0})};
+  for (int b = 0; b < bins; ++b) {
+    Particle p;
+    p.id = b;
+    p.radius = 4e-4;
+    p.mass = 1e-6;
+    const double x = (b + 0.5) * 1e-3;
+    p.position = Eigen::Vector3d(x, 0.002, 0.01);
+    p.rotation = Eigen::Vector3d(0.3, rotation(x), 0);
+    f.particles.push_back(p);
+  }
+  return f;
+}
+
+analysis::SiloReportOptions zone_options() {
+  analysis::SiloReportOptions o;
+  o.bin = 0.005;
+  o.zone_bin = 0.001;
+  o.zone_band = 0.002;
+  o.zone_height = 0.01;
+  return o;
 }
 
 }  // namespace
@@ -123,27 +154,13 @@ TEST(SiloReport, RefusesWhatIsNoSilo) {
 // mid-height: the inflection point, hence each zone's thickness, is at 5 mm (a logistic is
 // point-symmetric about it, and so is its smoothing).
 TEST(SiloReport, WallZoneThicknessAtTheInflectionOfTheRotationProfile) {
-  Frame f;
-  f.walls = {wall(100, WallKind::Plane, {0, 0, 0}, {1, 0, 0}, {0, 0, 0}),
-             wall(101, WallKind::Plane, {0.02, 0, 0}, {-1, 0, 0}, {0, 0, 0}),
-             wall(102, WallKind::Plane, {0, 0, 0}, {0, 0, 1}, {0, 0, 0})};
   auto logistic = [](double x) { return 1 / (1 + std::exp((x - 0.005) / 0.001)); };
-  for (int b = 0; b < 20; ++b) {
-    Particle p;
-    p.id = b;
-    p.radius = 4e-4;
-    p.mass = 1e-6;
-    const double x = (b + 0.5) * 1e-3;
-    p.position = Eigen::Vector3d(x, 0.002, 0.01);
-    // (the sign of the rotation does not matter: the profile is of |rotation about y|)
-    p.rotation = Eigen::Vector3d(0.3, (b % 2 ? -1 : 1) * (logistic(x) + logistic(0.02 - x)), 0);
-    f.particles.push_back(p);
-  }
-  analysis::SiloReportOptions o;
-  o.bin = 0.005;
-  o.zone_bin = 0.001;
-  o.zone_band = 0.002;
-  o.zone_height = 0.01;
+  // (the sign of the rotation does not matter: the profile is of |rotation about y|)
+  const Frame f = zone_silo(20, [&](double x) {
+    const int b = static_cast<int>(x / 1e-3);
+    return (b % 2 ? -1 : 1) * (logistic(x) + logistic(0.02 - x));
+  });
+  analysis::SiloReportOptions o = zone_options();
   const auto r = analysis::silo_report(f, o);
   ASSERT_EQ(r.zone_across.size(), 20u);
   // (the other wall's tail, e^-10 of the peak at 5 mm, breaks the symmetry by 1e-3 of a bin)
@@ -163,24 +180,8 @@ TEST(SiloReport, WallZoneThicknessAtTheInflectionOfTheRotationProfile) {
 // the centres of bins 6 and 7, at 6.5 + (0.325 − 0.2)/(0.325 − 0.1) mm; the right one mirrors it
 // 4 mm further in. The inflection method meanwhile finds the step's edge (6 and 10 mm).
 TEST(SiloReport, WallZoneExtentWhereTheRotationFallsToTwiceTheCore) {
-  Frame f;
-  f.walls = {wall(100, WallKind::Plane, {0, 0, 0}, {1, 0, 0}, {0, 0, 0}),
-             wall(101, WallKind::Plane, {0.04, 0, 0}, {-1, 0, 0}, {0, 0, 0}),
-             wall(102, WallKind::Plane, {0, 0, 0}, {0, 0, 1}, {0, 0, 0})};
-  for (int b = 0; b < 40; ++b) {
-    Particle p;
-    p.id = b;
-    p.radius = 4e-4;
-    p.mass = 1e-6;
-    p.position = Eigen::Vector3d((b + 0.5) * 1e-3, 0.002, 0.01);
-    p.rotation = Eigen::Vector3d(0, (b < 6 || b >= 30) ? -1.0 : 0.1, 0);
-    f.particles.push_back(p);
-  }
-  analysis::SiloReportOptions o;
-  o.bin = 0.005;
-  o.zone_bin = 0.001;
-  o.zone_band = 0.002;
-  o.zone_height = 0.01;
+  const Frame f = zone_silo(40, [](double x) { return (x < 0.006 || x > 0.03) ? -1.0 : 0.1; });
+  analysis::SiloReportOptions o = zone_options();
   const auto r = analysis::silo_report(f, o);
   ASSERT_EQ(r.zone_across.size(), 40u);
   EXPECT_DOUBLE_EQ(r.zone_core, 0.1);
