@@ -164,7 +164,8 @@ TEST(Silo, QuasiStaticBottomMovesAndTheForcesBalanceTheWeight) {
                                                         {"--phi-i", "95"},
                                                         {"--en-k", "-1"},
                                                         {"--flow-threshold", "1.5"},
-                                                        {"--flow-wall-d50", "0"}}) {
+                                                        {"--flow-wall-d50", "0"},
+                                                        {"--zone-extent-factor", "1"}}) {
     const auto b = run_cli("analyze silo " + (dir / "out" / "trajectory.h5").string() + " -o " +
                                (dir / "x.h5").string() + " " + option + " " + value,
                            dir.path);
