@@ -121,6 +121,14 @@ TEST(InterfaceShear, SweepWritesOneRunPerValueAndTheirTable) {
     // Each run's scene: its own roughness (the teeth are R_n·d50 high).
     const std::string copy = gs::test::slurp(run / "results.csv");
     EXPECT_NE(copy.find("mu_eff_max,"), std::string::npos);
+    // The run records the d50 its R_n is in, for `analyze interface` (not the frame's median by
+    // volume, 1.03 mm for this grading).
+    std::string d50;
+    for (const auto& [key, value] :
+         gs::read_hdf5_trajectory(run / "trajectory.h5").metadata.parameters)
+      if (key == "scene.d50_m") d50 = value;
+    ASSERT_FALSE(d50.empty()) << run;
+    EXPECT_DOUBLE_EQ(std::stod(d50), 0.001);
   }
   const std::string before = gs::test::slurp(dir / "out" / "sweep.csv");
   const auto again = run_cli(
