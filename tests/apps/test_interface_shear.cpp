@@ -122,7 +122,7 @@ TEST(InterfaceShear, SweepWritesOneRunPerValueAndTheirTable) {
     const std::string copy = gs::test::slurp(run / "results.csv");
     EXPECT_NE(copy.find("mu_eff_max,"), std::string::npos);
     // The run records the d50 its R_n is in, for `analyze interface` (not the frame's median by
-    // volume, 1.03 mm for this grading).
+    // volume, 1.06 mm for this grading).
     std::string d50;
     for (const auto& [key, value] :
          gs::read_hdf5_trajectory(run / "trajectory.h5").metadata.parameters)
