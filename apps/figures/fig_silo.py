@@ -120,9 +120,13 @@ def make(input_path, out_dir, args):
                       ["-", "--", ":", "-."][k % 4], color=COLOURS[s],
                       label="%s, %.3g m" % (s, height))
         if len(st.get("zone_rotation_rad", [])):
+            # (the extent: from reports written since 2026-12-06)
+            extent = [float(st.get("zone_extent_%s_m" % w, np.nan)) / d50
+                      for w in ("left", "right")]
             ax_r.plot(st["zone_across_m"], st["zone_rotation_rad"], color=COLOURS[s],
-                      label="%s (zones %.1f / %.1f d50)" % (
-                          s, float(st["zone_left_m"]) / d50, float(st["zone_right_m"]) / d50))
+                      label="%s (zones %.1f / %.1f d50, extent %.1f / %.1f)" % (
+                          s, float(st["zone_left_m"]) / d50, float(st["zone_right_m"]) / d50,
+                          extent[0], extent[1]))
         dens = np.asarray(st.get("rose_left_density", []))
         if dens.size:
             ang = np.radians(np.asarray(st["rose_left_angle_deg"]))
