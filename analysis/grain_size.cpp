@@ -3,8 +3,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
-#include <sstream>
 #include <stdexcept>
+#include <string_view>
+
+#include "text_parse.hpp"
 
 namespace gs::analysis {
 
@@ -48,20 +50,13 @@ double diameter_percentile(const Frame& frame, double fraction) {
 
 namespace {
 
-std::optional<double> positive_number(const std::string& text) {
-  const char* begin = text.c_str();
+// A positive finite number that is the whole of `text` (a trailing TOML comment allowed).
+std::optional<double> positive_number(std::string_view text) {
+  const std::string s(text::trim(text.substr(0, text.find('#'))));
   char* end = nullptr;
-  const double v = std::strtod(begin, &end);
-  if (end == begin) return std::nullopt;
-  while (*end == ' ' || *end == '\t') ++end;
-  if ((*end != '\0' && *end != '#') || !std::isfinite(v) || !(v > 0)) return std::nullopt;
+  const double v = std::strtod(s.c_str(), &end);
+  if (s.empty() || *end != '\0' || !std::isfinite(v) || !(v > 0)) return std::nullopt;
   return v;
-}
-
-std::string trimmed(const std::string& s) {
-  const auto a = s.find_first_not_of(" \t\r");
-  if (a == std::string::npos) return {};
-  return s.substr(a, s.find_last_not_of(" \t\r") - a + 1);
 }
 
 }  // namespace
@@ -74,18 +69,17 @@ std::optional<double> recorded_d50(
   // `[name]`, the way the scene reader writes it back).
   for (const auto& [key, value] : parameters) {
     if (key != "scene.toml") continue;
-    std::istringstream in(value);
-    std::string line, table;
-    while (std::getline(in, line)) {
-      line = trimmed(line);
+    std::string_view table;
+    for (const std::string_view raw : text::split_lines(value)) {
+      const std::string_view line = text::trim(raw);
       if (line.size() > 1 && line.front() == '[') {
-        table = trimmed(line.substr(1, line.find(']') - 1));
+        table = text::trim(line.substr(1, line.find(']') - 1));
         continue;
       }
-      if (table != "silo" && table != "interface_shear") continue;
       const auto eq = line.find('=');
-      if (eq == std::string::npos || trimmed(line.substr(0, eq)) != "d50_m") continue;
-      return positive_number(trimmed(line.substr(eq + 1)));
+      if ((table == "silo" || table == "interface_shear") && eq != std::string_view::npos &&
+          text::trim(line.substr(0, eq)) == "d50_m")
+        return positive_number(line.substr(eq + 1));
     }
   }
   return std::nullopt;

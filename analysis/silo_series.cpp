@@ -34,8 +34,11 @@ SiloSeries silo_series(const std::string& file, const std::vector<Frame>& t, con
   const Frame& last = t.back();
   if (last.particles.empty()) throw InputError(file, "the last frame has no particles");
   if (a.d50) require_positive(file, "--d50", *a.d50);
-  const double d50 = a.d50 ? *a.d50 : analysis::d50(last);
+  const double d50 = a.d50 ? *a.d50 : a.scene_d50 ? *a.scene_d50 : analysis::d50(last);
   out.d50 = d50;
+  out.d50_source = a.d50         ? "given"
+                   : a.scene_d50 ? "the scene's"
+                                 : "median by volume of the last frame";
   SiloReportOptions& o = out.options;
   o.up = a.up;
   o.across = a.across;

@@ -22,6 +22,9 @@ namespace gs::analysis {
 struct SiloSpec {
   Eigen::Vector3d up = Eigen::Vector3d::UnitZ(), across = Eigen::Vector3d::UnitX();
   std::optional<double> bin, bin_d50, depth, d50, zone_height, from_time;
+  // The d50 the run's scene recorded (recorded_d50): used when `d50` is not given, before the
+  // last frame's median by volume.
+  std::optional<double> scene_d50;
   double zone_bin_d50 = 1.0, zone_band_d50 = 5.0;
   double zone_extent_factor = 2.0;
   long from = 0;
@@ -44,6 +47,7 @@ struct SiloState {
 
 struct SiloSeries {
   double d50 = 0.0;
+  const char* d50_source = "";  // "given", "the scene's" or "median by volume of the last frame"
   SiloReportOptions options;
   long from = 0;                                                    // the initial state's frame
   std::vector<SiloFrameReport> reports;                             // frames from, from + 1, ...

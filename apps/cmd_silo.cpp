@@ -35,17 +35,13 @@ void run_silo(const SiloArgs& a) {
   spec.up = Eigen::Vector3d(a.up[0], a.up[1], a.up[2]);
   spec.across = Eigen::Vector3d(a.across[0], a.across[1], a.across[2]);
   const Trajectory t = read_snapshots(a.input);
-  // The d50 the lengths in d50 are in: given, the one the silo scene recorded, or the last
-  // frame's median by volume.
-  const char* d50_source = spec.d50 ? "given" : "the scene's";
-  if (!spec.d50) spec.d50 = ga::recorded_d50(t.metadata.parameters);
-  if (!spec.d50) d50_source = "median by volume of the last frame";
+  spec.scene_d50 = ga::recorded_d50(t.metadata.parameters);
   const ga::SiloSeries run = ga::silo_series(a.input, t.frames, spec);
   const auto& reports = run.reports;
   const auto& series = run.series;
   const double d50 = run.d50;
   const long from = run.from;
-  std::printf("d50 %.6g m (%s)\n", d50, d50_source);
+  std::printf("d50 %.6g m (%s)\n", d50, run.d50_source);
   const ga::SiloReportOptions& o = run.options;
   H5FieldFile h(a.output, "granoscope-silo");
   h.attr("source", a.input);

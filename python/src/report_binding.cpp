@@ -104,7 +104,8 @@ void bind_reports(py::module_& m) {
         spec.bin = bin;
         spec.bin_d50 = bin_d50;
         spec.depth = depth;
-        spec.d50 = d50 ? d50 : ga::recorded_d50(parameters_of(run));  // as the CLI
+        spec.d50 = d50;
+        spec.scene_d50 = ga::recorded_d50(parameters_of(run));  // as the CLI
         spec.gravity = gravity;
         spec.zone_height = zone_height;
         spec.zone_band_d50 = zone_band_d50;
