@@ -449,6 +449,7 @@ void read_lab_sections(const Reader& r, const toml::table& root, Scene& s) {
             "outlet_width_m",
             "max_discharge_s",
             "end_fraction",
+            "stop_after_s",
             "frame_every_s"});
     auto& x = s.silo;
     x.width_m = r.positive(t, sec, "width_m", true, 0);
@@ -472,7 +473,7 @@ void read_lab_sections(const Reader& r, const toml::table& root, Scene& s) {
     for (const char* k : {"bottom_velocity_m_s", "bottom_travel_m", "frame_every_m"})
       if (!quasi && t->contains(k)) r.fail(sec + "." + k, "is for mode = \"quasi_static\"");
     for (const char* k : {"settle_s", "outlet", "outlet_width_m", "max_discharge_s", "end_fraction",
-                          "frame_every_s"})
+                          "stop_after_s", "frame_every_s"})
       if (quasi && t->contains(k)) r.fail(sec + "." + k, "is for mode = \"gravitational\"");
     x.flow_damping = r.number(t, sec, "flow_damping", false, x.flow_damping);
     x.bottom_velocity_m_s = r.positive(t, sec, "bottom_velocity_m_s", false, x.bottom_velocity_m_s);
@@ -483,6 +484,7 @@ void read_lab_sections(const Reader& r, const toml::table& root, Scene& s) {
     x.outlet_width_m = r.number(t, sec, "outlet_width_m", false, x.outlet_width_m);
     x.max_discharge_s = r.positive(t, sec, "max_discharge_s", false, x.max_discharge_s);
     x.end_fraction = r.number(t, sec, "end_fraction", false, x.end_fraction);
+    x.stop_after_s = r.number(t, sec, "stop_after_s", false, x.stop_after_s);
     x.frame_every_s = r.number(t, sec, "frame_every_s", false, x.frame_every_s);
     if (!root.contains("fill")) r.fail("[fill]", "missing (the silo is filled in layers)");
   } else if (s.test == "stress_rotation") {

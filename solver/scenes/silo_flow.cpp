@@ -170,6 +170,8 @@ SiloFlow::SiloFlow(SiloSpec spec, SiloWalls walls) : spec_(std::move(spec)), w_(
                   "must be positive");
     require_value(spec_.end_fraction > 0 && spec_.end_fraction <= 1, "silo.end_fraction",
                   spec_.end_fraction, "outside (0, 1]");
+    require_value(spec_.stop_after_s >= 0, "silo.stop_after_s", spec_.stop_after_s,
+                  "must not be negative");
     require_value(spec_.frame_every_s >= 0, "silo.frame_every_s", spec_.frame_every_s,
                   "must not be negative");
   }
@@ -225,13 +227,26 @@ void SiloFlow::control(Simulation& sim) {
   if (!opened_ && sim.time() - t0_ >= spec_.settle_s) {
     sim.set_wall_active(w_.outlet, false);
     opened_ = true;
+    last_out_t_ = sim.time();
+    last_out_mass_ = discharged_mass(sim);
   }
+  if (!opened_) return;
+  const double out = discharged_mass(sim);
+  if (std::isnan(last_out_t_) || out > last_out_mass_) {  // (NaN: a checkpoint from before the key)
+    last_out_t_ = sim.time();
+    last_out_mass_ = out;
+  }
+}
+
+bool SiloFlow::stalled(const Simulation& sim) const {
+  return opened_ && spec_.stop_after_s > 0 && !std::isnan(last_out_t_) &&
+         sim.time() - last_out_t_ >= spec_.stop_after_s;
 }
 
 bool SiloFlow::finished(const Simulation& sim) const {
   if (quasi_static()) return travel(sim) >= spec_.bottom_travel_m;
   if (!opened_) return false;
-  return discharged_mass(sim) >= spec_.end_fraction * mass0_ ||
+  return discharged_mass(sim) >= spec_.end_fraction * mass0_ || stalled(sim) ||
          sim.time() - t0_ >= spec_.settle_s + spec_.max_discharge_s;
 }
 
@@ -279,7 +294,7 @@ std::int64_t SiloFlow::frame_index(const Simulation& sim) const {
 
 std::string SiloFlow::summary(const Simulation& sim) const {
   const SiloForces f = silo_forces(sim, w_);
-  char b[640];
+  char b[768];
   if (quasi_static()) {
     std::snprintf(
         b, sizeof b,
@@ -288,12 +303,18 @@ std::string SiloFlow::summary(const Simulation& sim) const {
         e0_, travel(sim), f.weight, f.bottom / f.weight, f.t_left / f.weight, f.t_right / f.weight,
         f.n_left / f.weight, f.n_right / f.weight, (f.bottom + f.t_left + f.t_right) / f.weight);
   } else {
+    char why[160] = "";
+    if (discharged_mass(sim) < spec_.end_fraction * mass0_ && stalled(sim))
+      std::snprintf(why, sizeof why,
+                    "; the flow stopped: nothing left in the last %.4g s (silo.stop_after_s)",
+                    spec_.stop_after_s);
     std::snprintf(
         b, sizeof b,
         "silo (gravitational, outlet %s, b = %.4g m): e0 = %.3f; %.4g kg of %.4g kg discharged "
-        "(%.1f %%) in %.4g s after the opening",
+        "(%.1f %%) in %.4g s after the opening%s",
         spec_.outlet.c_str(), spec_.outlet_width_m, e0_, discharged_mass(sim), mass0_,
-        mass0_ > 0 ? 100 * discharged_mass(sim) / mass0_ : 0.0, sim.time() - t0_ - spec_.settle_s);
+        mass0_ > 0 ? 100 * discharged_mass(sim) / mass0_ : 0.0, sim.time() - t0_ - spec_.settle_s,
+        why);
   }
   return b;
 }
@@ -306,6 +327,8 @@ std::string SiloFlow::save_state() const {
   st.set("removed0", removed0_);
   st.set("opened", static_cast<std::int64_t>(opened_));
   st.set("e0", e0_);
+  st.set("last_out_t", last_out_t_);
+  st.set("last_out_mass", last_out_mass_);
   for (int k = 0; k < 3; ++k) {
     st.set("gauge_lo" + std::to_string(k), gauge_lo_[k]);
     st.set("gauge_hi" + std::to_string(k), gauge_hi_[k]);
@@ -321,6 +344,9 @@ void SiloFlow::load_state(const std::string& state) {
   removed0_ = st.number("removed0");
   opened_ = st.integer("opened") != 0;
   e0_ = st.number("e0");
+  // (a checkpoint written before these keys: the next step's control starts the clock again)
+  last_out_t_ = st.has("last_out_t") ? st.number("last_out_t") : NAN;
+  last_out_mass_ = st.has("last_out_mass") ? st.number("last_out_mass") : 0;
   for (int k = 0; k < 3; ++k) {
     gauge_lo_[k] = st.number("gauge_lo" + std::to_string(k));
     gauge_hi_[k] = st.number("gauge_hi" + std::to_string(k));

@@ -8,8 +8,9 @@
 //    that the material stays between them;
 //  * gravitational (Fig 5.2b, Fig 5.4): the filled silo rests for settle_s (0.5 s), then an
 //    outlet of width b in the bottom opens, centred ('1') or at the right wall ('2', '3'), and the
-//    run goes on until the silo is empty (or a time limit); particles that fall below the bottom
-//    are removed and counted.
+//    run goes on until the silo is empty, or the flow has stopped (the heaps a flat bottom keeps
+//    beside the outlet, or an arch over it: nothing has left for stop_after_s), or a time limit;
+//    particles that fall below the bottom are removed and counted.
 // The curve (curve.csv) gives the resultant wall forces of seed 004 §5.3.1, normalised by the
 // weight G of the material in the silo: P the vertical force on the bottom (normal and tangential
 // parts), T the vertical force on each side wall (positive down), N the horizontal force on each
@@ -52,6 +53,7 @@ struct SiloSpec {
   double outlet_width_m = 0.03;   // b
   double max_discharge_s = 30;    // the run ends this long after the opening at the latest
   double end_fraction = 0.99;     // … or once this fraction of the mass has left
+  double stop_after_s = 1.0;      // … or once nothing has left for this long (0: never)
   double frame_every_s = 0.05;
 };
 
@@ -116,6 +118,9 @@ class SiloFlow final : public LoadingProgramme {
   double t0_ = 0, z0_ = 0, mass0_ = 0, removed0_ = 0, e0_ = 0;
   Eigen::Vector3d gauge_lo_ = Eigen::Vector3d::Zero(), gauge_hi_ = Eigen::Vector3d::Zero();
   bool opened_ = false;
+  // The time the discharged mass last grew (the opening's until something leaves), and that mass.
+  double last_out_t_ = NAN, last_out_mass_ = 0;
+  bool stalled(const Simulation& sim) const;
 };
 
 }  // namespace gs::solver

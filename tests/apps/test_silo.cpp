@@ -205,6 +205,45 @@ TEST(Silo, GravitationalOutletDischargesAndWeighsWhatLeaves) {
   EXPECT_NE(r.out.find("discharged"), std::string::npos) << r.out;
 }
 
+// An outlet 1.8 largest grains wide (4.5 mm, grains of 1.5–2.5 mm): about a tenth of the grains
+// leave, then an arch closes it. The run ends stop_after_s after the last grain left (0.1 s:
+// longer than a grain takes to fall from the outlet to where it is removed, two largest grains
+// below the bottom), long before its time limit and the end fraction, and says why; with
+// stop_after_s = 0 it runs to the limit.
+TEST(Silo, GravitationalRunEndsWhenTheFlowStops) {
+  gs::test::ScratchDir dir("silo_stall");
+  const std::string narrow =
+      replaced(kGravity, "outlet_width_m = 0.008", "outlet_width_m = 0.0045");
+  std::ofstream(dir / "silo.toml") << scene(
+      replaced(narrow, "end_fraction = 0.9\n", "end_fraction = 0.9\nstop_after_s = 0.1\n"));
+  const auto r = run_cli(
+      "simulate " + (dir / "silo.toml").string() + " -q -o " + (dir / "out").string(), dir.path);
+  ASSERT_EQ(r.rc, 0) << r.err;
+  EXPECT_NE(r.out.find("the flow stopped: nothing left in the last 0.1 s"), std::string::npos)
+      << r.out;
+  const auto c = read_csv_table(dir / "out" / "curve.csv");
+  const std::size_t n = c.rows.size() - 1;
+  const double end = c.num(n, "flow_time_s"), out = c.num(n, "discharged_kg");
+  EXPECT_LT(end, 0.5);  // (the limit: settle_s 0.02 + max_discharge_s 1.0)
+  EXPECT_LT(c.num(n, "discharged_fraction"), 0.9);
+  // The last grain left 0.1 s before the end (the opening at 0.02 s if none had): the curve's
+  // rows, 200 steps (2 ms) apart, reach the final mass within a row of that.
+  std::size_t first = n;
+  while (first > 0 && c.num(first - 1, "discharged_kg") == out) --first;
+  const double t_out = out > 0 ? c.num(first, "flow_time_s") : 0.02;
+  EXPECT_NEAR(end - t_out, 0.1, 0.0025) << "last grain out at " << t_out << ", end " << end;
+  // stop_after_s = 0 never stops on the flow: the run goes on to its time limit (here 0.1 s).
+  std::ofstream(dir / "silo0.toml") << scene(
+      replaced(replaced(narrow, "end_fraction = 0.9\n", "end_fraction = 0.9\nstop_after_s = 0\n"),
+               "max_discharge_s = 1.0", "max_discharge_s = 0.08"));
+  const auto r0 = run_cli(
+      "simulate " + (dir / "silo0.toml").string() + " -q -o " + (dir / "out0").string(), dir.path);
+  ASSERT_EQ(r0.rc, 0) << r0.err;
+  const auto c0 = read_csv_table(dir / "out0" / "curve.csv");
+  EXPECT_GE(c0.num(c0.rows.size() - 1, "flow_time_s"), 0.1);
+  EXPECT_EQ(r0.out.find("the flow stopped"), std::string::npos) << r0.out;
+}
+
 TEST(Silo, BadInputsFailWithOneLine) {
   gs::test::ScratchDir dir("silo_bad");
   const std::vector<std::pair<std::string, std::string>> cases = {
@@ -221,6 +260,10 @@ TEST(Silo, BadInputsFailWithOneLine) {
       {replaced(scene(kQuasi), "[fill]", "[nofill]"), "[nofill]: unknown section"},
       {replaced(replaced(scene(kQuasi), "[fill]", "[unused]"), "[unused]", "[walls_x]"),
        "[walls_x]: unknown section"},
+      {replaced(scene(kGravity), "end_fraction = 0.9", "stop_after_s = -1.0\nend_fraction = 0.9"),
+       "silo.stop_after_s: must not be negative (-1"},
+      {scene(kQuasi + "stop_after_s = 1.0\n"),
+       "silo.stop_after_s: is for mode = \"gravitational\""},
       {replaced(scene(kGravity), "outlet = \"centre\"", "outlet = \"middle\""),
        "silo.outlet: expected \"centre\" or \"right\" (middle)"},
       {scene(kQuasi,
