@@ -218,9 +218,16 @@ void flow_pattern(const Frame& f, const SiloReportOptions& o, const Eigen::Vecto
     return;
   }
   // The transition of a wall: the lowest band from which the wall moves in every band up to the
-  // one below the free surface's band.
+  // one below the free surface's band at that wall (the highest band its column has grains in:
+  // above an eccentric outlet the surface sinks into a crater, and the bands above it at that
+  // wall are empty, not stagnant).
+  auto highest = [&](const std::vector<double>& ns) {
+    int b = nb - 1;
+    while (b >= 0 && !(ns[static_cast<std::size_t>(b)] > 0)) --b;
+    return b;  // (−1: no grains at the wall)
+  };
   auto transition = [&](const std::vector<double>& ws, const std::vector<double>& ns) {
-    const int top = std::max(0, nb - 2);
+    const int top = std::max(0, highest(ns) - 1);
     int from = top + 1;
     for (int b = top; b >= 0; --b) {
       const auto k = static_cast<std::size_t>(b);
@@ -237,8 +244,15 @@ void flow_pattern(const Frame& f, const SiloReportOptions& o, const Eigen::Vecto
     if (std::isnan(t)) return FlowPattern::Funnel;
     return t <= 0.25 * r.fill_height ? FlowPattern::Mass : FlowPattern::Mixed;
   };
-  r.flow = static_cast<FlowPattern>(std::min(static_cast<int>(pattern(r.transition_left)),
-                                             static_cast<int>(pattern(r.transition_right))));
+  // A wall with no grains in its column (swept clean) holds no dead zone: the other decides.
+  const bool left = highest(nl) >= 0, right = highest(nr) >= 0;
+  if (left && right)
+    r.flow = static_cast<FlowPattern>(std::min(static_cast<int>(pattern(r.transition_left)),
+                                               static_cast<int>(pattern(r.transition_right))));
+  else if (left || right)
+    r.flow = pattern(left ? r.transition_left : r.transition_right);
+  else
+    r.flow = FlowPattern::Funnel;  // (grains moving between two bare walls: a stream)
 }
 
 }  // namespace

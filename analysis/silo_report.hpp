@@ -48,10 +48,13 @@
 //    teeth) against the fastest column of that width across the band. A wall moves in a band
 //    when its column goes down faster than `flow_threshold` times the fastest column. The
 //    transition height of a wall is the lowest band from which the wall moves in every band
-//    up to the one below the free surface (NaN: stagnant up to there); a wall is in mass flow
-//    when its transition lies in the lowest quarter of the fill (only the dead zones at a flat
-//    bottom), funnel flow when it has none, mixed flow in between; the silo's pattern is the
-//    slower wall's. A frame whose fastest column moves slower than 1e-6 m/s is at rest.
+//    up to the one below the free surface at that wall (the highest band its column has grains
+//    in: a crater over an eccentric outlet leaves the bands above it empty, not stagnant; NaN:
+//    stagnant up to there, or no grains at the wall); a wall is in mass flow when its transition
+//    lies in the lowest quarter of the fill (only the dead zones at a flat bottom), funnel flow
+//    when it has none, mixed flow in between; the silo's pattern is the slower wall's, or the
+//    other wall's where one has no grains in its column (swept bare: no dead zone there). A
+//    frame whose fastest column moves slower than 1e-6 m/s is at rest.
 //  * Contact orientation in the left half (Fig 5.27): particle–particle contacts whose point
 //    lies in the left half and above the bottom, their normals projected on the across–up
 //    plane; the rose of `fabric_bins` bins (angle from the left wall's inward normal, towards

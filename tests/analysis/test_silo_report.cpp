@@ -359,6 +359,35 @@ TEST(SiloReport, FlowPatternFromTheVelocityField) {
   EXPECT_DOUBLE_EQ(right.transition_right, 0.0);
   EXPECT_EQ(run([](double, double) { return 0.0; }).flow, FlowPattern::Rest);
   EXPECT_STREQ(flow_pattern_name(FlowPattern::Mixed), "mixed");
+  // A crater over an outlet at the right wall: the three columns next to it hold no grains above
+  // z = 24r (bands 6–9 empty at that wall). Everything that is there moving down is mass flow:
+  // the right wall is judged up to the band below its own surface (band 5), not through the
+  // empty bands above it. Its column stagnant under the crater is still funnel flow.
+  auto crater = [&](auto down, bool bare) {
+    Frame f = cubic_silo(r);
+    std::vector<Particle> kept;
+    for (Particle p : f.particles) {
+      if (p.position.x() > 14 * r && p.position.z() > 24 * r) continue;
+      if (bare && p.position.x() > 18 * r) continue;
+      p.velocity = {0, 0, -down(p.position.x(), p.position.z())};
+      kept.push_back(p);
+    }
+    f.particles = kept;
+    return silo_report(f, o);
+  };
+  const auto sunk = crater([](double, double) { return 1.0; }, false);
+  EXPECT_EQ(sunk.flow, FlowPattern::Mass);
+  EXPECT_DOUBLE_EQ(sunk.transition_right, 0.0);
+  EXPECT_DOUBLE_EQ(sunk.transition_left, 0.0);
+  EXPECT_EQ(crater([&](double x, double) { return x > 18 * r ? 0.0 : 1.0; }, false).flow,
+            FlowPattern::Funnel);
+  // A wall swept bare (no grains in its column) holds no dead zone: the other wall decides.
+  const auto bare = crater([](double, double) { return 1.0; }, true);
+  EXPECT_TRUE(std::isnan(bare.transition_right));
+  EXPECT_EQ(bare.flow, FlowPattern::Mass);
+  EXPECT_EQ(
+      crater([&](double x, double z) { return x < 2 * r && z < 20 * r ? 0.0 : 1.0; }, true).flow,
+      FlowPattern::Mixed);
 }
 
 // Hand-set: the reference frame holds the grains 0.3r higher in the left half and 0 elsewhere,
