@@ -226,8 +226,9 @@ void flow_pattern(const Frame& f, const SiloReportOptions& o, const Eigen::Vecto
     while (b >= 0 && !(ns[static_cast<std::size_t>(b)] > 0)) --b;
     return b;  // (−1: no grains at the wall)
   };
-  auto transition = [&](const std::vector<double>& ws, const std::vector<double>& ns) {
-    const int top = std::max(0, highest(ns) - 1);
+  const int hl = highest(nl), hr = highest(nr);
+  auto transition = [&](const std::vector<double>& ws, const std::vector<double>& ns, int hi) {
+    const int top = std::max(0, hi - 1);
     int from = top + 1;
     for (int b = top; b >= 0; --b) {
       const auto k = static_cast<std::size_t>(b);
@@ -238,14 +239,14 @@ void flow_pattern(const Frame& f, const SiloReportOptions& o, const Eigen::Vecto
     }
     return from > top ? NAN : from * band;
   };
-  r.transition_left = transition(wl, nl);
-  r.transition_right = transition(wr, nr);
+  r.transition_left = transition(wl, nl, hl);
+  r.transition_right = transition(wr, nr, hr);
   auto pattern = [&](double t) {
     if (std::isnan(t)) return FlowPattern::Funnel;
     return t <= 0.25 * r.fill_height ? FlowPattern::Mass : FlowPattern::Mixed;
   };
   // A wall with no grains in its column (swept clean) holds no dead zone: the other decides.
-  const bool left = highest(nl) >= 0, right = highest(nr) >= 0;
+  const bool left = hl >= 0, right = hr >= 0;
   if (left && right)
     r.flow = static_cast<FlowPattern>(std::min(static_cast<int>(pattern(r.transition_left)),
                                                static_cast<int>(pattern(r.transition_right))));

@@ -227,20 +227,18 @@ void SiloFlow::control(Simulation& sim) {
   if (!opened_ && sim.time() - t0_ >= spec_.settle_s) {
     sim.set_wall_active(w_.outlet, false);
     opened_ = true;
-    last_out_t_ = sim.time();
-    last_out_mass_ = discharged_mass(sim);
   }
   if (!opened_) return;
+  // (NaN: the opening step, or a checkpoint written before these keys)
   const double out = discharged_mass(sim);
-  if (std::isnan(last_out_t_) || out > last_out_mass_) {  // (NaN: a checkpoint from before the key)
+  if (std::isnan(last_out_t_) || out > last_out_mass_) {
     last_out_t_ = sim.time();
     last_out_mass_ = out;
   }
 }
 
 bool SiloFlow::stalled(const Simulation& sim) const {
-  return opened_ && spec_.stop_after_s > 0 && !std::isnan(last_out_t_) &&
-         sim.time() - last_out_t_ >= spec_.stop_after_s;
+  return opened_ && spec_.stop_after_s > 0 && sim.time() - last_out_t_ >= spec_.stop_after_s;
 }
 
 bool SiloFlow::finished(const Simulation& sim) const {
