@@ -37,47 +37,71 @@ void wall_zones(const Frame& f, const SiloReportOptions& o, const Eigen::Vector3
   r.zone_height = o.zone_height > 0 ? o.zone_height : 0.5 * (top - bottom);
   const double z = bottom + r.zone_height;
   const Eigen::Vector3d depth_axis = up.cross(across);
-  const int n = std::max(3, static_cast<int>(std::ceil((x1 - x0) / o.zone_bin)));
+  const double width = x1 - x0;
+  // The profile's points, from the left wall's base plane: bin centres, or the REV cells'
+  // centres (a cell `zone_window` wide moved by `zone_bin`, from flush with one wall to flush
+  // with the other).
+  const bool window = o.zone_window > 0;
+  const double first = window ? 0.5 * o.zone_window : 0.5 * o.zone_bin;
+  const int n = window
+                    ? static_cast<int>(std::floor((width - o.zone_window) / o.zone_bin + 1e-9)) + 1
+                    : std::max(3, static_cast<int>(std::ceil(width / o.zone_bin)));
+  if (n < 3) return;  // (a silo narrower than the cell and two steps: no profile)
   std::vector<double> sum(n, 0.0), count(n, 0.0);
   for (const Particle& p : f.particles) {
     if (std::abs(p.position.dot(up) - z) > 0.5 * o.zone_band) continue;
     const double x = p.position.dot(across) - x0;
+    const double w = std::abs(p.rotation.dot(depth_axis));
+    if (window) {  // (the cells whose span [c − W/2, c + W/2] holds x)
+      const double h = 0.5 * o.zone_window;
+      const int lo = std::max(0, static_cast<int>(std::ceil((x - h - first) / o.zone_bin)));
+      const int hi = std::min(n - 1, static_cast<int>(std::floor((x + h - first) / o.zone_bin)));
+      for (int b = lo; b <= hi; ++b) {
+        const double c = first + b * o.zone_bin;
+        if (!(std::abs(x - c) <= h)) continue;  // (the rounding of lo and hi)
+        sum[b] += w;
+        count[b] += 1;
+      }
+      continue;
+    }
     if (x < 0 || x >= n * o.zone_bin) continue;
     const int b = static_cast<int>(x / o.zone_bin);
-    sum[b] += std::abs(p.rotation.dot(depth_axis));
+    sum[b] += w;
     count[b] += 1;
   }
   std::vector<double> mean(n, 0.0);
   for (int b = 0; b < n; ++b) mean[b] = count[b] > 0 ? sum[b] / count[b] : 0.0;
+  // (bins: smoothed by [1 2 1]/4; the cells are their own smoothing, as the seed's REV)
   std::vector<double> s(n);
   for (int b = 0; b < n; ++b)
-    s[b] = (mean[std::max(0, b - 1)] + 2 * mean[b] + mean[std::min(n - 1, b + 1)]) / 4;
+    s[b] = window ? mean[b]
+                  : (mean[std::max(0, b - 1)] + 2 * mean[b] + mean[std::min(n - 1, b + 1)]) / 4;
   r.zone_across.resize(n);
-  for (int b = 0; b < n; ++b) r.zone_across[b] = x0 + (b + 0.5) * o.zone_bin;
+  for (int b = 0; b < n; ++b) r.zone_across[b] = x0 + first + b * o.zone_bin;
   r.zone_rotation = s;
   const int half = n / 2;
   const int pl = static_cast<int>(std::max_element(s.begin(), s.begin() + half) - s.begin());
   const int pr = static_cast<int>(std::max_element(s.begin() + (n - half), s.end()) - s.begin());
-  // (bin centres are at (b + 1/2)·bin from the base plane)
-  r.zone_left = profile_inflection(s, pl, +1, o.zone_bin) + 0.5 * o.zone_bin;
+  // (point b is at first + b·bin from the left base plane)
+  r.zone_left = profile_inflection(s, pl, +1, o.zone_bin) + first;
   const double right = profile_inflection(s, pr, -1, o.zone_bin);
-  r.zone_right = std::isnan(right) ? NAN : (x1 - x0) - (right + 0.5 * o.zone_bin);
+  r.zone_right = std::isnan(right) ? NAN : width - (right + first);
   // The extent: where the profile falls below a multiple of the core's level (the median over
-  // the middle third of the bins).
+  // the middle third of the points).
   std::vector<double> core(s.begin() + n / 3, s.begin() + std::max(n / 3 + 1, 2 * n / 3));
   std::sort(core.begin(), core.end());
   const std::size_t m = core.size();
   r.zone_core = m % 2 ? core[m / 2] : 0.5 * (core[m / 2 - 1] + core[m / 2]);
   const double level = o.zone_extent_factor * r.zone_core;
-  // From the peak `b` towards `step`, the crossing's position in bins from bin 0's centre.
+  // From the peak `b` towards `step`, the crossing's position in steps from point 0.
   const auto crossing = [&](int b, int step) {
     if (!(s[b] >= level)) return static_cast<double>(NAN);
     while (b + step >= 0 && b + step < n && s[b + step] >= level) b += step;
     if (b + step < 0 || b + step >= n) return static_cast<double>(NAN);
     return b + step * (s[b] - level) / (s[b] - s[b + step]);
   };
-  r.zone_extent_left = (crossing(pl, +1) + 0.5) * o.zone_bin;
-  r.zone_extent_right = (x1 - x0) - (crossing(pr, -1) + 0.5) * o.zone_bin;
+  r.zone_extent_left = crossing(pl, +1) * o.zone_bin + first;
+  r.zone_extent_right = width - (crossing(pr, -1) * o.zone_bin + first);
 }
 
 void void_ratio_layers(const Frame& f, const SiloReportOptions& o, const Eigen::Vector3d& up,

@@ -25,8 +25,12 @@
 //  * Wall shear zones at a height (§5.3.1, Table 5.4; the procedure of §4.2.3): the particles'
 //    rotation about the depth axis (cumulative, from the snapshot) averaged in bins across the
 //    silo (`zone_bin` wide) within a horizontal band (`zone_band` thick) centred at `zone_height`
-//    above the bottom (default: half the height of the fill), smoothed by [1 2 1]/4; from the
-//    largest mean |rotation| in the half next to a wall, the first sign change of the second
+//    above the bottom (default: half the height of the fill), smoothed by [1 2 1]/4, or with
+//    `zone_window` > 0 averaged in the seed's REV cells instead (§4.2.3, §5.3.1: cells
+//    `zone_window` wide across, moved by `zone_bin`, from flush with the left wall to flush with
+//    the right one; a grain counts in each cell that holds its centre; no further smoothing),
+//    the profile's points then the cells' centres; from the largest mean |rotation| in the half
+//    next to a wall, the first sign change of the second
 //    difference towards the middle (linear interpolation) is the zone's inner boundary, and its
 //    distance from the wall's base plane (the extreme wall point across) the zone's thickness
 //    (NaN when the profile has no such point). A profile that falls convexly from the wall has
@@ -78,6 +82,8 @@ struct SiloReportOptions {
   double gravity = 9.81;
   double zone_bin = 0;                  // m; 0: no shear-zone profile
   double zone_band = 0;                 // m, > 0 with zone_bin
+  double zone_window = 0;               // m: the REV cell across, moved by zone_bin (seed 004
+                                        // §4.2, §5.3: 5·d50 moved by d50); 0: bins of zone_bin
   double zone_height = 0;               // m above the bottom; 0: half the fill's height
   double zone_extent_factor = 2;        // the zones' extent: where the rotation falls below
                                         // this multiple of the core's (> 1)

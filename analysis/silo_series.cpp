@@ -51,6 +51,9 @@ SiloSeries silo_series(const std::string& file, const std::vector<Frame>& t, con
   require_positive(file, "--zone-band-d50", a.zone_band_d50);
   o.zone_bin = a.zone_bin_d50 * d50;
   o.zone_band = a.zone_band_d50 * d50;
+  if (!(a.zone_window_d50 >= 0) || !std::isfinite(a.zone_window_d50))
+    throw InputError(file, "--zone-window-d50: negative", value_str(a.zone_window_d50));
+  o.zone_window = a.zone_window_d50 * d50;
   if (!(a.zone_extent_factor > 1) || !std::isfinite(a.zone_extent_factor))
     throw InputError(file, "--zone-extent-factor: must be above 1",
                      value_str(a.zone_extent_factor));

@@ -26,6 +26,7 @@ struct SiloSpec {
   // last frame's median by volume.
   std::optional<double> scene_d50;
   double zone_bin_d50 = 1.0, zone_band_d50 = 5.0;
+  double zone_window_d50 = 0.0;  // the REV cell across (0: bins of zone_bin_d50)
   double zone_extent_factor = 2.0;
   long from = 0;
   double gravity = 9.81;

@@ -225,7 +225,11 @@ void register_analyze_silo(CLI::App& app) {
                 "height of the wall shear zones above the bottom in m (default: half the fill)");
   s->add_option("--zone-band-d50", a->spec.zone_band_d50,
                 "thickness of the band the rotation profile is taken in, d50 (default 5)");
-  s->add_option("--zone-bin-d50", a->spec.zone_bin_d50, "bins across the silo, d50 (default 1)");
+  s->add_option("--zone-bin-d50", a->spec.zone_bin_d50,
+                "bins across the silo, or the REV cells' step, d50 (default 1)");
+  s->add_option("--zone-window-d50", a->spec.zone_window_d50,
+                "average the rotation profile in REV cells this wide, moved by --zone-bin-d50 "
+                "(seed 004 §4.2: 5), d50 (default 0: bins, smoothed by [1 2 1]/4)");
   s->add_option("--zone-extent-factor", a->spec.zone_extent_factor,
                 "a wall zone's extent ends where the rotation falls below this multiple of the "
                 "core's (default 2)");

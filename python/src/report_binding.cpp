@@ -93,9 +93,9 @@ void bind_reports(py::module_& m) {
          std::optional<double> from_time, std::optional<double> bin, std::optional<double> bin_d50,
          std::optional<double> depth, std::optional<double> d50, double gravity,
          std::optional<double> zone_height, double zone_band_d50, double zone_bin_d50,
-         double zone_extent_factor, std::vector<double> layers, double layer_bin_d50,
-         double layer_band_d50, int rose_bins, double rev_width_d50, int flow_bands,
-         double flow_wall_d50, double flow_threshold, double phi_i, double en_k) {
+         double zone_window_d50, double zone_extent_factor, std::vector<double> layers,
+         double layer_bin_d50, double layer_band_d50, int rose_bins, double rev_width_d50,
+         int flow_bands, double flow_wall_d50, double flow_threshold, double phi_i, double en_k) {
         ga::SiloSpec spec;
         spec.up = vec3(up, "--up");
         spec.across = vec3(across, "--across");
@@ -110,6 +110,7 @@ void bind_reports(py::module_& m) {
         spec.zone_height = zone_height;
         spec.zone_band_d50 = zone_band_d50;
         spec.zone_bin_d50 = zone_bin_d50;
+        spec.zone_window_d50 = zone_window_d50;
         spec.zone_extent_factor = zone_extent_factor;
         spec.layers = layers;
         spec.layer_bin_d50 = layer_bin_d50;
@@ -199,10 +200,11 @@ void bind_reports(py::module_& m) {
       py::arg("bin_d50") = py::none(), py::arg("depth") = py::none(), py::arg("d50") = py::none(),
       py::arg("gravity") = 9.81, py::arg("zone_height") = py::none(),
       py::arg("zone_band_d50") = 5.0, py::arg("zone_bin_d50") = 1.0,
-      py::arg("zone_extent_factor") = 2.0, py::arg("layers") = std::vector<double>{0.2, 0.5, 0.8},
-      py::arg("layer_bin_d50") = 2.0, py::arg("layer_band_d50") = 5.0, py::arg("rose_bins") = 36,
-      py::arg("rev_width_d50") = 2.0, py::arg("flow_bands") = 10, py::arg("flow_wall_d50") = 3.0,
-      py::arg("flow_threshold") = 0.1, py::arg("phi_i") = 35.0, py::arg("en_k") = 0.63,
+      py::arg("zone_window_d50") = 0.0, py::arg("zone_extent_factor") = 2.0,
+      py::arg("layers") = std::vector<double>{0.2, 0.5, 0.8}, py::arg("layer_bin_d50") = 2.0,
+      py::arg("layer_band_d50") = 5.0, py::arg("rose_bins") = 36, py::arg("rev_width_d50") = 2.0,
+      py::arg("flow_bands") = 10, py::arg("flow_wall_d50") = 3.0, py::arg("flow_threshold") = 0.1,
+      py::arg("phi_i") = 35.0, py::arg("en_k") = 0.63,
       "Silo report as `granoscope analyze silo` (seed 004 §5.3) of a silo run (a Trajectory or "
       "a list of Frames): series per frame (frame, time_s, G_N, P_N, T_left_N, ..., P_G, "
       "T_left_G, ..., balance_G, phi_w_left_deg, discharged_kg, flow_pattern, ...) and the "

@@ -200,6 +200,46 @@ TEST(SiloReport, WallZoneExtentWhereTheRotationFallsToTwiceTheCore) {
   EXPECT_THROW(analysis::silo_report(f, o), std::invalid_argument);
 }
 
+// The seed's REV cells (§4.2.3, §5.3.1) in place of the bins: cells 5 mm wide moved by 1 mm
+// across a 40 mm silo with one particle per mm, from flush with the left wall (centre 2.5 mm) to
+// flush with the right one (37.5 mm): 36 cells of five particles each. The step profile of the
+// test above (1 rad out to 6 mm from the left wall and to 10 mm from the right one, 0.1 rad in
+// between) averages to 1, 1, 0.82, 0.64, 0.46, 0.28, 0.1, … (k of the five particles on the
+// step: 0.1 + 0.18·k), unsmoothed, and mirrored 4 mm further in from the right. The core is
+// 0.1, and twice it is crossed 0.08/0.18 of a step past the cell at 7.5 mm (the left) and
+// before the cell at 28.5 mm (the right).
+TEST(SiloReport, WallZonesInTheSeedsRevCells) {
+  const Frame f = zone_silo(40, [](double x) { return (x < 0.006 || x > 0.03) ? -1.0 : 0.1; });
+  analysis::SiloReportOptions o = zone_options();
+  o.zone_window = 0.005;
+  const auto r = analysis::silo_report(f, o);
+  ASSERT_EQ(r.zone_across.size(), 36u);
+  EXPECT_NEAR(r.zone_across.front(), 0.0025, 1e-15);
+  EXPECT_NEAR(r.zone_across.back(), 0.0375, 1e-15);
+  const double left[] = {1, 1, 0.82, 0.64, 0.46, 0.28, 0.1, 0.1};
+  for (int b = 0; b < 8; ++b) {
+    EXPECT_NEAR(r.zone_rotation[b], left[b], 1e-15) << b;
+    EXPECT_NEAR(r.zone_rotation[35 - 4 - b], left[b], 1e-15) << b;  // (the right, 4 mm in)
+  }
+  EXPECT_NEAR(r.zone_core, 0.1, 1e-15);
+  const double past = 0.08 / 0.18 * 1e-3;
+  EXPECT_NEAR(r.zone_extent_left, 0.0075 + past, 1e-15);
+  EXPECT_NEAR(r.zone_extent_right, 0.04 - (0.0285 - past), 1e-15);
+  // The logistic of the inflection test above, averaged in the cells, stays point-symmetric
+  // about 5 mm from each wall: the inflection is there still (in a silo 40 mm wide, where the
+  // other wall's tail, e^-30 of the peak, does not reach).
+  auto logistic = [](double x) { return 1 / (1 + std::exp((x - 0.005) / 0.001)); };
+  const Frame g = zone_silo(40, [&](double x) { return logistic(x) + logistic(0.04 - x); });
+  const auto z = analysis::silo_report(g, o);
+  ASSERT_EQ(z.zone_across.size(), 36u);
+  EXPECT_NEAR(z.zone_left, 0.005, 1e-12);
+  EXPECT_NEAR(z.zone_right, 0.005, 1e-12);
+  // A silo narrower than a cell and two steps has no profile (the zones NaN).
+  const auto narrow = analysis::silo_report(zone_silo(6, [](double) { return 1.0; }), o);
+  EXPECT_TRUE(narrow.zone_across.empty());
+  EXPECT_TRUE(std::isnan(narrow.zone_left) && std::isnan(narrow.zone_extent_left));
+}
+
 // Exact answers for the slice method of seed 004 §5.3.1: Eq 5.2 at φw = φi reduces to
 // K = cos²φ / (1 + sin²φ); at 35°/32° it is the printed 0.83. Eq 5.1 with the seed's own
 // inputs (γ = 16 kN/m³, b = 0.2 m, depth 0.6 m, h = 0.5 m, the printed K and the experimental

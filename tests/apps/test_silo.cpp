@@ -165,7 +165,8 @@ TEST(Silo, QuasiStaticBottomMovesAndTheForcesBalanceTheWeight) {
                                                         {"--en-k", "-1"},
                                                         {"--flow-threshold", "1.5"},
                                                         {"--flow-wall-d50", "0"},
-                                                        {"--zone-extent-factor", "1"}}) {
+                                                        {"--zone-extent-factor", "1"},
+                                                        {"--zone-window-d50", "-5"}}) {
     const auto b = run_cli("analyze silo " + (dir / "out" / "trajectory.h5").string() + " -o " +
                                (dir / "x.h5").string() + " " + option + " " + value,
                            dir.path);

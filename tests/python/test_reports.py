@@ -83,6 +83,18 @@ def test_silo_of_a_simulated_silo_equals_the_cli(cli, tmp_path):
     assert [st["name"] for st in py["states"]] == ["initial", "maximum", "residual"]
     with pytest.raises(gs.Error, match=r"^<trajectory>: --phi-i: not in \(0, 90\) deg \(95\)$"):
         gs.silo(run.open(), phi_i=95.0)
+    # The seed's REV cells for the wall zones (5 d50 moved by d50), as the CLI's option.
+    rc, _, err = cli("analyze", "silo", traj, "-o", tmp_path / "w.h5", "--zone-window-d50", 5,
+                     "--from-time", repr(t0))
+    assert rc == 0, err
+    win = gs.silo(run.open(), zone_window_d50=5, from_time=t0)["states"][-1]["zone"]
+    with h5py.File(tmp_path / "w.h5", "r") as h:
+        g = h["profiles"]["residual"]
+        np.testing.assert_array_equal(g["zone_rotation_rad"][()], win["rotation_rad"])
+        np.testing.assert_array_equal(g["zone_across_m"][()], win["across_m"])
+    step = np.diff(win["across_m"])
+    np.testing.assert_allclose(step, py["d50"], rtol=1e-9)
+    assert len(win["across_m"]) != len(py["states"][-1]["zone"]["across_m"])
 
 
 def sheared_block(gamma=0.02, n=(20, 3, 12), d=1e-3, surface=0.0):
