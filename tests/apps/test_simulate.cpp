@@ -1031,6 +1031,42 @@ TEST(Simulate, ProgressLinesInALogAndTheShippedOedometerPacking) {
   EXPECT_EQ(gs::TrajectoryReader(dir / "oed" / "oedometer_yade.h5").particle_count(0), 883u);
 }
 
+// Every scene shipped in data/scenes (the laptop and the paper sizes) reads, builds and takes a
+// step: a key renamed in the schema, a file moved or a paper-size scene that no longer fits its
+// region shows here, not hours into a run on a bigger box. Scenes that read the DEM8 inputs from
+// ../shared are skipped, with a message, where that folder is absent.
+TEST(Simulate, EveryShippedSceneLoadsAndSteps) {
+  gs::test::ScratchDir dir("shipped");
+  const std::filesystem::path scenes = std::filesystem::path(GS_SOURCE_DIR) / "data" / "scenes";
+  const bool shared = std::filesystem::is_directory(std::filesystem::path(GS_SOURCE_DIR) / ".." /
+                                                    "shared" / "dem8");
+  std::vector<std::filesystem::path> files;
+  for (const auto& e : std::filesystem::directory_iterator(scenes))
+    if (e.path().extension() == ".toml") files.push_back(e.path());
+  std::sort(files.begin(), files.end());
+  ASSERT_GE(files.size(), 20u);
+  int ran = 0;
+  for (const auto& f : files) {
+    if (!shared && slurp(f).find("shared/dem8") != std::string::npos) {
+      std::printf("skipped %s: ../shared/dem8 is absent\n", f.filename().c_str());
+      continue;
+    }
+    const auto out = dir / f.stem();
+    const auto r =
+        gs::test::run_cli("simulate " + f.string() + " -q --steps 1 -o " + out.string(), dir.path);
+    EXPECT_EQ(r.rc, 0) << f.filename() << ": " << r.err;
+    // (a history, or, for a scene with a [sweep], one per run in its folders)
+    bool history = false;
+    if (std::filesystem::is_directory(out))
+      for (const auto& e : std::filesystem::recursive_directory_iterator(out))
+        history = history || e.path().filename() == "history.csv";
+    EXPECT_TRUE(history) << f.filename();
+    std::filesystem::remove_all(out);
+    ++ran;
+  }
+  EXPECT_GE(ran, 16);  // (the scenes without the DEM8 inputs)
+}
+
 // [output] track_ids: the history holds those particles' position and velocity, the same
 // numbers the trajectory's frames hold at the same steps; a Hertz–Mindlin run adds its viscous
 // dissipation column; an id that no particle has is one line naming the key.
