@@ -249,6 +249,7 @@ void LayeredFilling::insert_layer(Simulation& sim) {
   ++inserted_;
   last_insert_step_ = sim.step_count();
   moved_ = false;
+  below_ = 0;
 }
 
 void LayeredFilling::start(Simulation& sim) {
@@ -285,12 +286,15 @@ void LayeredFilling::control(Simulation& sim) {
                                     std::sqrt(2 * fall_height / g.norm());
   if (ek >= threshold_J) moved_ = true;
   if (ek >= threshold_J || !fallen) {
+    below_ = 0;
     if (since >= spec_.max_steps)
       throw FillError("fill: layer " + std::to_string(inserted_) + " did not settle within " +
                       std::to_string(spec_.max_steps) + " steps (translational kinetic energy " +
                       std::to_string(ek) + " J, threshold " + std::to_string(threshold_J) + " J)");
     return;
   }
+  if (++below_ < spec_.hold_steps) return;  // (held below for hold_steps steps in a row)
+  below_ = 0;
   if (inserted_ < static_cast<int>(layers_.size())) {
     insert_layer(sim);
     return;
@@ -325,6 +329,7 @@ std::string LayeredFilling::save_state() const {
   st.set("material_friction_deg", material_friction_deg_);
   st.set("solver_damping", solver_damping_);
   st.set("moved", static_cast<std::int64_t>(moved_));
+  st.set("below", below_);
   return st.text();
 }
 
@@ -337,6 +342,7 @@ void LayeredFilling::load_state(const std::string& state) {
                                                            : -1.0;  // (older checkpoints)
   solver_damping_ = st.has("solver_damping") ? st.number("solver_damping") : 0.0;
   moved_ = st.has("moved") ? st.integer("moved") != 0 : true;
+  below_ = st.has("below") ? st.integer("below") : 0;  // (older checkpoints: no hold)
 }
 
 }  // namespace gs::solver

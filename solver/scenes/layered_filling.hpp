@@ -30,8 +30,13 @@ struct FillSpec {
   std::int64_t count = 0;  // particles in all layers (the first layers take the remainder)
   SizeSpec sizes;
   std::uint64_t seed = 1;
-  double kinetic_ratio = 1e-4;        // next layer once E_k < ratio · Σ m·|g|·d
-  std::int64_t min_steps = 100;       // steps a layer falls at least before the next
+  double kinetic_ratio = 1e-4;   // next layer once E_k < ratio · Σ m·|g|·d
+  std::int64_t min_steps = 100;  // steps a layer falls at least before the next
+  // Steps in a row the energy must stay below the threshold before a layer counts as settled
+  // (1: the first step below). A grain at the top of a bounce, or a layer held up for a moment
+  // before it collapses, is below the threshold for a few steps: a hold longer than that does
+  // not take it for rest.
+  std::int64_t hold_steps = 1;
   std::int64_t max_steps = 10000000;  // a layer that has not settled by then is an error
   int max_attempts = 20000;           // random draws per particle before the region is full
   // The inter-particle friction angle while filling (negative: the material's): a lower one
@@ -115,7 +120,8 @@ class LayeredFilling final : public LoadingProgramme {
   std::int64_t frame_every_ = 0;
   double material_friction_deg_ = 0;  // restored when the filling ends (fill.friction_deg)
   double solver_damping_ = 0;         // restored when the filling ends (fill.damping)
-  bool moved_ = false;  // the last layer's kinetic energy has been above the threshold
+  bool moved_ = false;      // the last layer's kinetic energy has been above the threshold
+  std::int64_t below_ = 0;  // steps in a row below the threshold (fill.hold_steps)
 };
 
 }  // namespace gs::solver

@@ -873,8 +873,8 @@ void read_fill(const Reader& r, Scene& s) {
     r.fail("[fill]", "a laboratory test makes its own specimen; remove [fill]");
   r.only(t, "fill",
          {"region_lo_m", "region_hi_m", "layers", "count", "dmin_m", "dmax_m", "distribution",
-          "seed", "kinetic_ratio", "min_steps", "max_steps", "max_attempts", "friction_deg",
-          "damping", "placement"});
+          "seed", "kinetic_ratio", "min_steps", "max_steps", "hold_steps", "max_attempts",
+          "friction_deg", "damping", "placement"});
   FillSpec f;
   f.region_lo_m = r.vec3(t, "fill", "region_lo_m", true, {});
   f.region_hi_m = r.vec3(t, "fill", "region_hi_m", true, {});
@@ -896,6 +896,9 @@ void read_fill(const Reader& r, Scene& s) {
   f.kinetic_ratio = r.positive(t, "fill", "kinetic_ratio", false, f.kinetic_ratio);
   f.min_steps = r.integer(t, "fill", "min_steps", false, f.min_steps, 1);
   f.max_steps = r.integer(t, "fill", "max_steps", false, f.max_steps, f.min_steps);
+  f.hold_steps = r.integer(t, "fill", "hold_steps", false, f.hold_steps, 1);
+  if (f.hold_steps > f.max_steps)
+    r.fail("fill.hold_steps", "more than max_steps", std::to_string(f.hold_steps));
   f.max_attempts = static_cast<int>(r.integer(t, "fill", "max_attempts", false, 20000, 1));
   f.friction_deg = r.number(t, "fill", "friction_deg", false, -1);
   if (!(f.friction_deg < 90))

@@ -684,6 +684,9 @@ TEST(Simulate, FillRegionTooSmallSaysHowManyFitted) {
       {fill + "count = 4\nplacement = \"grid\"\n",
        "fill.placement: expected \"random\" or \"lattice\" (grid)"},
       {fill + "count = 4\ndamping = 1.0\n", "fill.damping: outside [0, 1) (1)"},
+      {fill + "count = 4\nhold_steps = 0\n", "fill.hold_steps: must be at least 1 (0)"},
+      {fill + "count = 4\nmax_steps = 500\nhold_steps = 501\n",
+       "fill.hold_steps: more than max_steps (501)"},
       {fill + "count = 4\n[[walls]]\nshape = \"plane\"\npoint_m = [0.0, 0.0, 0.0]\n"
               "normal = [0.0, 0.0, 1.0]\noff_after_fill = \"yes\"\n",
        "walls[0].off_after_fill: expected true or false"},

@@ -182,6 +182,60 @@ TEST(LayeredFilling, ResumesFromACheckpointBitForBit) {
   }
 }
 
+// One sphere dropped 12 mm onto the floor bounces (Cundall damping 0.3, no viscous damping): at
+// the top of its first bounce it stands still for a moment, its kinetic energy below the
+// threshold for a few dozen steps. With hold_steps = 1 the filling ends there, the sphere in the
+// air; held for 2 000 steps (20 ms, longer than that moment and shorter than a bounce) it ends
+// only once the sphere rests on the floor. The hold's count is in the checkpoint: a run resumed
+// in the middle of it ends at the same step.
+TEST(LayeredFilling, AMomentOfRestInABounceIsNotRestWithAHold) {
+  FillSpec f = spec();
+  f.layers = 1;
+  f.count = 1;
+  f.sizes.dmin_m = f.sizes.dmax_m = 1.5e-3;
+  auto fill_until_done = [](Filled& s, std::int64_t stop = -1) {
+    while (!s.fill.finished(s.sim) && s.sim.step_count() != stop) {
+      s.fill.control(s.sim);
+      if (s.fill.finished(s.sim)) break;
+      s.sim.step();
+      if (s.sim.step_count() > 2000000) ADD_FAILURE() << "no end";
+    }
+  };
+  Filled once(f);
+  once.fill.start(once.sim);
+  fill_until_done(once);
+  const double r = 0.75e-3;
+  const double height = once.sim.particles().pos[0].z() - r;
+  std::printf("hold 1: ended at step %lld, the sphere %.3g m above the floor\n",
+              static_cast<long long>(once.sim.step_count()), height);
+  EXPECT_GT(height, 1e-3);  // (at the top of its first bounce)
+
+  f.hold_steps = 2000;
+  Filled held(f);
+  held.fill.start(held.sim);
+  fill_until_done(held);
+  const double rest = held.sim.particles().pos[0].z() - r;
+  std::printf("hold 2000: ended at step %lld, the sphere %.3g m above the floor, %.3g m/s\n",
+              static_cast<long long>(held.sim.step_count()), rest,
+              held.sim.particles().vel[0].norm());
+  EXPECT_LT(rest, 0.0);  // (on the floor: pressed into it by its weight)
+  EXPECT_GT(rest, -1e-5);
+  EXPECT_LT(solver::LayeredFilling::settling_energy(held.sim), held.fill.threshold(held.sim));
+  EXPECT_GT(held.sim.step_count(), once.sim.step_count() + 2000);
+
+  // Resumed from a checkpoint taken 500 steps before the end, inside the hold.
+  Filled a(f), b(f);
+  a.fill.start(a.sim);
+  fill_until_done(a, held.sim.step_count() - 500);
+  const auto ck = std::filesystem::temp_directory_path() / "gs_fill_hold_ck.bin";
+  a.sim.save_checkpoint(ck, a.fill.save_state());
+  b.fill.load_state(b.sim.load_checkpoint(ck));
+  std::filesystem::remove(ck);
+  fill_until_done(b);
+  EXPECT_EQ(b.sim.step_count(), held.sim.step_count());
+  EXPECT_EQ(b.sim.particles().pos[0], held.sim.particles().pos[0]);
+}
+
 // A region that cannot take a layer: the error says how many of its particles fitted.
 TEST(LayeredFilling, ARegionTooSmallSaysHowManyFitted) {
   FillSpec f = spec();
