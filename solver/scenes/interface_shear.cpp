@@ -181,6 +181,8 @@ InterfaceShear::InterfaceShear(InterfaceShearSpec spec, InterfaceShearGeometry g
                 "must be positive");
   require_value(spec_.residual_fraction > 0 && spec_.residual_fraction < 1,
                 sec + "residual_fraction", spec_.residual_fraction, "outside (0, 1)");
+  require_value(spec_.peak_fraction > 0 && spec_.peak_fraction <= 0.5, sec + "peak_fraction",
+                spec_.peak_fraction, "outside (0, 0.5]");
   require_value(spec_.internal_friction_deg > 0 && spec_.internal_friction_deg < 90,
                 sec + "internal_friction_deg", spec_.internal_friction_deg, "outside (0, 90)");
   if (!(spec_.frame_every_m > 0)) spec_.frame_every_m = spec_.max_displacement_m / 10;
@@ -239,12 +241,11 @@ double InterfaceShear::void_ratio(const Simulation& sim) const {
 }
 
 void InterfaceShear::record(double u, double mu, double eps_v) const {
-  const std::int64_t bin =
-      static_cast<std::int64_t>(std::floor(kBins * u / spec_.max_displacement_m));
+  const std::int64_t bin = static_cast<std::int64_t>(std::floor(u / bin_width()));
   if (bin != bin_) {
     if (bin_n_ > 0 && bin_sum_ / bin_n_ > peak_) {
       peak_ = bin_sum_ / bin_n_;
-      peak_u_ = (static_cast<double>(bin_) + 0.5) * spec_.max_displacement_m / kBins;
+      peak_u_ = (static_cast<double>(bin_) + 0.5) * bin_width();
     }
     bin_ = bin;
     bin_sum_ = bin_n_ = 0;
@@ -298,7 +299,7 @@ std::vector<std::pair<std::string, double>> InterfaceShear::results(const Simula
   double peak = peak_, peak_u = peak_u_;
   if (bin_n_ > 0 && bin_sum_ / bin_n_ > peak) {
     peak = bin_sum_ / bin_n_;
-    peak_u = (static_cast<double>(bin_) + 0.5) * spec_.max_displacement_m / kBins;
+    peak_u = (static_cast<double>(bin_) + 0.5) * bin_width();
   }
   const double res = res_n_ > 0 ? res_sum_ / res_n_ : NAN;
   const double eps_res = res_n_ > 0 ? eps_res_sum_ / res_n_ : NAN;

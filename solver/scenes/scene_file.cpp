@@ -356,6 +356,7 @@ void read_lab_sections(const Reader& r, const toml::table& root, Scene& s) {
             "servo_gain",
             "max_platen_speed_m_s",
             "residual_fraction",
+            "peak_fraction",
             "internal_friction_deg",
             "flat_friction"});
     auto& f = s.interface_surface;
@@ -415,6 +416,9 @@ void read_lab_sections(const Reader& r, const toml::table& root, Scene& s) {
     x.residual_fraction = r.positive(t, sec, "residual_fraction", false, x.residual_fraction);
     if (!(x.residual_fraction < 1))
       r.fail(sec + ".residual_fraction", "must be below 1", value_str(x.residual_fraction));
+    x.peak_fraction = r.positive(t, sec, "peak_fraction", false, x.peak_fraction);
+    if (!(x.peak_fraction <= 0.5))
+      r.fail(sec + ".peak_fraction", "must be at most 0.5", value_str(x.peak_fraction));
     x.internal_friction_deg = angle("internal_friction_deg", x.internal_friction_deg);
     if (!(x.internal_friction_deg > 0))
       r.fail(sec + ".internal_friction_deg", "must be positive",

@@ -69,6 +69,24 @@ TEST(InterfaceShear, FlatSurfaceSlidesAtItsFriction) {
   };
   EXPECT_NEAR(value("mu_eff_res"), mu, 0.01 * mu);
   EXPECT_NEAR(value("phi_s_res_deg"), 18.0, 0.2);
+  // The peak in bins of 0.5 % of the travel instead of 5 %: each 5 % bin is the mean of the ten
+  // finer bins it holds, so the finest peak is at least the coarse one; it sits at a fine bin's
+  // centre, (k + 1/2)·5 µm.
+  std::ofstream(dir / "fine.toml")
+      << scene("surface = \"flat\"\n", "max_displacement_m = 0.001\npeak_fraction = 0.005\n");
+  const auto f = run_cli(
+      "simulate " + (dir / "fine.toml").string() + " -q -o " + (dir / "fine").string(), dir.path);
+  ASSERT_EQ(f.rc, 0) << f.err;
+  const std::string fine = gs::test::slurp(dir / "fine" / "results.csv");
+  auto fine_value = [&](const std::string& name) {
+    const auto at = fine.find("\n" + name + ",");
+    EXPECT_NE(at, std::string::npos) << name;
+    return std::strtod(fine.c_str() + at + name.size() + 2, nullptr);
+  };
+  EXPECT_GE(fine_value("mu_eff_max"), value("mu_eff_max") - 1e-12);
+  EXPECT_EQ(fine_value("mu_eff_res"), value("mu_eff_res"));  // (the same run otherwise)
+  const double k = fine_value("u_peak_m") / 5e-6 - 0.5;
+  EXPECT_NEAR(k, std::round(k), 1e-6);
   // A block sliding on a flat plate neither dilates nor contracts (Table 4.5, R_n = 0.01: 0).
   EXPECT_LT(std::abs(value("eps_v_res")), 1e-3);
   // `analyze interface` finds the surface the run recorded: the block slides on it, so the
@@ -164,6 +182,8 @@ TEST(InterfaceShear, BadInputIsOneLine) {
        {scene("surface = \"sinusoid\"\nwavelength_m = 0.015\ndepth_ratio = 1.5\n", u),
         "interface_shear.depth_ratio: outside [0, 1) (1.5)"},
        {scene("surface = \"bumpy\"\n", u), "interface_shear.surface: expected"},
+       {scene(saw, u + "peak_fraction = 0.75\n"),
+        "interface_shear.peak_fraction: must be at most 0.5 (0.75)"},
        {scene(saw + "surface_contact = \"facets\"\n", u),
         "interface_shear.surface_contact: expected \"merged\" or \"yade\" (facets)"},
        {scene(saw, u + "[sweep]\nkey = \"nowhere.roughness\"\nvalues = [1.0]\n"),
