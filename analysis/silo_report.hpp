@@ -30,14 +30,14 @@
 //    `zone_window` wide across, moved by `zone_bin`, from flush with the left wall to flush with
 //    the right one; a grain counts in each cell that holds its centre; no further smoothing),
 //    the profile's points then the cells' centres; from the largest mean |rotation| in the half
-//    next to a wall, the first sign change of the second
-//    difference towards the middle (linear interpolation) is the zone's inner boundary, and its
-//    distance from the wall's base plane (the extreme wall point across) the zone's thickness
-//    (NaN when the profile has no such point). A profile that falls convexly from the wall has
-//    no inflection but its noise's, so the report also gives each zone's extent: the core's
-//    level, the median of the smoothed profile over the middle third of the width, and from the
-//    wall's peak the first point towards the middle (linear interpolation between bin centres)
-//    where the profile falls below `zone_extent_factor` times that level (NaN when it does not).
+//    next to a wall, the first sign change of the second difference towards the middle (linear
+//    interpolation) is the zone's inner boundary, and its distance from the wall's base plane
+//    (the extreme wall point across) the zone's thickness (NaN when the profile has no such
+//    point). A profile that falls convexly from the wall has no inflection but its noise's, so
+//    the report also gives each zone's extent: the core's level, the median of the profile over
+//    the middle third of the width, and from the wall's peak the first point towards the middle
+//    (linear interpolation between the profile's points) where the profile falls below
+//    `zone_extent_factor` times that level (NaN when it does not).
 //  * Void ratio across the width (§5.3.1; at 10, 25 and 40 cm of the seed's 0.5 m silo): in
 //    horizontal bands (`layer_band` thick, clipped to the fill: from the bottom to the highest
 //    grain's top) centred at fractions of the fill's height (`layer_fractions`), boxes `layer_bin`
