@@ -240,16 +240,37 @@ double InterfaceShear::void_ratio(const Simulation& sim) const {
                         g_.clump_solid_factor);
 }
 
-void InterfaceShear::record(double u, double mu, double eps_v) const {
-  const std::int64_t bin = static_cast<std::int64_t>(std::floor(u / bin_width()));
-  if (bin != bin_) {
-    if (bin_n_ > 0 && bin_sum_ / bin_n_ > peak_) {
-      peak_ = bin_sum_ / bin_n_;
-      peak_u_ = (static_cast<double>(bin_) + 0.5) * bin_width();
-    }
-    bin_ = bin;
-    bin_sum_ = bin_n_ = 0;
+// The mean of μ over the sub-bins max(0, j − kWindowBins + 1) … j, j the last closed sub-bin, or
+// the one in progress with `with_current` (a run shorter than a window: from u = 0); `last`: j.
+double InterfaceShear::window_mean(bool with_current, std::int64_t& last) const {
+  last = with_current ? bin_ : bin_ - 1;
+  double sum = with_current ? bin_sum_ : 0.0, n = with_current ? bin_n_ : 0.0;
+  const std::int64_t first = std::max<std::int64_t>(0, last - kWindowBins + 1);
+  for (std::int64_t j = with_current ? last - 1 : last; j >= first; --j) {
+    sum += ring_sum_[static_cast<std::size_t>(j % kWindowBins)];
+    n += ring_n_[static_cast<std::size_t>(j % kWindowBins)];
   }
+  return n > 0 ? sum / n : -1e300;
+}
+
+void InterfaceShear::close_sub_bin() const {
+  ring_sum_[static_cast<std::size_t>(bin_ % kWindowBins)] = bin_sum_;
+  ring_n_[static_cast<std::size_t>(bin_ % kWindowBins)] = bin_n_;
+  ++bin_;
+  bin_sum_ = bin_n_ = 0;
+  std::int64_t last = 0;
+  const double m = window_mean(false, last);
+  if (last + 1 >= kWindowBins && m > peak_) {  // (whole windows only; see results())
+    peak_ = m;
+    peak_u_ = (static_cast<double>(last + 1) - 0.5 * kWindowBins) * sub_bin_width();
+  }
+}
+
+void InterfaceShear::record(double u, double mu, double eps_v) const {
+  const std::int64_t bin =
+      std::max<std::int64_t>(0, static_cast<std::int64_t>(std::floor(u / sub_bin_width())));
+  if (bin_ < 0) bin_ = bin;          // (the first row: the sub-bins before it stay empty)
+  while (bin_ < bin) close_sub_bin();  // (and any the frame passed without a row, empty)
   bin_sum_ += mu;
   bin_n_ += 1;
   if (u >= (1 - spec_.residual_fraction) * spec_.max_displacement_m) {
@@ -295,11 +316,16 @@ std::string InterfaceShear::curve_row(const Simulation& sim) const {
 }
 
 std::vector<std::pair<std::string, double>> InterfaceShear::results(const Simulation& sim) const {
-  // The bin in progress counts towards the peak too.
+  // The window that ends with the sub-bin in progress counts towards the peak too, and so, for a
+  // run shorter than a window, the mean over its whole travel.
   double peak = peak_, peak_u = peak_u_;
-  if (bin_n_ > 0 && bin_sum_ / bin_n_ > peak) {
-    peak = bin_sum_ / bin_n_;
-    peak_u = (static_cast<double>(bin_) + 0.5) * bin_width();
+  std::int64_t last = 0;
+  const double m = bin_ >= 0 ? window_mean(true, last) : -1e300;
+  if (m > peak) {
+    peak = m;
+    peak_u = 0.5 * (static_cast<double>(std::max<std::int64_t>(0, last - kWindowBins + 1)) +
+                    static_cast<double>(last + 1)) *
+             sub_bin_width();
   }
   const double res = res_n_ > 0 ? res_sum_ / res_n_ : NAN;
   const double eps_res = res_n_ > 0 ? eps_res_sum_ / res_n_ : NAN;
@@ -346,6 +372,10 @@ std::string InterfaceShear::save_state() const {
   st.set("bin", bin_);
   st.set("bin_sum", bin_sum_);
   st.set("bin_n", bin_n_);
+  for (int k = 0; k < kWindowBins; ++k) {
+    st.set("ring_sum_" + std::to_string(k), ring_sum_[static_cast<std::size_t>(k)]);
+    st.set("ring_n_" + std::to_string(k), ring_n_[static_cast<std::size_t>(k)]);
+  }
   st.set("peak", peak_);
   st.set("peak_u", peak_u_);
   st.set("res_sum", res_sum_);
@@ -363,6 +393,15 @@ void InterfaceShear::load_state(const std::string& state) {
   bin_ = st.integer("bin");
   bin_sum_ = st.number("bin_sum");
   bin_n_ = st.number("bin_n");
+  if (st.has("ring_n_0")) {
+    for (int k = 0; k < kWindowBins; ++k) {
+      ring_sum_[static_cast<std::size_t>(k)] = st.number("ring_sum_" + std::to_string(k));
+      ring_n_[static_cast<std::size_t>(k)] = st.number("ring_n_" + std::to_string(k));
+    }
+  } else {  // (older checkpoints: fixed bins of the whole width; the windows start afresh)
+    bin_ = -1;
+    bin_sum_ = bin_n_ = 0;
+  }
   peak_ = st.number("peak");
   peak_u_ = st.number("peak_u");
   res_sum_ = st.number("res_sum");

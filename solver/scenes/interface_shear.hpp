@@ -100,7 +100,7 @@ struct InterfaceShearSpec {
   double servo_gain = 0.25;
   double max_platen_speed_m_s = 0.05;
   double residual_fraction = 0.1;     // the residual: mean over the last 10 % of the travel
-  double peak_fraction = 0.05;        // the peak: the largest mean over bins of 5 % of it
+  double peak_fraction = 0.05;        // the peak: the largest mean over 5 % of the travel
   double internal_friction_deg = 42;  // φi of Eq 4.7 (the thesis's φi,max)
   double flat_friction = -1;          // μw of Eq 4.7 (< 0: no a_w)
 };
@@ -136,11 +136,19 @@ class InterfaceShear final : public MeasuredProgramme {
   InterfaceShearGeometry g_;
   InterfaceShearWalls w_;
   double x0_ = 0, h0_ = 0, e0_ = 0;
-  // μ averaged over bins of `peak_fraction` of the travel: the peak is the largest bin mean (one
-  // noisy row does not make a peak); the residual the mean over the last `residual_fraction`.
-  double bin_width() const { return spec_.peak_fraction * spec_.max_displacement_m; }
-  mutable std::int64_t bin_ = -1;
+  // The peak: the largest mean μ over a window `peak_fraction` of the travel wide (one noisy
+  // row does not make a peak), the window moved along the travel by a tenth of its width: μ is
+  // summed in sub-bins of that tenth, and each window is kWindowBins consecutive sub-bins. The
+  // residual: the mean over the last `residual_fraction`.
+  static constexpr int kWindowBins = 10;
+  double sub_bin_width() const {
+    return spec_.peak_fraction * spec_.max_displacement_m / kWindowBins;
+  }
+  void close_sub_bin() const;  // the sub-bin in progress into the ring; its window's mean
+  double window_mean(bool with_current, std::int64_t& last) const;
+  mutable std::int64_t bin_ = -1;  // the sub-bin in progress
   mutable double bin_sum_ = 0, bin_n_ = 0;
+  mutable std::array<double, kWindowBins> ring_sum_{}, ring_n_{};  // sub-bin j at j % kWindowBins
   mutable double peak_ = -1e300, peak_u_ = 0;
   mutable double res_sum_ = 0, res_n_ = 0, eps_res_sum_ = 0;
   mutable double last_eps_ = 0;
