@@ -253,6 +253,12 @@ double InterfaceShear::window_mean(bool with_current, std::int64_t& last) const 
   return n > 0 ? sum / n : -1e300;
 }
 
+// The centre of the window that ends with sub-bin `last` (from u = 0 while shorter).
+double InterfaceShear::window_centre(std::int64_t last) const {
+  const std::int64_t first = std::max<std::int64_t>(0, last - kWindowBins + 1);
+  return 0.5 * static_cast<double>(first + last + 1) * sub_bin_width();
+}
+
 void InterfaceShear::close_sub_bin() const {
   ring_sum_[static_cast<std::size_t>(bin_ % kWindowBins)] = bin_sum_;
   ring_n_[static_cast<std::size_t>(bin_ % kWindowBins)] = bin_n_;
@@ -262,14 +268,14 @@ void InterfaceShear::close_sub_bin() const {
   const double m = window_mean(false, last);
   if (last + 1 >= kWindowBins && m > peak_) {  // (whole windows only; see results())
     peak_ = m;
-    peak_u_ = (static_cast<double>(last + 1) - 0.5 * kWindowBins) * sub_bin_width();
+    peak_u_ = window_centre(last);
   }
 }
 
 void InterfaceShear::record(double u, double mu, double eps_v) const {
   const std::int64_t bin =
       std::max<std::int64_t>(0, static_cast<std::int64_t>(std::floor(u / sub_bin_width())));
-  if (bin_ < 0) bin_ = bin;          // (the first row: the sub-bins before it stay empty)
+  if (bin_ < 0) bin_ = bin;            // (the first row: the sub-bins before it stay empty)
   while (bin_ < bin) close_sub_bin();  // (and any the frame passed without a row, empty)
   bin_sum_ += mu;
   bin_n_ += 1;
@@ -323,9 +329,7 @@ std::vector<std::pair<std::string, double>> InterfaceShear::results(const Simula
   const double m = bin_ >= 0 ? window_mean(true, last) : -1e300;
   if (m > peak) {
     peak = m;
-    peak_u = 0.5 * (static_cast<double>(std::max<std::int64_t>(0, last - kWindowBins + 1)) +
-                    static_cast<double>(last + 1)) *
-             sub_bin_width();
+    peak_u = window_centre(last);
   }
   const double res = res_n_ > 0 ? res_sum_ / res_n_ : NAN;
   const double eps_res = res_n_ > 0 ? eps_res_sum_ / res_n_ : NAN;

@@ -146,6 +146,7 @@ class InterfaceShear final : public MeasuredProgramme {
   }
   void close_sub_bin() const;  // the sub-bin in progress into the ring; its window's mean
   double window_mean(bool with_current, std::int64_t& last) const;
+  double window_centre(std::int64_t last) const;
   mutable std::int64_t bin_ = -1;  // the sub-bin in progress
   mutable double bin_sum_ = 0, bin_n_ = 0;
   mutable std::array<double, kWindowBins> ring_sum_{}, ring_n_{};  // sub-bin j at j % kWindowBins

@@ -294,7 +294,6 @@ void LayeredFilling::control(Simulation& sim) {
     return;
   }
   if (++below_ < spec_.hold_steps) return;  // (held below for hold_steps steps in a row)
-  below_ = 0;
   if (inserted_ < static_cast<int>(layers_.size())) {
     insert_layer(sim);
     return;
