@@ -556,7 +556,7 @@ void amg_vcycle(const AmgHierarchy& h, const Eigen::Ref<const AmgBlock>& b, Eige
 
 Eigen::MatrixXd amg_pcg(const AmgHierarchy& h, const Eigen::MatrixXd& b0, double tolerance,
                         int max_iterations, int& iterations, bool& converged,
-                        std::vector<int>* column_iterations) {
+                        std::vector<int>* column_iterations, const std::function<void()>& poll) {
   if (h.levels.empty()) throw std::invalid_argument("AMG: empty hierarchy");
   const RowMat& a = h.levels.front().a;
   const Index n = b0.rows(), cols = b0.cols();
@@ -620,6 +620,7 @@ Eigen::MatrixXd amg_pcg(const AmgHierarchy& h, const Eigen::MatrixXd& b0, double
       if (!done[static_cast<std::size_t>(c)] && rnorm(c) <= tolerance * bnorm(c))
         done[static_cast<std::size_t>(c)] = 1;
     if (all_done()) return finish();
+    if (poll && it % 8 == 0) poll();
     cycle(h, 0, w, r, static_cast<Block*>(nullptr));
     const Eigen::VectorXd rz_new = column_dots(r, z);
     for (Index c = 0; c < cols; ++c) {

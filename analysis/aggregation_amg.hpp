@@ -9,6 +9,7 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
 #include <Eigen/Sparse>
+#include <functional>
 #include <vector>
 
 namespace gs::analysis {
@@ -68,9 +69,12 @@ void amg_vcycle(const AmgHierarchy& h, const Eigen::Ref<const AmgBlock>& b, Eige
 /// amg_vcycle, from x = 0, until every column's relative residual ‖b − A x‖ ≤ tolerance ‖b‖ or
 /// max_iterations. Returns x (each column the same bits as if solved alone); `iterations` is
 /// the number of iterations run, `converged` whether every column reached the tolerance,
-/// `column_iterations` (if given) the iterations each column took.
+/// `column_iterations` (if given) the iterations each column took. `poll` (if set) is called
+/// every 8 iterations, outside any parallel region, and may throw to stop the solve (Ctrl-C in
+/// the Python package); it does not change the iterates.
 Eigen::MatrixXd amg_pcg(const AmgHierarchy& h, const Eigen::MatrixXd& b, double tolerance,
                         int max_iterations, int& iterations, bool& converged,
-                        std::vector<int>* column_iterations = nullptr);
+                        std::vector<int>* column_iterations = nullptr,
+                        const std::function<void()>& poll = {});
 
 }  // namespace gs::analysis

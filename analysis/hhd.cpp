@@ -766,7 +766,7 @@ HhdResult helmholtz_hodge(const HhdMesh& m, const std::vector<Eigen::Vector3d>& 
     std::vector<int> its;
     int iterations = 0;
     bool converged = true;
-    x = amg_pcg(h, rhs, tol, o.max_iterations, iterations, converged, &its);
+    x = amg_pcg(h, rhs, tol, o.max_iterations, iterations, converged, &its, o.poll);
     r.report.iterations_u = its[0];
     r.report.iterations_v = *std::max_element(its.begin() + 1, its.end());
     r.report.converged = converged;

@@ -64,8 +64,10 @@ struct HhdOptions {
   HhdSolver solver = HhdSolver::Auto;
   double tolerance = 0.0;  // iterative solvers: relative residual ‖r‖/‖b‖ per system; 0: default
   int max_iterations = 10000;  // iterative solvers, per system
-  /// Called between the phases and every 8 iterations of the projection solver; may throw to
-  /// abandon the decomposition (Python's Ctrl-C). Changes no result.
+  /// Called between the phases and every 8 iterations of the projection's and the AMG path's
+  /// conjugate gradients (`projection`, `projection-amg`; the direct and Eigen iterative paths
+  /// finish their solve first); may throw to abandon the decomposition (Python's Ctrl-C).
+  /// Changes no result.
   std::function<void()> poll;
 };
 

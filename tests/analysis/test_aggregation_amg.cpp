@@ -130,6 +130,32 @@ TEST(AggregationAmg, GalerkinCoarseMatricesAndColumnsSolvedAsAlone) {
   }
 }
 
+// The poll (the Python package's Ctrl-C): called every 8 iterations, between two iterations, so
+// that it changes no iterate; what it throws ends the solve. A tolerance no solve reaches keeps
+// the iterations going to the limit.
+TEST(AggregationAmg, PollIsCalledEveryEightIterationsAndMayStopTheSolve) {
+  const SpMat a = grid_laplacian(16, 100.0);
+  const AmgHierarchy h = build_amg(a);
+  ASSERT_GT(h.levels.size(), 1u);
+  const Eigen::MatrixXd b = random_columns(a.rows(), 2, 5);
+  int its = 0, calls = 0;
+  bool ok = true;
+  const Eigen::MatrixXd polled = amg_pcg(h, b, 1e-300, 30, its, ok, nullptr, [&] { ++calls; });
+  EXPECT_FALSE(ok);
+  EXPECT_EQ(its, 30);
+  EXPECT_EQ(calls, 3);  // after iterations 8, 16 and 24
+  const Eigen::MatrixXd plain = amg_pcg(h, b, 1e-300, 30, its, ok);
+  EXPECT_EQ(polled, plain);
+  calls = 0;
+  EXPECT_THROW(amg_pcg(h, b, 1e-300, 1000000, its, ok, nullptr,
+                       [&] {
+                         if (++calls == 2) throw std::runtime_error("interrupted");
+                       }),
+               std::runtime_error);
+  EXPECT_EQ(calls, 2);
+  EXPECT_EQ(its, 16);
+}
+
 TEST(AggregationAmg, RowMajorMatrixGivenUpBuildsTheSameHierarchy) {
   // The row-major overload takes the matrix's storage (no copy) and builds what the
   // column-major one builds from the same symmetric matrix, to the bit.

@@ -180,27 +180,31 @@ def test_motion_errors_are_the_cli_lines():
         gs.vortices([f], every=1)
 
 
-def test_ctrl_c_interrupts_a_long_hhd():
-    """A 3D decomposition of 20 000 nodes (about 1.2 s on 2 cores): SIGINT after 0.5 s raises
-    KeyboardInterrupt from the projection solver's iterations, well before it would end (timed
-    against the same decomposition run to its end, so that a loaded machine slows both)."""
+@pytest.mark.parametrize("solver", ["projection", "projection-amg"])
+def test_ctrl_c_interrupts_a_long_hhd(solver):
+    """A 3D decomposition of 20 000 nodes that would iterate for hours (a random field, a
+    tolerance no solve reaches, 10^6 iterations a system: ~3 ms each here): SIGINT after 0.5 s
+    raises KeyboardInterrupt from the iterations (the projection's after a direct path (b), or
+    the AMG path (b)'s) within seconds. Not timed against a full run: on a loaded machine the
+    phases before the first poll (Delaunay, assembly, factorisation: 0.2 s here) took longer
+    than a whole default decomposition had a moment before."""
     import os
     import signal
     import threading
     import time
     rng = np.random.default_rng(0)
     x = rng.uniform(0.0, 1.0, size=(20000, 3))
-    u = np.stack([-x[:, 1], x[:, 0], 0.0 * x[:, 0]], 1)
-    t0 = time.monotonic()
-    whole = gs.hhd(points=x, vectors=u)
-    full = time.monotonic() - t0
-    assert whole["report"]["iterations_v"] > 50
+    u = rng.normal(size=(20000, 3))
+    # (the same field to a few iterations: both paths iterate, and do not converge)
+    short = gs.hhd(points=x, vectors=u, solver=solver, tolerance=1e-300, max_iterations=20)
+    assert not short["report"]["converged"]
+    assert short["report"]["iterations_v"] == 20
     timer = threading.Timer(0.5, lambda: os.kill(os.getpid(), signal.SIGINT))
     t0 = time.monotonic()
     timer.start()
     with pytest.raises(KeyboardInterrupt):
-        gs.hhd(points=x, vectors=u)
+        gs.hhd(points=x, vectors=u, solver=solver, tolerance=1e-300, max_iterations=1_000_000)
     elapsed = time.monotonic() - t0
     timer.join()
-    print("interrupted after %.2f s of %.2f s" % (elapsed, full))
-    assert elapsed < 0.75 * full, (elapsed, full)
+    print("%s interrupted after %.2f s" % (solver, elapsed))
+    assert elapsed < 60.0, elapsed
