@@ -18,11 +18,11 @@ using gs::test::replaced;
 using gs::test::run_cli;
 
 // ~330 spheres of 0.8–1.2 mm in a 12 × 4 × 6 mm box under σn = 100 kPa, no gravity (so that the
-// platen's force is all the surface carries), Table 4.4's sphere material. One thread, as
-// `threads = "auto"` picks below 5 000 particles: a team of two meets at several barriers a
-// step, and on the CI machine of 2026-12-07 the two-thread runs took 11 and over 27 times their
-// time here (the flat test past its 600 s limit) while the one-thread tests kept theirs. The
-// results are the same bits on any number of threads.
+// platen's force is all the surface carries), Table 4.4's sphere material. `threads = "auto"`:
+// one thread below 5 000 particles (the scene set 2 before): a team of two meets at several
+// barriers a step, and on the CI machine of 2026-12-07 the two-thread runs took 11 and over 27
+// times their time here (the flat test past its 600 s limit) while the one-thread tests kept
+// theirs. The results are the same bits on any number of threads.
 std::string scene(const std::string& surface, const std::string& extra = "") {
   return "[scene]\nname = \"is\"\ntest = \"interface_shear\"\n"
          "[specimen]\nsize_m = [0.012, 0.004, 0.006]\ndmin_m = 0.0008\ndmax_m = 0.0012\n"
@@ -30,7 +30,7 @@ std::string scene(const std::string& surface, const std::string& extra = "") {
          "[material]\nyoung_Pa = 3.0e8\nstiffness_ratio = 0.3\nfriction_deg = 18.0\n"
          "density_kg_m3 = 2600.0\nrolling_stiffness = 0.7\nrolling_limit = 0.4\n"
          "rolling_limit_radius = \"mean\"\n"
-         "[solver]\ndt_s = \"auto\"\ndt_safety = 0.6\ndamping = 0.08\nthreads = 1\n"
+         "[solver]\ndt_s = \"auto\"\ndt_safety = 0.6\ndamping = 0.08\nthreads = \"auto\"\n"
          "[preparation]\nstage_steps = 2000\nmax_wall_speed_m_s = 0.5\n"
          "[interface_shear]\n" +
          surface +
