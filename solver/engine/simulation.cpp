@@ -125,6 +125,11 @@ Simulation::Simulation(SimulationConfig config, const std::vector<Particle>& par
   nl_.threads = std::max(1, cfg_.threads);
 }
 
+void Simulation::set_threads(int threads) {
+  cfg_.threads = std::max(1, threads);
+  nl_.threads = cfg_.threads;
+}
+
 void Simulation::set_clumps(std::vector<ClumpBody> clumps) {
   if (step_ != 0) throw std::logic_error("clumps must be set before the first step");
   for (std::size_t i = 0; i < p_.size(); ++i)

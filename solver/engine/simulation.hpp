@@ -115,6 +115,9 @@ class Simulation {
   std::int64_t step_count() const { return step_; }
   double time() const { return time_; }
   const SimulationConfig& config() const { return cfg_; }
+  /// The OpenMP threads of the following steps (at least 1). Every count gives the same bits
+  /// (docs/physics.md), so a run may change it between any two steps (ThreadTuner).
+  void set_threads(int threads);
   const ParticleState& particles() const { return p_; }
   ParticleState& particles() { return p_; }
   const std::vector<WallState>& walls() const { return walls_; }

@@ -1064,10 +1064,12 @@ void apply_override(const Reader& r, toml::table& root, const std::string& key,
 
 }  // namespace
 
+int machine_threads() {
+  return std::clamp(omp_get_num_procs(), 1, kMaxThreads);
+}
+
 int auto_threads(std::size_t particles) {
-  if (particles < kAutoThreadsFrom) return 1;
-  const int cores = omp_get_num_procs();
-  return std::clamp(cores, 1, kMaxThreads);
+  return particles < kAutoThreadsFrom ? 1 : machine_threads();
 }
 
 Scene load_scene(const std::filesystem::path& path, int sweep_point,

@@ -37,9 +37,12 @@ inline constexpr int kMaxThreads = 1024;
 /// slower from 5 000 up (docs/scale.md).
 inline constexpr std::size_t kAutoThreadsFrom = 5000;
 
-/// The thread count `threads = "auto"` picks for `particles` particles: one below
-/// kAutoThreadsFrom, else the machine's cores (at most kMaxThreads).
+/// The thread count `threads = "auto"` starts a run with for `particles` particles: one below
+/// kAutoThreadsFrom, else machine_threads(). (The run then times its steps on both counts and
+/// keeps the faster: ThreadTuner.)
 int auto_threads(std::size_t particles);
+/// The machine's cores as OpenMP sees them, at most kMaxThreads.
+int machine_threads();
 
 struct OutputSpec {
   std::string trajectory = "trajectory.h5";

@@ -342,6 +342,10 @@ RunOutcome run_scene(Scene scene, const RunOptions& a) {
   const bool threads_by_size = scene.config.threads == 0;
   if (threads_by_size)  // "auto"; under mpirun one thread a process (the processes take the cores)
     scene.config.threads = par ? 1 : auto_threads(scene.particles.size());
+  // "auto" in one process: the count then follows the steps' timing (thread_tuner.hpp).
+  std::optional<ThreadTuner> tuner;
+  if (threads_by_size && !par && machine_threads() > 1)
+    tuner.emplace(scene.config.threads, machine_threads(), a.thread_tuning);
   // Where the run stops at the latest: `steps`, or a plain scene's own number of steps.
   std::optional<std::int64_t> stop_at = a.steps;
   if (scene.test.empty() && !scene.fill) {
@@ -637,7 +641,15 @@ RunOutcome run_scene(Scene scene, const RunOptions& a) {
       if (stop_at && sim.step_count() >= *stop_at) break;
       programmes[k]->control(sim);
       if (programmes[k]->finished(sim)) continue;  // ended by its control (a stage check)
-      sim.step();
+      if (tuner) {
+        const auto before = std::chrono::steady_clock::now();
+        sim.step();
+        const int t = tuner->record(
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - before).count());
+        if (t != sim.config().threads) sim.set_threads(t);
+      } else {
+        sim.step();
+      }
       const std::int64_t s = sim.step_count();
       if (s % scene.output.history_every == 0) history_append(true);
       if (s % scene.output.curve_every == 0) curve_row();
@@ -698,11 +710,24 @@ RunOutcome run_scene(Scene scene, const RunOptions& a) {
   const double ps = static_cast<double>(s - first) * static_cast<double>(sim.particles().size());
   const auto& e = sim.energy();
   char buf[512];
+  std::string how;  // (which count, and how it was picked)
+  int threads = scene.config.threads;
+  if (tuner) {
+    // the count of most steps, and the share of the steps on each
+    const double one = static_cast<double>(tuner->steps_on_one());
+    const double most = static_cast<double>(tuner->steps_on_most());
+    threads = most > one ? machine_threads() : 1;
+    std::snprintf(buf, sizeof buf, ", picked by timing: %.0f %% of the steps on 1, %.0f %% on %d",
+                  100 * one / std::max(1.0, one + most), 100 * most / std::max(1.0, one + most),
+                  machine_threads());
+    how = buf;
+  } else if (threads_by_size) {
+    how = ", picked by size";
+  }
   std::snprintf(buf, sizeof buf,
                 "%s: %lld steps of %zu particles in %.2f s (%.3g particle-steps/s, %d thread(s)%s)",
                 scene.name.c_str(), static_cast<long long>(s - first), sim.particles().size(), el,
-                ps / std::max(el, 1e-9), scene.config.threads,
-                threads_by_size ? ", picked by size" : "");
+                ps / std::max(el, 1e-9), threads, how.c_str());
   print(buf);
   std::snprintf(
       buf, sizeof buf,

@@ -15,6 +15,7 @@
 
 #include "scene_file.hpp"
 #include "simulation.hpp"
+#include "thread_tuner.hpp"
 
 namespace gs::solver {
 
@@ -38,6 +39,9 @@ struct RunOptions {
   int threads = 0;                    // 0: the scene's
   bool resume = false;                // continue from the last checkpoint in `out`
   std::string provenance;             // metadata; default "granoscope simulate FILE"
+  /// With `threads = "auto"` in one process: the windows in which the run times its steps on one
+  /// thread and on all (thread_tuner.hpp).
+  ThreadTunerOptions thread_tuning;
   /// Called at the start of each programme and every `progress_every` steps; returning false
   /// stops the run (checkpoint written, outputs left to resume). May throw to abort likewise.
   std::function<bool(const RunProgress&)> progress;

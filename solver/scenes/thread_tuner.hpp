@@ -1,0 +1,58 @@
+#pragma once
+// `threads = "auto"`: the thread count of a run chosen by timing its own steps.
+//
+// The engine gives the same bits on any number of threads (docs/physics.md), so a run may change
+// its count between any two steps without changing a result. Which count is faster depends on
+// the scene and on the machine's other load: on a quiet 2-core machine two threads ran the
+// laptop scenes of 1 000-2 800 particles 6-28 % faster than one, but with a second run beside
+// them each run's two threads spun at the step's barriers while the other run held a core, and
+// both ran 4-13 times slower than on one thread each (docs/scale.md, "Picked by timing"). The
+// tuner measures the steps on its current count and on the other one, one short window each,
+// keeps the faster, and measures again after a hold, so that a run adapts when another starts or
+// ends beside it.
+
+#include <cstdint>
+
+namespace gs::solver {
+
+struct ThreadTunerOptions {
+  double window_s = 0.25;  // a measurement lasts at least this long (wall-clock) ...
+  int window_steps = 3;    // ... and this many steps
+  double hold_s = 10.0;    // between the end of one comparison and the next
+  double margin = 0.02;    // the other count must be this much faster (relative) to be taken
+};
+
+/// Chooses between one thread and `most` threads from the wall-clock time of each step.
+class ThreadTuner {
+ public:
+  /// Starts on `start` (1 or `most`); `most` ≤ 1 never changes the count.
+  ThreadTuner(int start, int most, ThreadTunerOptions options = {});
+
+  /// The thread count for the next step.
+  int threads() const { return current_; }
+  /// The step just taken on threads() took `seconds`; returns the count for the next step.
+  int record(double seconds);
+  /// Steps recorded on one thread and on `most` threads.
+  std::int64_t steps_on_one() const { return steps_one_; }
+  std::int64_t steps_on_most() const { return steps_most_; }
+  /// Comparisons made, and how many of them changed the count.
+  int comparisons() const { return comparisons_; }
+  int switches() const { return switches_; }
+
+ private:
+  enum class Phase { Measure, Probe, Hold };
+  int other() const { return current_ == 1 ? most_ : 1; }
+  void start_window();
+
+  int most_;
+  int current_;
+  ThreadTunerOptions o_;
+  Phase phase_ = Phase::Measure;
+  double window_seconds_ = 0;  // this phase's time and steps so far
+  std::int64_t window_count_ = 0;
+  double measured_ = 0;  // seconds per step on the held count, from the Measure window
+  std::int64_t steps_one_ = 0, steps_most_ = 0;
+  int comparisons_ = 0, switches_ = 0;
+};
+
+}  // namespace gs::solver
