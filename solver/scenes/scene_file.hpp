@@ -32,7 +32,7 @@ namespace gs::solver {
 /// The most threads a scene or `simulate --threads` may ask for (a million crashed the run).
 inline constexpr int kMaxThreads = 1024;
 
-/// Below this many particles a scene with `threads = "auto"` (the default) runs on one thread:
+/// Below this many particles a scene with `threads = "auto"` (the default) starts on one thread:
 /// two threads were slower than one on 883 and 2 000 spheres on a 2-core machine, and never
 /// slower from 5 000 up (docs/scale.md).
 inline constexpr std::size_t kAutoThreadsFrom = 5000;
