@@ -38,8 +38,8 @@ inline constexpr int kMaxThreads = 1024;
 inline constexpr std::size_t kAutoThreadsFrom = 5000;
 
 /// The thread count `threads = "auto"` starts a run with for `particles` particles: one below
-/// kAutoThreadsFrom, else machine_threads(). (The run then times its steps on both counts and
-/// keeps the faster: ThreadTuner.)
+/// kAutoThreadsFrom, else machine_threads(). (The run then times its steps on neighbouring
+/// counts and keeps the fastest: ThreadTuner.)
 int auto_threads(std::size_t particles);
 /// The machine's cores as OpenMP sees them, at most kMaxThreads.
 int machine_threads();

@@ -713,14 +713,22 @@ RunOutcome run_scene(Scene scene, const RunOptions& a) {
   std::string how;  // (which count, and how it was picked)
   int threads = scene.config.threads;
   if (tuner) {
-    // the count of most steps, and the share of the steps on each
-    const double one = static_cast<double>(tuner->steps_on_one());
-    const double most = static_cast<double>(tuner->steps_on_most());
-    threads = most > one ? machine_threads() : 1;
-    std::snprintf(buf, sizeof buf, ", picked by timing: %.0f %% of the steps on 1, %.0f %% on %d",
-                  100 * one / std::max(1.0, one + most), 100 * most / std::max(1.0, one + most),
-                  machine_threads());
-    how = buf;
+    // the count of most steps, and the share of the steps on each count
+    std::int64_t all = 0, most = -1;
+    for (const int c : tuner->counts()) all += tuner->steps_on(c);
+    how = ", picked by timing: ";
+    for (const int c : tuner->counts()) {
+      const std::int64_t n = tuner->steps_on(c);
+      if (n > most) {
+        most = n;
+        threads = c;
+      }
+      std::snprintf(
+          buf, sizeof buf, "%s%.0f %%%s on %d", c == 1 ? "" : ", ",
+          100.0 * static_cast<double>(n) / static_cast<double>(std::max<std::int64_t>(1, all)),
+          c == 1 ? " of the steps" : "", c);
+      how += buf;
+    }
   } else if (threads_by_size) {
     how = ", picked by size";
   }

@@ -39,8 +39,8 @@ struct RunOptions {
   int threads = 0;                    // 0: the scene's
   bool resume = false;                // continue from the last checkpoint in `out`
   std::string provenance;             // metadata; default "granoscope simulate FILE"
-  /// With `threads = "auto"` in one process: the windows in which the run times its steps on one
-  /// thread and on all (thread_tuner.hpp).
+  /// With `threads = "auto"` in one process: the windows in which the run times its steps on
+  /// the counts it compares (thread_tuner.hpp).
   ThreadTunerOptions thread_tuning;
   /// Called at the start of each programme and every `progress_every` steps; returning false
   /// stops the run (checkpoint written, outputs left to resume). May throw to abort likewise.

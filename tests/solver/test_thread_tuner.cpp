@@ -25,6 +25,14 @@ std::vector<int> feed(ThreadTuner& tuner, double one_s, double most_s, int steps
   return counts;
 }
 
+/// The same with a step time for each count: `seconds(count)`.
+template <class Seconds>
+std::vector<int> feed_by(ThreadTuner& tuner, Seconds seconds, int steps) {
+  std::vector<int> counts;
+  for (int i = 0; i < steps; ++i) counts.push_back(tuner.record(seconds(tuner.threads())));
+  return counts;
+}
+
 ThreadTunerOptions windows() {
   ThreadTunerOptions o;
   o.window_s = 1.0;
@@ -62,8 +70,8 @@ TEST(ThreadTuner, LeavesTwoThreadsThatAreSlowerThanOne) {
   EXPECT_EQ(c, (std::vector<int>{2, 1}));  // two slower again: back to one
   EXPECT_EQ(t.comparisons(), 2);
   EXPECT_EQ(t.switches(), 1);
-  EXPECT_EQ(t.steps_on_most(), 4);
-  EXPECT_EQ(t.steps_on_one(), 8 + 47 + 1);
+  EXPECT_EQ(t.steps_on(2), 4);
+  EXPECT_EQ(t.steps_on(1), 8 + 47 + 1);
 }
 
 // Exact answer, the quiet machine: two threads 25 % faster (0.09375 s a step against 0.125 s)
@@ -80,8 +88,8 @@ TEST(ThreadTuner, TakesTwoThreadsThatAreFasterByTheMargin) {
   EXPECT_EQ(t.threads(), 2);
   EXPECT_EQ(t.comparisons(), 7);
   EXPECT_EQ(t.switches(), 1);  // (each later probe of one thread went back to two)
-  EXPECT_EQ(t.steps_on_one(), 8 + 6 * 8);
-  EXPECT_EQ(t.steps_on_most(), 8 + 11 + 6 * 73 + 62 - (8 + 6 * 8));
+  EXPECT_EQ(t.steps_on(1), 8 + 6 * 8);
+  EXPECT_EQ(t.steps_on(2), 8 + 11 + 6 * 73 + 62 - (8 + 6 * 8));
 
   ThreadTuner close(1, 2, windows());
   feed(close, 0.125, 0.123, 1000);
@@ -90,16 +98,61 @@ TEST(ThreadTuner, TakesTwoThreadsThatAreFasterByTheMargin) {
   EXPECT_EQ(close.threads(), 1);
 }
 
-// A machine of one core, or a start above the cores: nothing to choose, or the cores.
+// A machine of one core, or a start above the cores: nothing to choose, or the cores. The
+// ladder is 1, 2, 4, … below the cores and the cores; a start between two counts takes the lower.
 TEST(ThreadTuner, OneCoreNeverSwitchesAndTheStartIsClamped) {
   ThreadTuner t(1, 1, windows());
   const std::vector<int> c = feed(t, 0.125, 0.001, 100);
   for (const int n : c) EXPECT_EQ(n, 1);
   EXPECT_EQ(t.comparisons(), 0);
-  EXPECT_EQ(t.steps_on_one(), 100);
+  EXPECT_EQ(t.steps_on(1), 100);
+  EXPECT_EQ(t.counts(), (std::vector<int>{1}));
   EXPECT_EQ(ThreadTuner(8, 2).threads(), 2);
   EXPECT_EQ(ThreadTuner(0, 4).threads(), 1);
-  EXPECT_EQ(ThreadTuner(3, 4).threads(), 4);
+  EXPECT_EQ(ThreadTuner(3, 4).threads(), 2);
+  EXPECT_EQ(ThreadTuner(1, 12).counts(), (std::vector<int>{1, 2, 4, 8, 12}));
+  EXPECT_EQ(ThreadTuner(12, 12).threads(), 12);
+  EXPECT_EQ(ThreadTuner(1, 2).counts(), (std::vector<int>{1, 2}));
+}
+
+// Exact answer, 8 cores shared with another run (times exact in binary): all 8 threads spin
+// (0.5 s a step), 4 run best (0.125 s), 2 and 1 slower (0.25, 0.5). From 8 the tuner probes 4
+// (kept), then 8 above it (slower: back), then 2 below it (slower: back), and stays on 4: it
+// neither keeps the spinning count nor falls to one thread.
+TEST(ThreadTuner, ClimbsToTheFastestCountOfManyCores) {
+  auto seconds = [](int count) {
+    switch (count) {
+      case 1:
+        return 0.5;
+      case 2:
+        return 0.25;
+      case 4:
+        return 0.125;
+      default:
+        return 0.5;
+    }
+  };
+  ThreadTuner t(8, 8, windows());
+  EXPECT_EQ(t.counts(), (std::vector<int>{1, 2, 4, 8}));
+  feed_by(t, seconds, 2);  // measure 8 (two steps, 1 s): then the probe of 4
+  EXPECT_EQ(t.threads(), 4);
+  feed_by(t, seconds, 8);  // probe 4 (8 steps, 1 s): kept
+  EXPECT_EQ(t.threads(), 4);
+  EXPECT_EQ(t.switches(), 1);
+  feed_by(t, seconds, 40 + 8);  // hold (5 s), measure 4: then the probe above, 8
+  EXPECT_EQ(t.threads(), 8);
+  feed_by(t, seconds, 2);  // probe 8: slower, back to 4
+  EXPECT_EQ(t.threads(), 4);
+  feed_by(t, seconds, 40 + 8);  // hold, measure 4: then the probe below, 2
+  EXPECT_EQ(t.threads(), 2);
+  feed_by(t, seconds, 4);  // probe 2 (4 steps, 1 s): slower, back to 4
+  EXPECT_EQ(t.threads(), 4);
+  EXPECT_EQ(t.comparisons(), 3);
+  EXPECT_EQ(t.switches(), 1);
+  feed_by(t, seconds, 1000);
+  EXPECT_EQ(t.switches(), 1);
+  EXPECT_GT(t.steps_on(4), 10 * (t.steps_on(8) + t.steps_on(2)));
+  EXPECT_EQ(t.steps_on(1), 0);  // (never two rungs away)
 }
 
 // The engine gives the same bits on any number of threads, so a run whose count changes between
