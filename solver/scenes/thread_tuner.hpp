@@ -21,7 +21,7 @@ struct ThreadTunerOptions {
   double window_s = 0.25;  // a measurement lasts at least this long (wall-clock) ...
   int window_steps = 3;    // ... and this many steps
   double hold_s = 10.0;    // between the end of one comparison and the next
-  double margin = 0.02;    // the other count must be this much faster (relative) to be taken
+  double margin = 0.02;    // the probed count must be this much faster (relative) to be kept
 };
 
 /// Chooses among 1, 2, 4, … threads and `most` (the counts() ladder) from the wall-clock time of
