@@ -2,13 +2,12 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 #include <string>
 #include <vector>
 
 #include "scene_file.hpp"
 #include "scene_run.hpp"
+#include "text_parse.hpp"
 #include "thread_tuner.hpp"
 
 namespace {
@@ -16,21 +15,19 @@ namespace {
 using gs::solver::ThreadTuner;
 using gs::solver::ThreadTunerOptions;
 
-/// Feeds `tuner` steps that take `one_s` on one thread and `most_s` on more until `steps` have
-/// been recorded; returns the count after each step.
-std::vector<int> feed(ThreadTuner& tuner, double one_s, double most_s, int steps) {
-  std::vector<int> counts;
-  for (int i = 0; i < steps; ++i)
-    counts.push_back(tuner.record(tuner.threads() == 1 ? one_s : most_s));
-  return counts;
-}
-
-/// The same with a step time for each count: `seconds(count)`.
+/// Feeds `tuner` steps that take `seconds(count)` on `count` threads until `steps` have been
+/// recorded; returns the count after each step.
 template <class Seconds>
 std::vector<int> feed_by(ThreadTuner& tuner, Seconds seconds, int steps) {
   std::vector<int> counts;
   for (int i = 0; i < steps; ++i) counts.push_back(tuner.record(seconds(tuner.threads())));
   return counts;
+}
+
+/// The same with `one_s` on one thread and `most_s` on more.
+std::vector<int> feed(ThreadTuner& tuner, double one_s, double most_s, int steps) {
+  return feed_by(
+      tuner, [&](int count) { return count == 1 ? one_s : most_s; }, steps);
 }
 
 ThreadTunerOptions windows() {
@@ -40,13 +37,6 @@ ThreadTunerOptions windows() {
   o.hold_s = 5.0;
   o.margin = 0.02;
   return o;
-}
-
-std::string slurp(const std::filesystem::path& p) {
-  std::ifstream in(p);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
 }
 
 }  // namespace
@@ -183,9 +173,10 @@ TEST(ThreadTuner, ARunChangingItsThreadsIsTheRunOnOneThread) {
       };
       gs::solver::run_scene(std::move(scene), o);
     }
-    const std::string one = slurp(tmp / (std::string(name) + "_one") / "history.csv");
+    const std::string one =
+        gs::text::read_text_file(tmp / (std::string(name) + "_one") / "history.csv");
     ASSERT_GT(one.size(), 100u);
-    EXPECT_EQ(one, slurp(tmp / (std::string(name) + "_tuned") / "history.csv"));
+    EXPECT_EQ(one, gs::text::read_text_file(tmp / (std::string(name) + "_tuned") / "history.csv"));
     if (gs::solver::machine_threads() > 1) {
       // (half the steps on each: measure, probe kept, hold, measure, ...: 1, 2, 2, 1, 1, 2, ...)
       EXPECT_NE(summary.find("picked by timing: 50 % of the steps on 1, 50 % on"),
