@@ -200,6 +200,7 @@ void InterfaceShear::start(Simulation& sim) {
   for (std::size_t k = 0; k < sim.walls().size(); ++k)
     if (!sim.walls()[k].spec.velocity.isZero()) sim.set_wall_velocity(k, Eigen::Vector3d::Zero());
   x0_ = sim.walls()[w_.frame[0]].pos.x();
+  frame_z0_ = sim.walls()[w_.frame[0]].pos.z();
   h0_ = specimen_height(sim);
   e0_ = void_ratio(sim);
 }
@@ -210,7 +211,19 @@ double InterfaceShear::platen_force(const Simulation& sim) const {
 
 void InterfaceShear::control(Simulation& sim) {
   const Eigen::Vector3d v(spec_.shear_velocity_m_s, 0, 0);
-  for (const auto k : w_.frame) sim.set_wall_velocity(k, v);
+  // A free frame moves up at the speed that removes the fraction servo_gain of its vertical
+  // load per step (over its contacts' summed stiffness), as the platen's servo; untouched, it
+  // stays.
+  double frame_vz = 0;
+  if (spec_.frame_free) {
+    const double fz = frame_vertical_force(sim);
+    double k = 0;
+    for (const auto w : w_.frame) k += sim.wall_stiffness(w).first;
+    if (k > 0)
+      frame_vz = std::clamp(spec_.servo_gain * fz / (k * sim.config().dt),
+                            -spec_.max_platen_speed_m_s, spec_.max_platen_speed_m_s);
+  }
+  for (const auto k : w_.frame) sim.set_wall_velocity(k, v + Eigen::Vector3d(0, 0, frame_vz));
   const double area = g_.length_m * g_.width_m;
   const double vz = servo_speed(sim, w_.platen, platen_force(sim) / area, spec_.normal_stress_Pa,
                                 area, spec_.servo_gain, spec_.max_platen_speed_m_s);
@@ -219,6 +232,12 @@ void InterfaceShear::control(Simulation& sim) {
 
 double InterfaceShear::displacement(const Simulation& sim) const {
   return sim.walls()[w_.frame[0]].pos.x() - x0_;
+}
+
+double InterfaceShear::frame_vertical_force(const Simulation& sim) const {
+  double fz = 0;
+  for (const auto k : w_.frame) fz += sim.walls()[k].force.z();
+  return fz;
 }
 
 double InterfaceShear::frame_shear_force(const Simulation& sim) const {
@@ -290,7 +309,7 @@ void InterfaceShear::record(double u, double mu, double eps_v) const {
 std::string InterfaceShear::curve_header() const {
   return "step,time_s,u_m,u_over_L,T_N,P_N,tau_Pa,sigma_n_Pa,mu_eff,phi_s_deg,surface_T_N,"
          "surface_P_N,surface_mu,dh_m,eps_v,void_ratio,coordination,particles_outside,"
-         "inertial_number";
+         "inertial_number,frame_dz_m,frame_P_N";
 }
 
 std::string InterfaceShear::curve_row(const Simulation& sim) const {
@@ -313,11 +332,13 @@ std::string InterfaceShear::curve_row(const Simulation& sim) const {
   char buf[640];
   std::snprintf(buf, sizeof buf,
                 "%lld,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,"
-                "%.9g,%.6g,%zu,%.6g",
+                "%.9g,%.6g,%zu,%.6g,%.9g,%.9g",
                 static_cast<long long>(sim.step_count()), sim.time(), u, u / g_.length_m, T, P,
                 T / A, P / A, mu, std::atan(mu) * 180 / M_PI, sT, sP, sP > 0 ? sT / sP : 0.0,
                 h - h0_, eps, void_ratio(sim), coordination_number(sim), outside,
-                sim.inertial_number());
+                sim.inertial_number(),
+                spec_.frame_free ? sim.walls()[w_.frame[0]].pos.z() - frame_z0_ : 0.0,
+                frame_vertical_force(sim));
   return buf;
 }
 
@@ -372,6 +393,7 @@ std::string InterfaceShear::save_state() const {
   ProgrammeState st;
   st.set("x0", x0_);
   st.set("h0", h0_);
+  st.set("frame_z0", frame_z0_);
   st.set("e0", e0_);
   st.set("bin", bin_);
   st.set("bin_sum", bin_sum_);
@@ -393,6 +415,8 @@ void InterfaceShear::load_state(const std::string& state) {
   const ProgrammeState st(state);
   x0_ = st.number("x0");
   h0_ = st.number("h0");
+  // (older checkpoints: a held frame, whose rise is 0 without it)
+  frame_z0_ = st.has("frame_z0") ? st.number("frame_z0") : 0;
   e0_ = st.number("e0");
   bin_ = st.integer("bin");
   bin_sum_ = st.number("bin_sum");

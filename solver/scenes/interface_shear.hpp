@@ -103,6 +103,10 @@ struct InterfaceShearSpec {
   double peak_fraction = 0.05;        // the peak: the largest mean over 5 % of the travel
   double internal_friction_deg = 42;  // φi of Eq 4.7 (the thesis's φi,max)
   double flat_friction = -1;          // μw of Eq 4.7 (< 0: no a_w)
+  /// The frame in z while shearing: held at its height (false), or free (true: it rises
+  /// when grains push its lower edges up, a servo holding its vertical force at zero; §4.3.2
+  /// "the upper frame was free to move").
+  bool frame_free = false;
 };
 
 class InterfaceShear final : public MeasuredProgramme {
@@ -123,6 +127,8 @@ class InterfaceShear final : public MeasuredProgramme {
   /// T: −Σ F_x on the frame and the platen (N); P: the platen's normal force (N).
   double frame_shear_force(const Simulation& sim) const;
   double platen_force(const Simulation& sim) const;
+  /// The frame's vertical load: Σ F_z of its walls (N, up: grains pushing its lower edges).
+  double frame_vertical_force(const Simulation& sim) const;
   /// Σ F over the surface's walls (N).
   Eigen::Vector3d surface_force(const Simulation& sim) const;
   /// Platen underside above the mean surface (m).
@@ -135,7 +141,7 @@ class InterfaceShear final : public MeasuredProgramme {
   InterfaceShearSpec spec_;
   InterfaceShearGeometry g_;
   InterfaceShearWalls w_;
-  double x0_ = 0, h0_ = 0, e0_ = 0;
+  double x0_ = 0, h0_ = 0, e0_ = 0, frame_z0_ = 0;
   // The peak: the largest mean μ over a window `peak_fraction` of the travel wide (one noisy
   // row does not make a peak), the window moved along the travel by a tenth of its width: μ is
   // summed in sub-bins of that tenth, and each window is kWindowBins consecutive sub-bins. The

@@ -358,7 +358,8 @@ void read_lab_sections(const Reader& r, const toml::table& root, Scene& s) {
             "residual_fraction",
             "peak_fraction",
             "internal_friction_deg",
-            "flat_friction"});
+            "flat_friction",
+            "frame"});
     auto& f = s.interface_surface;
     f.kind = r.string(t, sec, "surface", true, "");
     if (f.kind != "saw_tooth" && f.kind != "sinusoid" && f.kind != "flat")
@@ -419,6 +420,10 @@ void read_lab_sections(const Reader& r, const toml::table& root, Scene& s) {
     x.peak_fraction = r.positive(t, sec, "peak_fraction", false, x.peak_fraction);
     if (!(x.peak_fraction <= 0.5))
       r.fail(sec + ".peak_fraction", "must be at most 0.5", value_str(x.peak_fraction));
+    const std::string frame = r.string(t, sec, "frame", false, "held");
+    if (frame != "held" && frame != "free")
+      r.fail(sec + ".frame", "expected \"held\" or \"free\"", frame);
+    x.frame_free = frame == "free";
     x.internal_friction_deg = angle("internal_friction_deg", x.internal_friction_deg);
     if (!(x.internal_friction_deg > 0))
       r.fail(sec + ".internal_friction_deg", "must be positive",

@@ -174,6 +174,60 @@ TEST(InterfaceShear, ResumeIsBitForBit) {
                                       {"history.csv", "curve.csv", "results.csv"}, "trajectory.h5");
 }
 
+// The frame held in z, or free (seed 004 §4.3.2: "the upper frame was free to move"). Without
+// gravity the grains are in vertical balance between the platen, the surface and the frame:
+// surface P = platen P + the frame's load, on the mean over the shearing to 0.5 % (measured
+// 0.05 % and 0.09 %; the rest is the grains' acceleration). A held frame never moves in z; on
+// rough teeth the dilating grains push its lower edges up (8 % of P on the mean here). A free frame
+// rises as they push (its walls are smooth, so a grain can only push them up: its rise never
+// falls), and its servo removes a quarter of its load each step, so it carries a fraction of
+// the held frame's (measured 0.13 of it, 1.1 % of P). A run killed while shearing resumes to the
+// same bits (the frame's start height is in the checkpoint).
+TEST(InterfaceShear, FreeFrameRisesAndCarriesNoLoad) {
+  gs::test::ScratchDir dir("is_free_frame");
+  // (2 mm of travel: the dilating grains reach the frame's edges after about 1.4 mm here)
+  const std::string saw = "surface = \"saw_tooth\"\nroughness = 1.0\nd50_m = 0.001\n";
+  std::ofstream(dir / "held.toml") << scene(saw, "max_displacement_m = 0.002\n");
+  std::ofstream(dir / "free.toml") << scene(saw, "max_displacement_m = 0.002\nframe = \"free\"\n");
+  // The free frame's run is the resume check's uninterrupted one (killed at step 125 000, while
+  // the frame rises; the shearing runs from about step 81 500 to 138 000).
+  gs::test::expect_resume_bit_for_bit(dir.path, (dir / "free.toml").string(), {125000},
+                                      {"history.csv", "curve.csv", "results.csv"}, "trajectory.h5");
+  const auto r = run_cli(
+      "simulate " + (dir / "held.toml").string() + " -q -o " + (dir / "held").string(), dir.path);
+  ASSERT_EQ(r.rc, 0) << r.err;
+  double load[2] = {0, 0}, platen[2] = {0, 0};
+  for (int free = 0; free < 2; ++free) {
+    const std::string name = free ? "free" : "held";
+    const auto c = read_csv_table(dir / (free ? "straight" : "held") / "curve.csv");
+    ASSERT_GE(c.rows.size(), 200u);
+    double balance = 0, n = 0, rise = 0;
+    for (std::size_t i = 0; i < c.rows.size(); ++i) {
+      const double dz = c.num(i, "frame_dz_m");
+      if (free) {
+        EXPECT_GE(dz, rise) << i;
+      } else {
+        EXPECT_EQ(dz, 0.0) << i;
+      }
+      rise = dz;
+      if (c.num(i, "u_m") < 0.2e-3) continue;  // (the first tenth: the loads building up)
+      balance += c.num(i, "surface_P_N") - c.num(i, "P_N") - c.num(i, "frame_P_N");
+      load[free] += c.num(i, "frame_P_N");
+      platen[free] += c.num(i, "P_N");
+      n += 1;
+    }
+    EXPECT_LT(std::abs(balance), 0.005 * platen[free]) << name;
+    if (free) {
+      EXPECT_GT(rise, 0.05e-3);  // (measured 0.23 mm)
+    }
+    load[free] /= n;
+    platen[free] /= n;
+  }
+  EXPECT_GT(load[0], 0.04 * platen[0]);
+  EXPECT_LT(load[1], 0.25 * load[0]);
+  EXPECT_LT(load[1], 0.02 * platen[1]);
+}
+
 TEST(InterfaceShear, BadInputIsOneLine) {
   gs::test::ScratchDir dir("is_bad");
   const std::string saw = "surface = \"saw_tooth\"\nroughness = 1.0\nd50_m = 0.001\n";
@@ -189,6 +243,8 @@ TEST(InterfaceShear, BadInputIsOneLine) {
        {scene("surface = \"bumpy\"\n", u), "interface_shear.surface: expected"},
        {scene(saw, u + "peak_fraction = 0.75\n"),
         "interface_shear.peak_fraction: must be at most 0.5 (0.75)"},
+       {scene(saw, u + "frame = \"floating\"\n"),
+        "interface_shear.frame: expected \"held\" or \"free\" (floating)"},
        {scene(saw + "surface_contact = \"facets\"\n", u),
         "interface_shear.surface_contact: expected \"merged\" or \"yade\" (facets)"},
        {scene(saw, u + "[sweep]\nkey = \"nowhere.roughness\"\nvalues = [1.0]\n"),
