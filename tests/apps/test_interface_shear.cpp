@@ -179,8 +179,9 @@ TEST(InterfaceShear, ResumeIsBitForBit) {
 // surface P = platen P + the frame's load, on the mean over the shearing to 0.5 % (measured
 // 0.05 % and 0.09 %; the rest is the grains' acceleration). A held frame never moves in z; on
 // rough teeth the dilating grains push its lower edges up (8 % of P on the mean here). A free frame
-// rises as they push (its walls are smooth, so a grain can only push them up: its rise never
-// falls), and its servo removes a quarter of its load each step, so it carries a fraction of
+// rises as they push, and never sinks: its walls are smooth, so a grain pushes them along the
+// normal of a lower face (up), a vertical face (level) or a lower edge (up and sideways), never
+// down. Its servo removes a quarter of its load each step, so it carries a fraction of
 // the held frame's (measured 0.13 of it, 1.1 % of P). A run killed while shearing resumes to the
 // same bits (the frame's start height is in the checkpoint).
 TEST(InterfaceShear, FreeFrameRisesAndCarriesNoLoad) {
